@@ -1,0 +1,1 @@
+//! Nonlinear programs: problem builder and solvers (work in progress).

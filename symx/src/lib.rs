@@ -1,0 +1,1 @@
+//! symx: scalar expression graphs.
