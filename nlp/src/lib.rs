@@ -1,1 +1,17 @@
 //! Nonlinear programs: problem builder and solvers (work in progress).
+
+pub mod error;
+pub mod ipm;
+pub mod kkt;
+pub mod log;
+pub mod numeric;
+pub mod options;
+pub mod scaling;
+pub mod solution;
+
+pub use error::SolveError;
+
+pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
+pub use numeric::NumericNlp;
+pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
+pub use solution::{IterationRecord, Solution, Stats, Status};

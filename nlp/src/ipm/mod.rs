@@ -1,0 +1,1 @@
+//! Interior-point method (IPOPT algorithm).

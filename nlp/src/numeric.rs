@@ -1,0 +1,47 @@
+//! The numeric NLP interface solved by the interior-point method (IPOPT's TNLP shape).
+
+use faer::sparse::SymbolicSparseColMat;
+
+/// A nonlinear program given by numeric callbacks:
+///
+/// min f(x)  s.t.  g_l <= g(x) <= g_u,  x_l <= x <= x_u
+///
+/// (`±f64::INFINITY` = no bound; `g_l == g_u` = equality).
+///
+/// Sparse values are written in the storage order of the corresponding pattern: the value
+/// of storage position `p` (an index into `pattern.row_idx()`) goes to `values[p]`.
+/// A non-finite value from any callback signals an evaluation failure; the solver detects
+/// NaN/Inf itself (it cuts the step in the line search, or reports
+/// [`Status::InvalidNumberDetected`](crate::Status::InvalidNumberDetected) at the start).
+pub trait NumericNlp {
+    /// Number of variables `n`.
+    fn n(&self) -> usize;
+    /// Number of constraints `m`.
+    fn m(&self) -> usize;
+    /// Writes variable bounds (length `n`) and constraint bounds (length `m`).
+    fn bounds(&self, x_l: &mut [f64], x_u: &mut [f64], g_l: &mut [f64], g_u: &mut [f64]);
+    /// Writes the starting point (length `n`).
+    fn initial_point(&self, x: &mut [f64]);
+    /// CSC pattern of the m×n constraint Jacobian; `eval_jac_g` writes values in this CSC order.
+    fn jac_g_sparsity(&self) -> &SymbolicSparseColMat<usize>;
+    /// CSC pattern of the LOWER triangle of the n×n Lagrangian Hessian.
+    fn hess_l_sparsity(&self) -> &SymbolicSparseColMat<usize>;
+    /// Objective value f(x).
+    fn eval_f(&mut self, x: &[f64]) -> f64;
+    /// Objective gradient ∇f(x) (length `n`).
+    fn eval_grad_f(&mut self, x: &[f64], grad: &mut [f64]);
+    /// Constraint values g(x) (length `m`).
+    fn eval_g(&mut self, x: &[f64], g: &mut [f64]);
+    /// Jacobian values in `jac_g_sparsity` order.
+    fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]);
+    /// Values of `obj_factor·∇²f(x) + Σ λ_i ∇²g_i(x)`, lower triangle, in `hess_l_sparsity` order.
+    fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]);
+    /// Name of variable `i` for messages (default `x[i]`).
+    fn variable_name(&self, i: usize) -> String {
+        format!("x[{i}]")
+    }
+    /// Name of constraint `i` for messages (default `g[i]`).
+    fn constraint_name(&self, i: usize) -> String {
+        format!("g[{i}]")
+    }
+}

@@ -1,0 +1,457 @@
+//! Options of the interior-point solver. Names and defaults follow IPOPT where the concept
+//! is the same.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::SolveError;
+
+/// Barrier parameter update strategy (IPOPT `mu_strategy`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MuStrategy {
+    /// Fiacco–McCormick monotone decrease (IPOPT's default).
+    Monotone,
+    /// Adaptive μ chosen by an oracle each iteration, globalised by a KKT-error test.
+    Adaptive,
+}
+
+/// Oracle for the adaptive barrier parameter (IPOPT `mu_oracle`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MuOracle {
+    /// Mehrotra's probing heuristic (affine-scaling predictor step).
+    Probing,
+    /// LOQO's centrality rule.
+    Loqo,
+}
+
+/// NLP scaling method (IPOPT `nlp_scaling_method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ScalingMethod {
+    /// No scaling.
+    None,
+    /// Scale f and each g_i so that the max-norm of its gradient at x0 is at most
+    /// `nlp_scaling_max_gradient`.
+    GradientBased,
+}
+
+/// All options of the interior-point method.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IpmOptions {
+    // ---------- termination ----------
+    /// Desired relative (scaled) convergence tolerance. Default 1e-8.
+    pub tol: f64,
+    /// Scaling threshold s_max for the NLP error. Default 100.
+    pub s_max: f64,
+    /// Maximum number of iterations (restoration iterations included). Default 3000.
+    pub max_iter: usize,
+    /// Maximum wall-clock time in seconds. Default 1e20.
+    pub max_wall_time: f64,
+    /// Absolute tolerance on (unscaled) dual infeasibility. Default 1.
+    pub dual_inf_tol: f64,
+    /// Absolute tolerance on (unscaled) constraint violation. Default 1e-4.
+    pub constr_viol_tol: f64,
+    /// Absolute tolerance on (unscaled) complementarity. Default 1e-4.
+    pub compl_inf_tol: f64,
+    /// "Acceptable" relative convergence tolerance. Default 1e-6.
+    pub acceptable_tol: f64,
+    /// Number of consecutive acceptable iterates before stopping. Default 15 (0 disables).
+    pub acceptable_iter: usize,
+    /// Acceptable dual infeasibility. Default 1e10.
+    pub acceptable_dual_inf_tol: f64,
+    /// Acceptable constraint violation. Default 1e-2.
+    pub acceptable_constr_viol_tol: f64,
+    /// Acceptable complementarity. Default 1e-2.
+    pub acceptable_compl_inf_tol: f64,
+    /// Acceptable relative objective change between iterations. Default 1e20.
+    pub acceptable_obj_change_tol: f64,
+    /// Iterates with a component larger than this in magnitude are diverging. Default 1e20.
+    pub diverging_iterates_tol: f64,
+    // ---------- barrier parameter ----------
+    /// Barrier parameter update strategy. Default monotone.
+    pub mu_strategy: MuStrategy,
+    /// Oracle for the adaptive strategy. Default probing.
+    pub mu_oracle: MuOracle,
+    /// Initial barrier parameter. Default 0.1.
+    pub mu_init: f64,
+    /// Maximum barrier parameter (adaptive strategy). Default 1e5.
+    pub mu_max: f64,
+    /// Minimum barrier parameter. Default 1e-11.
+    pub mu_min: f64,
+    /// κ_ε: the subproblem is solved when its error is below κ_ε·μ. Default 10.
+    pub barrier_tol_factor: f64,
+    /// κ_μ: linear decrease factor of μ. Default 0.2.
+    pub mu_linear_decrease_factor: f64,
+    /// θ_μ: superlinear decrease power of μ. Default 1.5.
+    pub mu_superlinear_decrease_power: f64,
+    /// Allow several μ decreases at one iterate. Default true.
+    pub mu_allow_fast_monotone_decrease: bool,
+    /// Lower bound of the fraction-to-the-boundary parameter τ. Default 0.99.
+    pub tau_min: f64,
+    /// Required KKT-error reduction factor in adaptive free mode. Default 0.9999.
+    pub adaptive_mu_kkterror_red_fact: f64,
+    /// Number of reference KKT errors kept in adaptive free mode. Default 4.
+    pub adaptive_mu_kkterror_red_iters: usize,
+    /// μ = this × average complementarity when switching to monotone mode. Default 0.8.
+    pub adaptive_mu_monotone_init_factor: f64,
+    // ---------- scaling ----------
+    /// NLP scaling method. Default gradient-based.
+    pub nlp_scaling_method: ScalingMethod,
+    /// Maximum gradient after scaling. Default 100.
+    pub nlp_scaling_max_gradient: f64,
+    /// Minimum scaling factor. Default 1e-8.
+    pub nlp_scaling_min_value: f64,
+    /// User objective scaling factor (multiplies the automatic one). Default 1.
+    pub obj_scaling_factor: f64,
+    // ---------- initialisation ----------
+    /// Absolute push of the initial point into the interior. Default 1e-2.
+    pub bound_push: f64,
+    /// Relative push of the initial point into the interior. Default 1e-2.
+    pub bound_frac: f64,
+    /// Absolute push of initial slacks. Default 1e-2.
+    pub slack_bound_push: f64,
+    /// Relative push of initial slacks. Default 1e-2.
+    pub slack_bound_frac: f64,
+    /// Relative relaxation of all bounds. Default 1e-8.
+    pub bound_relax_factor: f64,
+    /// Initial bound multipliers. Default 1.
+    pub bound_mult_init_val: f64,
+    /// Least-squares multipliers larger than this are discarded (set to 0). Default 1e3.
+    pub constr_mult_init_max: f64,
+    /// Use the warm-start initialisation in [`Ipm::solve_warm`](crate::ipm::Ipm::solve_warm).
+    /// Default false (then only the primal point of the previous solution is reused).
+    pub warm_start_init_point: bool,
+    /// Absolute bound push for warm starts. Default 1e-3.
+    pub warm_start_bound_push: f64,
+    /// Relative bound push for warm starts. Default 1e-3.
+    pub warm_start_bound_frac: f64,
+    /// Absolute slack push for warm starts. Default 1e-3.
+    pub warm_start_slack_bound_push: f64,
+    /// Relative slack push for warm starts. Default 1e-3.
+    pub warm_start_slack_bound_frac: f64,
+    /// Minimum bound multiplier for warm starts. Default 1e-3.
+    pub warm_start_mult_bound_push: f64,
+    /// Initial μ for warm starts (IPOPT users set mu_init small). Default 1e-6.
+    pub warm_start_mu_init: f64,
+    // ---------- line search ----------
+    /// Maximum number of second-order corrections. Default 4.
+    pub max_soc: usize,
+    /// κ_soc: required reduction of the infeasibility in each SOC. Default 0.99.
+    pub kappa_soc: f64,
+    /// θ_max = theta_max_fact·max(1, θ(x0)). Default 1e4.
+    pub theta_max_fact: f64,
+    /// θ_min = theta_min_fact·max(1, θ(x0)). Default 1e-4.
+    pub theta_min_fact: f64,
+    /// η_φ: Armijo relaxation. Default 1e-8.
+    pub eta_phi: f64,
+    /// δ of the switching condition. Default 1.
+    pub delta: f64,
+    /// s_φ of the switching condition. Default 2.3.
+    pub s_phi: f64,
+    /// s_θ of the switching condition. Default 1.1.
+    pub s_theta: f64,
+    /// γ_φ: filter margin on the barrier function. Default 1e-8.
+    pub gamma_phi: f64,
+    /// γ_θ: filter margin on the infeasibility. Default 1e-5.
+    pub gamma_theta: f64,
+    /// γ_α: safety factor for the minimal step size. Default 0.05.
+    pub alpha_min_frac: f64,
+    /// Backtracking factor. Default 0.5.
+    pub alpha_red_factor: f64,
+    /// κ_Σ: bound-multiplier safeguard. Default 1e10.
+    pub kappa_sigma: f64,
+    /// Relative step size below which a step is "tiny". Default 10·ε_mach.
+    pub tiny_step_tol: f64,
+    /// Dual step size below which a tiny step ends the run. Default 1e-2.
+    pub tiny_step_y_tol: f64,
+    // ---------- linear algebra / inertia correction ----------
+    /// δ_w^0: first Hessian perturbation. Default 1e-4.
+    pub first_hessian_perturbation: f64,
+    /// δ_w^min. Default 1e-20.
+    pub min_hessian_perturbation: f64,
+    /// δ_w^max. Default 1e40.
+    pub max_hessian_perturbation: f64,
+    /// κ̄_w^+: increase factor for the first perturbation. Default 100.
+    pub perturb_inc_fact_first: f64,
+    /// κ_w^+: increase factor. Default 8.
+    pub perturb_inc_fact: f64,
+    /// κ_w^-: decrease factor. Default 1/3.
+    pub perturb_dec_fact: f64,
+    /// δ_c base value δ̄_c (δ_c = δ̄_c·μ^κ_c). Default 1e-8.
+    pub jacobian_regularization_value: f64,
+    /// κ_c. Default 0.25.
+    pub jacobian_regularization_exponent: f64,
+    /// Static regularisation always applied to the constraint block (faer's unpivoted
+    /// LDLᵀ needs a non-zero (2,2) block); iterative refinement removes its effect on the
+    /// step. Default 1e-8.
+    pub kkt_static_regularization: f64,
+    /// Minimum iterative-refinement steps. Default 1.
+    pub min_refinement_steps: usize,
+    /// Maximum iterative-refinement steps. Default 10.
+    pub max_refinement_steps: usize,
+    /// Target relative residual of the linear solves. Default 1e-10.
+    pub residual_ratio_max: f64,
+    // ---------- restoration ----------
+    /// κ_resto: required infeasibility reduction in restoration. Default 0.9.
+    pub required_infeasibility_reduction: f64,
+    /// ρ: ℓ1 penalty of the restoration problem. Default 1000.
+    pub resto_penalty_parameter: f64,
+    /// Weight of the proximity term ζ = weight·√μ. Default 1.
+    pub resto_proximity_weight: f64,
+    /// Maximum iterations of one restoration phase. Default 3000.
+    pub max_resto_iter: usize,
+    /// Bound multipliers larger than this are reset to 1 after restoration. Default 1e3.
+    pub bound_mult_reset_threshold: f64,
+    /// Start with a restoration phase. Default false.
+    pub start_with_resto: bool,
+    // ---------- output ----------
+    /// 0: silent; ≥ 3: summary; ≥ 5: iteration table. Default 0.
+    pub print_level: u8,
+}
+
+impl Default for IpmOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-8,
+            s_max: 100.0,
+            max_iter: 3000,
+            max_wall_time: 1e20,
+            dual_inf_tol: 1.0,
+            constr_viol_tol: 1e-4,
+            compl_inf_tol: 1e-4,
+            acceptable_tol: 1e-6,
+            acceptable_iter: 15,
+            acceptable_dual_inf_tol: 1e10,
+            acceptable_constr_viol_tol: 1e-2,
+            acceptable_compl_inf_tol: 1e-2,
+            acceptable_obj_change_tol: 1e20,
+            diverging_iterates_tol: 1e20,
+            mu_strategy: MuStrategy::Monotone,
+            mu_oracle: MuOracle::Probing,
+            mu_init: 0.1,
+            mu_max: 1e5,
+            mu_min: 1e-11,
+            barrier_tol_factor: 10.0,
+            mu_linear_decrease_factor: 0.2,
+            mu_superlinear_decrease_power: 1.5,
+            mu_allow_fast_monotone_decrease: true,
+            tau_min: 0.99,
+            adaptive_mu_kkterror_red_fact: 0.9999,
+            adaptive_mu_kkterror_red_iters: 4,
+            adaptive_mu_monotone_init_factor: 0.8,
+            nlp_scaling_method: ScalingMethod::GradientBased,
+            nlp_scaling_max_gradient: 100.0,
+            nlp_scaling_min_value: 1e-8,
+            obj_scaling_factor: 1.0,
+            bound_push: 1e-2,
+            bound_frac: 1e-2,
+            slack_bound_push: 1e-2,
+            slack_bound_frac: 1e-2,
+            bound_relax_factor: 1e-8,
+            bound_mult_init_val: 1.0,
+            constr_mult_init_max: 1e3,
+            warm_start_init_point: false,
+            warm_start_bound_push: 1e-3,
+            warm_start_bound_frac: 1e-3,
+            warm_start_slack_bound_push: 1e-3,
+            warm_start_slack_bound_frac: 1e-3,
+            warm_start_mult_bound_push: 1e-3,
+            warm_start_mu_init: 1e-6,
+            max_soc: 4,
+            kappa_soc: 0.99,
+            theta_max_fact: 1e4,
+            theta_min_fact: 1e-4,
+            eta_phi: 1e-8,
+            delta: 1.0,
+            s_phi: 2.3,
+            s_theta: 1.1,
+            gamma_phi: 1e-8,
+            gamma_theta: 1e-5,
+            alpha_min_frac: 0.05,
+            alpha_red_factor: 0.5,
+            kappa_sigma: 1e10,
+            tiny_step_tol: 10.0 * f64::EPSILON,
+            tiny_step_y_tol: 1e-2,
+            first_hessian_perturbation: 1e-4,
+            min_hessian_perturbation: 1e-20,
+            max_hessian_perturbation: 1e40,
+            perturb_inc_fact_first: 100.0,
+            perturb_inc_fact: 8.0,
+            perturb_dec_fact: 1.0 / 3.0,
+            jacobian_regularization_value: 1e-8,
+            jacobian_regularization_exponent: 0.25,
+            kkt_static_regularization: 1e-8,
+            min_refinement_steps: 1,
+            max_refinement_steps: 10,
+            residual_ratio_max: 1e-10,
+            required_infeasibility_reduction: 0.9,
+            resto_penalty_parameter: 1000.0,
+            resto_proximity_weight: 1.0,
+            max_resto_iter: 3000,
+            bound_mult_reset_threshold: 1e3,
+            start_with_resto: false,
+            print_level: 0,
+        }
+    }
+}
+
+fn bad(field: &'static str, reason: impl Into<String>) -> SolveError {
+    SolveError::InvalidOption {
+        field,
+        reason: reason.into(),
+    }
+}
+
+impl IpmOptions {
+    /// Checks every option; the error names the first bad field.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        macro_rules! positive {
+            ($($f:ident),*) => {$(
+                if !(self.$f > 0.0) || !self.$f.is_finite() {
+                    return Err(bad(stringify!($f), format!("must be finite and > 0, got {}", self.$f)));
+                }
+            )*};
+        }
+        macro_rules! nonneg {
+            ($($f:ident),*) => {$(
+                if !(self.$f >= 0.0) || !self.$f.is_finite() {
+                    return Err(bad(stringify!($f), format!("must be finite and >= 0, got {}", self.$f)));
+                }
+            )*};
+        }
+        macro_rules! open_unit {
+            ($($f:ident),*) => {$(
+                if !(self.$f > 0.0 && self.$f < 1.0) {
+                    return Err(bad(stringify!($f), format!("must be in (0, 1), got {}", self.$f)));
+                }
+            )*};
+        }
+        positive!(
+            tol,
+            s_max,
+            max_wall_time,
+            dual_inf_tol,
+            constr_viol_tol,
+            compl_inf_tol,
+            acceptable_tol,
+            acceptable_dual_inf_tol,
+            acceptable_constr_viol_tol,
+            acceptable_compl_inf_tol,
+            acceptable_obj_change_tol,
+            diverging_iterates_tol,
+            mu_init,
+            mu_max,
+            mu_min,
+            barrier_tol_factor,
+            nlp_scaling_max_gradient,
+            nlp_scaling_min_value,
+            obj_scaling_factor,
+            bound_mult_init_val,
+            warm_start_bound_push,
+            warm_start_bound_frac,
+            warm_start_slack_bound_push,
+            warm_start_slack_bound_frac,
+            warm_start_mult_bound_push,
+            warm_start_mu_init,
+            theta_max_fact,
+            theta_min_fact,
+            delta,
+            first_hessian_perturbation,
+            min_hessian_perturbation,
+            max_hessian_perturbation,
+            perturb_inc_fact_first,
+            perturb_inc_fact,
+            resto_penalty_parameter,
+            bound_mult_reset_threshold,
+            residual_ratio_max,
+            kkt_static_regularization
+        );
+        nonneg!(
+            bound_push,
+            bound_frac,
+            slack_bound_push,
+            slack_bound_frac,
+            bound_relax_factor,
+            constr_mult_init_max,
+            tiny_step_tol,
+            tiny_step_y_tol,
+            jacobian_regularization_value,
+            jacobian_regularization_exponent,
+            resto_proximity_weight
+        );
+        open_unit!(
+            mu_linear_decrease_factor,
+            tau_min,
+            adaptive_mu_kkterror_red_fact,
+            adaptive_mu_monotone_init_factor,
+            kappa_soc,
+            eta_phi,
+            gamma_phi,
+            gamma_theta,
+            alpha_min_frac,
+            alpha_red_factor,
+            perturb_dec_fact,
+            required_infeasibility_reduction
+        );
+        if !(self.mu_superlinear_decrease_power > 1.0 && self.mu_superlinear_decrease_power < 2.0) {
+            return Err(bad("mu_superlinear_decrease_power", "must be in (1, 2)"));
+        }
+        if !(self.s_phi > 1.0) || !self.s_phi.is_finite() {
+            return Err(bad("s_phi", "must be > 1"));
+        }
+        if !(self.s_theta > 1.0) || !self.s_theta.is_finite() {
+            return Err(bad("s_theta", "must be > 1"));
+        }
+        if self.mu_min > self.mu_init {
+            return Err(bad("mu_min", "must not exceed mu_init"));
+        }
+        if self.mu_max < self.mu_init {
+            return Err(bad("mu_max", "must not be below mu_init"));
+        }
+        if self.bound_frac > 0.5 {
+            return Err(bad("bound_frac", "must be <= 0.5"));
+        }
+        if self.slack_bound_frac > 0.5 {
+            return Err(bad("slack_bound_frac", "must be <= 0.5"));
+        }
+        if self.warm_start_bound_frac > 0.5 {
+            return Err(bad("warm_start_bound_frac", "must be <= 0.5"));
+        }
+        if self.warm_start_slack_bound_frac > 0.5 {
+            return Err(bad("warm_start_slack_bound_frac", "must be <= 0.5"));
+        }
+        if self.bound_push == 0.0 && self.bound_frac == 0.0 {
+            return Err(bad(
+                "bound_push",
+                "bound_push and bound_frac cannot both be 0",
+            ));
+        }
+        if self.min_hessian_perturbation > self.max_hessian_perturbation {
+            return Err(bad(
+                "min_hessian_perturbation",
+                "must not exceed max_hessian_perturbation",
+            ));
+        }
+        if self.perturb_inc_fact <= 1.0 {
+            return Err(bad("perturb_inc_fact", "must be > 1"));
+        }
+        if self.perturb_inc_fact_first <= 1.0 {
+            return Err(bad("perturb_inc_fact_first", "must be > 1"));
+        }
+        if self.adaptive_mu_kkterror_red_iters == 0 {
+            return Err(bad("adaptive_mu_kkterror_red_iters", "must be >= 1"));
+        }
+        if self.min_refinement_steps > self.max_refinement_steps {
+            return Err(bad(
+                "min_refinement_steps",
+                "must not exceed max_refinement_steps",
+            ));
+        }
+        if self.acceptable_tol < self.tol {
+            return Err(bad("acceptable_tol", "must be >= tol"));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,141 @@
+//! Results of a solve: status, primal/dual point, statistics and iteration records.
+
+use serde::{Deserialize, Serialize};
+
+/// Outcome of a solve (IPOPT's return-code vocabulary).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Status {
+    /// Converged to the requested tolerances.
+    SolveSucceeded,
+    /// Converged to the "acceptable" tolerances only.
+    SolvedToAcceptableLevel,
+    /// The iterates converged to a local minimiser of the infeasibility: the problem is
+    /// (locally) infeasible.
+    InfeasibleProblemDetected,
+    /// The search direction became negligibly small before convergence.
+    SearchDirectionBecomesTooSmall,
+    /// The iterates grew beyond `diverging_iterates_tol` (problem possibly unbounded).
+    DivergingIterates,
+    /// A user callback asked to stop.
+    UserRequestedStop,
+    /// A feasible point was found (feasibility-only problems).
+    FeasiblePointFound,
+    /// `max_iter` was reached.
+    MaximumIterationsExceeded,
+    /// The feasibility restoration phase failed.
+    RestorationFailed,
+    /// The linear system could not be solved (inertia correction failed).
+    ErrorInStepComputation,
+    /// `max_wall_time` was reached.
+    MaximumWallTimeExceeded,
+    /// A callback returned NaN/Inf at a point where the solver could not recover.
+    InvalidNumberDetected,
+    /// Fewer free variables than equality constraints.
+    NotEnoughDegreesOfFreedom,
+    /// An internal error.
+    InternalError,
+}
+
+impl Status {
+    /// True for `SolveSucceeded`, `SolvedToAcceptableLevel` and `FeasiblePointFound`.
+    pub fn is_success(self) -> bool {
+        matches!(
+            self,
+            Status::SolveSucceeded | Status::SolvedToAcceptableLevel | Status::FeasiblePointFound
+        )
+    }
+}
+
+/// One row of the IPOPT-style iteration table.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IterationRecord {
+    /// Iteration number.
+    pub iter: usize,
+    /// True during the feasibility restoration phase (printed as 'r').
+    pub restoration: bool,
+    /// Unscaled objective (the original objective also during restoration).
+    pub objective: f64,
+    /// Unscaled constraint violation (max-norm).
+    pub inf_pr: f64,
+    /// Scaled dual infeasibility (max-norm).
+    pub inf_du: f64,
+    /// Barrier parameter μ (printed as lg(mu)).
+    pub mu: f64,
+    /// Max-norm of the primal step.
+    pub d_norm: f64,
+    /// Hessian regularisation δ_w used for the step (0: none; printed as lg(rg)).
+    pub regularization: f64,
+    /// Dual step size.
+    pub alpha_du: f64,
+    /// Primal step size.
+    pub alpha_pr: f64,
+    /// IPOPT's step-type character after alpha_pr: 'f' (f-type), 'h' (h-type), upper
+    /// case with second-order correction, 'r' after restoration, 't' tiny step, ' ' for
+    /// the initial row.
+    pub alpha_pr_char: char,
+    /// Number of line-search trials.
+    pub ls: usize,
+}
+
+/// Counters and timers of a solve.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Stats {
+    /// Number of iterations (including restoration iterations).
+    pub iterations: usize,
+    /// Iterations spent in restoration.
+    pub restoration_iterations: usize,
+    /// One record per iteration (row 0 is the starting point).
+    pub records: Vec<IterationRecord>,
+    /// Objective evaluations.
+    pub n_eval_f: usize,
+    /// Objective-gradient evaluations.
+    pub n_eval_grad_f: usize,
+    /// Constraint evaluations.
+    pub n_eval_g: usize,
+    /// Jacobian evaluations.
+    pub n_eval_jac_g: usize,
+    /// Hessian evaluations.
+    pub n_eval_hess_l: usize,
+    /// Numeric KKT factorisations.
+    pub n_factorizations: usize,
+    /// Largest Hessian regularisation δ_w used (0: none).
+    pub max_regularization: f64,
+    /// Seconds in user callbacks.
+    pub eval_seconds: f64,
+    /// Seconds in KKT factorisations and solves.
+    pub factor_seconds: f64,
+    /// Total wall-clock seconds.
+    pub total_seconds: f64,
+    /// Seconds in everything else.
+    pub other_seconds: f64,
+    /// Objective scaling factor used.
+    pub obj_scaling: f64,
+}
+
+/// Result of a solve. Multipliers use IPOPT's sign convention:
+/// ∇f(x) + ∇g(x)ᵀλ − z_L + z_U = 0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Solution {
+    /// Outcome.
+    pub status: Status,
+    /// Primal point (length n).
+    pub x: Vec<f64>,
+    /// Constraint multipliers (length m).
+    pub lambda: Vec<f64>,
+    /// Lower-bound multipliers (length n, ≥ 0).
+    pub z_l: Vec<f64>,
+    /// Upper-bound multipliers (length n, ≥ 0).
+    pub z_u: Vec<f64>,
+    /// Constraint values g(x) (length m).
+    pub g: Vec<f64>,
+    /// Objective f(x).
+    pub objective: f64,
+    /// Unscaled constraint violation (max-norm, bounds of g and x).
+    pub constr_viol: f64,
+    /// Unscaled dual infeasibility (max-norm).
+    pub dual_inf: f64,
+    /// Unscaled complementarity (max-norm).
+    pub compl: f64,
+    /// Statistics.
+    pub stats: Stats,
+}
