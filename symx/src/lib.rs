@@ -1,1 +1,41 @@
-//! symx: scalar expression graphs.
+//! symx: a small CasADi-like scalar expression graph.
+//!
+//! * [`Expr`]: scalar expressions with operator overloading (`f64` on either side) and
+//!   the usual math functions; [`Matrix`]: dense matrices and vectors of them.
+//! * Automatic differentiation producing expressions: [`forward`], [`reverse`],
+//!   [`gradient`], [`jacobian`], [`hessian`], [`lagrangian_hessian`].
+//! * Structural sparsity ([`Sparsity`], faer's CSC pattern).
+//! * [`Function`]: compilation to an allocation-free, `Send + Sync` evaluator.
+//!
+//! ```
+//! use symx::{Function, Matrix, gradient};
+//! let x = Matrix::sym_vec("x", 2);
+//! let f = (1.0 - x[0]).sq() + 100.0 * (x[1] - x[0].sq()).sq(); // Rosenbrock
+//! let grad = gradient(f, &x).unwrap();
+//! let fun = Function::new(&[&x], &[&[f], &grad]).unwrap();
+//! let out = fun.call(&[&[1.0, 1.0]]).unwrap();
+//! assert_eq!(out, vec![vec![0.0], vec![0.0, 0.0]]);
+//! ```
+//!
+//! Expressions live in a graph owned by the current thread; a compiled [`Function`] is
+//! independent of it and can be shared across threads.
+mod ad;
+mod display;
+mod error;
+mod expr;
+mod function;
+mod graph;
+mod matrix;
+mod op;
+mod simplify;
+pub mod sparsity;
+
+pub use ad::{forward, gradient, hessian, jacobian, lagrangian_hessian, reverse};
+pub use display::parse;
+pub use error::SymxError;
+pub use expr::{and, eq, ge, gt, if_else, le, lt, ne, not, or, Expr};
+pub use function::Function;
+pub use graph::node_count;
+pub use matrix::{Matrix, SparseMatrix};
+pub use op::Op;
+pub use sparsity::Sparsity;

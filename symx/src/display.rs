@@ -1,0 +1,360 @@
+//! Printing expressions, and parsing the printed form back.
+//!
+//! The printed form is fully parenthesised: `+ − * /` are infix, negation is `(-x)`, every
+//! other operation is a call such as `pow(x,3)` or `if_else(c,a,b)`. A subexpression used
+//! more than once is printed once as a binding `@1=...; ` before the result, as CasADi does,
+//! so that printing a graph with sharing stays linear in its size. [`parse`] reads this
+//! form back into the identical expression (same node).
+use crate::error::SymxError;
+use crate::expr::Expr;
+use crate::graph::{self, Graph};
+use crate::op::Op;
+use rustc_hash::FxHashMap;
+use std::fmt::{self, Write};
+
+fn infix(op: Op) -> Option<char> {
+    match op {
+        Op::Add => Some('+'),
+        Op::Sub => Some('-'),
+        Op::Mul => Some('*'),
+        Op::Div => Some('/'),
+        _ => None,
+    }
+}
+
+fn write_constant(out: &mut impl Write, v: f64) -> fmt::Result {
+    if v == v.trunc() && v.abs() < 1e15 {
+        write!(out, "{}", v as i64)
+    } else {
+        write!(out, "{v:?}")
+    }
+}
+
+enum Task {
+    Node(u32),
+    Text(&'static str),
+}
+
+/// Writes `root` with shared subexpressions bound to `@k` names.
+fn write_expr(g: &Graph, root: u32, out: &mut impl Write) -> fmt::Result {
+    // Count uses of each interior node inside the tree of `root`, iteratively.
+    let mut uses: FxHashMap<u32, u32> = FxHashMap::default();
+    let mut stack = vec![root];
+    while let Some(id) = stack.pop() {
+        let n = g.node(id);
+        if n.op.arity() == 0 {
+            continue;
+        }
+        let count = uses.entry(id).or_insert(0);
+        *count += 1;
+        if *count == 1 {
+            stack.extend_from_slice(n.operands());
+        }
+    }
+    // Shared nodes in ascending (topological) order get bindings.
+    let mut shared: Vec<u32> = uses
+        .iter()
+        .filter(|&(&id, &c)| c > 1 && id != root)
+        .map(|(&id, _)| id)
+        .collect();
+    shared.sort_unstable();
+    let mut names: FxHashMap<u32, usize> = FxHashMap::default();
+    for (k, &id) in shared.iter().enumerate() {
+        write!(out, "@{}=", k + 1)?;
+        write_tree(g, id, &names, out)?;
+        out.write_str("; ")?;
+        names.insert(id, k + 1);
+    }
+    write_tree(g, root, &names, out)
+}
+
+fn write_tree(
+    g: &Graph,
+    root: u32,
+    names: &FxHashMap<u32, usize>,
+    out: &mut impl Write,
+) -> fmt::Result {
+    let mut tasks = vec![Task::Node(root)];
+    let mut top = true;
+    while let Some(task) = tasks.pop() {
+        let id = match task {
+            Task::Text(t) => {
+                out.write_str(t)?;
+                continue;
+            }
+            Task::Node(id) => id,
+        };
+        let n = g.node(id);
+        if !top {
+            if let Some(k) = names.get(&id) {
+                write!(out, "@{k}")?;
+                continue;
+            }
+        }
+        top = false;
+        match n.op {
+            Op::Const => write_constant(out, n.value().unwrap_or(f64::NAN))?,
+            Op::Sym => out.write_str(g.symbol_name(id))?,
+            Op::Neg => {
+                out.write_str("(-")?;
+                tasks.push(Task::Text(")"));
+                tasks.push(Task::Node(n.args[0]));
+            }
+            op => {
+                let args = n.operands();
+                if let Some(c) = infix(op) {
+                    out.write_char('(')?;
+                    tasks.push(Task::Text(")"));
+                    tasks.push(Task::Node(args[1]));
+                    tasks.push(Task::Text(match c {
+                        '+' => "+",
+                        '-' => "-",
+                        '*' => "*",
+                        _ => "/",
+                    }));
+                    tasks.push(Task::Node(args[0]));
+                } else {
+                    out.write_str(op.name())?;
+                    out.write_char('(')?;
+                    tasks.push(Task::Text(")"));
+                    for (i, &a) in args.iter().enumerate().rev() {
+                        tasks.push(Task::Node(a));
+                        if i > 0 {
+                            tasks.push(Task::Text(","));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Render into a string first: the graph must not stay borrowed while the
+        // formatter runs user code.
+        let mut s = String::new();
+        graph::with(|g| write_expr(g, self.id, &mut s))?;
+        f.write_str(&s)
+    }
+}
+
+/// Parses the printed form of an expression, resolving names against `symbols`.
+///
+/// `parse(&e.to_string(), symbols)` returns `e` itself (the same node) when `symbols`
+/// holds every symbol of `e` under distinct names.
+pub fn parse(text: &str, symbols: &[Expr]) -> Result<Expr, SymxError> {
+    let mut by_name = FxHashMap::default();
+    for &s in symbols {
+        let name = s.name().ok_or_else(|| SymxError::NotASymbol {
+            what: "parse symbol table".into(),
+            index: by_name.len(),
+        })?;
+        by_name.insert(name, s);
+    }
+    let mut p = Parser {
+        s: text.as_bytes(),
+        pos: 0,
+        by_name,
+        bindings: FxHashMap::default(),
+        depth: 0,
+    };
+    loop {
+        p.skip_ws();
+        if p.peek() == Some(b'@') && p.s[p.pos..].contains(&b'=') && p.is_binding() {
+            p.pos += 1;
+            let k = p.integer()?;
+            p.expect(b'=')?;
+            let e = p.expr()?;
+            p.expect(b';')?;
+            p.bindings.insert(k, e);
+        } else {
+            break;
+        }
+    }
+    let e = p.expr()?;
+    p.skip_ws();
+    if p.pos != p.s.len() {
+        return Err(p.error("unexpected trailing text"));
+    }
+    Ok(e)
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    pos: usize,
+    by_name: FxHashMap<String, Expr>,
+    bindings: FxHashMap<usize, Expr>,
+    depth: usize,
+}
+
+const MAX_DEPTH: usize = 10_000;
+
+impl Parser<'_> {
+    fn error(&self, msg: &str) -> SymxError {
+        SymxError::Parse {
+            position: self.pos,
+            message: msg.to_string(),
+        }
+    }
+    fn skip_ws(&mut self) {
+        while self.pos < self.s.len() && self.s[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+    }
+    fn peek(&mut self) -> Option<u8> {
+        self.skip_ws();
+        self.s.get(self.pos).copied()
+    }
+    fn expect(&mut self, c: u8) -> Result<(), SymxError> {
+        if self.peek() == Some(c) {
+            self.pos += 1;
+            Ok(())
+        } else {
+            Err(self.error(&format!("expected '{}'", c as char)))
+        }
+    }
+    /// Whether the text at `pos` is `@k=` (a binding) rather than a use of `@k`.
+    fn is_binding(&self) -> bool {
+        let mut i = self.pos + 1;
+        while i < self.s.len() && self.s[i].is_ascii_digit() {
+            i += 1;
+        }
+        self.s.get(i) == Some(&b'=')
+    }
+    fn integer(&mut self) -> Result<usize, SymxError> {
+        let start = self.pos;
+        while self.pos < self.s.len() && self.s[self.pos].is_ascii_digit() {
+            self.pos += 1;
+        }
+        std::str::from_utf8(&self.s[start..self.pos])
+            .ok()
+            .and_then(|t| t.parse().ok())
+            .ok_or_else(|| self.error("expected an integer"))
+    }
+    fn expr(&mut self) -> Result<Expr, SymxError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(self.error("expression nested too deeply"));
+        }
+        let mut e = self.term()?;
+        while let Some(c @ (b'+' | b'-')) = self.peek() {
+            self.pos += 1;
+            let r = self.term()?;
+            e = if c == b'+' { e + r } else { e - r };
+        }
+        self.depth -= 1;
+        Ok(e)
+    }
+    fn term(&mut self) -> Result<Expr, SymxError> {
+        let mut e = self.unary()?;
+        while let Some(c @ (b'*' | b'/')) = self.peek() {
+            self.pos += 1;
+            let r = self.unary()?;
+            e = if c == b'*' { e * r } else { e / r };
+        }
+        Ok(e)
+    }
+    fn unary(&mut self) -> Result<Expr, SymxError> {
+        if self.peek() == Some(b'-') {
+            self.pos += 1;
+            return Ok(-self.unary()?);
+        }
+        self.primary()
+    }
+    fn primary(&mut self) -> Result<Expr, SymxError> {
+        match self.peek() {
+            Some(b'(') => {
+                self.pos += 1;
+                let e = self.expr()?;
+                self.expect(b')')?;
+                Ok(e)
+            }
+            Some(b'@') => {
+                self.pos += 1;
+                let k = self.integer()?;
+                self.bindings
+                    .get(&k)
+                    .copied()
+                    .ok_or_else(|| self.error(&format!("unknown binding @{k}")))
+            }
+            Some(c) if c.is_ascii_digit() || c == b'.' => self.number(),
+            Some(c) if c.is_ascii_alphabetic() || c == b'_' => {
+                let start = self.pos;
+                while self.pos < self.s.len() {
+                    let c = self.s[self.pos];
+                    if c.is_ascii_alphanumeric() || matches!(c, b'_' | b'.') {
+                        self.pos += 1;
+                    } else if c == b'[' {
+                        // Indexed names such as `x[3]` or `A[1,2]`.
+                        match self.s[self.pos..].iter().position(|&c| c == b']') {
+                            Some(close) => self.pos += close + 1,
+                            None => return Err(self.error("unclosed '['")),
+                        }
+                    } else {
+                        break;
+                    }
+                }
+                let name = String::from_utf8_lossy(&self.s[start..self.pos]).into_owned();
+                if self.peek() == Some(b'(') {
+                    return self.call(&name);
+                }
+                match name.as_str() {
+                    "inf" => return Ok(Expr::constant(f64::INFINITY)),
+                    "NaN" => return Ok(Expr::constant(f64::NAN)),
+                    _ => {}
+                }
+                self.by_name
+                    .get(&name)
+                    .copied()
+                    .ok_or_else(|| self.error(&format!("unknown symbol '{name}'")))
+            }
+            _ => Err(self.error("expected an expression")),
+        }
+    }
+    fn number(&mut self) -> Result<Expr, SymxError> {
+        let start = self.pos;
+        while self.pos < self.s.len() {
+            let c = self.s[self.pos];
+            let exp_sign = matches!(c, b'+' | b'-')
+                && self.pos > start
+                && matches!(self.s[self.pos - 1], b'e' | b'E');
+            if c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'E') || exp_sign {
+                self.pos += 1;
+            } else {
+                break;
+            }
+        }
+        std::str::from_utf8(&self.s[start..self.pos])
+            .ok()
+            .and_then(|t| t.parse::<f64>().ok())
+            .map(Expr::constant)
+            .ok_or_else(|| self.error("malformed number"))
+    }
+    fn call(&mut self, name: &str) -> Result<Expr, SymxError> {
+        let op = Op::WITH_OPERANDS
+            .iter()
+            .copied()
+            .find(|op| op.name() == name)
+            .ok_or_else(|| self.error(&format!("unknown function '{name}'")))?;
+        self.expect(b'(')?;
+        let mut args = Vec::with_capacity(3);
+        loop {
+            args.push(self.expr()?.id);
+            match self.peek() {
+                Some(b',') => self.pos += 1,
+                _ => break,
+            }
+        }
+        self.expect(b')')?;
+        if args.len() != op.arity() {
+            return Err(self.error(&format!(
+                "'{name}' takes {} arguments, got {}",
+                op.arity(),
+                args.len()
+            )));
+        }
+        Ok(Expr::from_id(graph::with(|g| g.make(op, &args))))
+    }
+}

@@ -1,0 +1,131 @@
+//! The expression arena: nodes stored in a thread-local vector, children before parents.
+//!
+//! Every node is identified by a `u32` index. Nodes are hash-consed when created (a
+//! structurally identical node is never stored twice), so common subexpressions are shared
+//! by construction and constants are interned. Because a node can only refer to nodes that
+//! already exist, ascending index order is a topological order of the whole graph; every
+//! traversal in this crate relies on that and none of them recurses.
+use crate::op::Op;
+use rustc_hash::FxHashMap;
+use std::cell::RefCell;
+
+/// One node: an operation and up to three operand indices.
+///
+/// For `Const` the two first slots hold the bits of the value; for `Sym` the first slot
+/// holds the symbol's number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Node {
+    pub op: Op,
+    pub args: [u32; 3],
+}
+
+impl Node {
+    pub fn constant(v: f64) -> Node {
+        // One zero: -0.0 and 0.0 intern to the same node.
+        let v = if v == 0.0 { 0.0 } else { v };
+        let bits = v.to_bits();
+        Node {
+            op: Op::Const,
+            args: [bits as u32, (bits >> 32) as u32, 0],
+        }
+    }
+
+    /// The value of a `Const` node.
+    pub fn value(&self) -> Option<f64> {
+        (self.op == Op::Const)
+            .then(|| f64::from_bits(self.args[0] as u64 | ((self.args[1] as u64) << 32)))
+    }
+
+    /// The operand indices actually used by this node.
+    pub fn operands(&self) -> &[u32] {
+        &self.args[..self.op.arity()]
+    }
+}
+
+/// The arena of one thread.
+pub(crate) struct Graph {
+    pub nodes: Vec<Node>,
+    index: FxHashMap<Node, u32>,
+    pub symbol_names: Vec<Box<str>>,
+    /// Node index of each symbol, by symbol number.
+    pub symbol_nodes: Vec<u32>,
+}
+
+thread_local! {
+    static GRAPH: RefCell<Graph> = RefCell::new(Graph::new());
+}
+
+/// Runs `f` with exclusive access to this thread's graph.
+///
+/// Must not be nested: code inside `f` works on the `&mut Graph` it receives.
+pub(crate) fn with<R>(f: impl FnOnce(&mut Graph) -> R) -> R {
+    GRAPH.with(|g| f(&mut g.borrow_mut()))
+}
+
+impl Graph {
+    fn new() -> Graph {
+        let mut g = Graph {
+            nodes: Vec::new(),
+            index: FxHashMap::default(),
+            symbol_names: Vec::new(),
+            symbol_nodes: Vec::new(),
+        };
+        // Indices 0 and 1 are the constants 0 and 1, used everywhere.
+        g.intern(Node::constant(0.0));
+        g.intern(Node::constant(1.0));
+        g
+    }
+
+    /// Adds `node` unless an identical one exists; returns its index.
+    pub fn intern(&mut self, node: Node) -> u32 {
+        if let Some(&id) = self.index.get(&node) {
+            return id;
+        }
+        let id = u32::try_from(self.nodes.len()).expect("symx graph exceeds 2^32 nodes");
+        self.nodes.push(node);
+        self.index.insert(node, id);
+        id
+    }
+
+    /// Creates a new, distinct symbol.
+    pub fn symbol(&mut self, name: &str) -> u32 {
+        let number = self.symbol_names.len() as u32;
+        let id = u32::try_from(self.nodes.len()).expect("symx graph exceeds 2^32 nodes");
+        self.nodes.push(Node {
+            op: Op::Sym,
+            args: [number, 0, 0],
+        });
+        self.symbol_names.push(name.into());
+        self.symbol_nodes.push(id);
+        id
+    }
+
+    pub fn constant(&mut self, v: f64) -> u32 {
+        self.intern(Node::constant(v))
+    }
+
+    #[inline]
+    pub fn node(&self, id: u32) -> Node {
+        self.nodes[id as usize]
+    }
+
+    #[inline]
+    pub fn value(&self, id: u32) -> Option<f64> {
+        self.nodes[id as usize].value()
+    }
+
+    pub fn symbol_name(&self, id: u32) -> &str {
+        let n = self.node(id);
+        debug_assert_eq!(n.op, Op::Sym);
+        &self.symbol_names[n.args[0] as usize]
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+}
+
+/// Number of nodes in this thread's graph (a measure of memory use).
+pub fn node_count() -> usize {
+    with(|g| g.len())
+}

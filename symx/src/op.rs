@@ -1,0 +1,237 @@
+//! The operation set of the expression graph: arity, numeric evaluation and printing names.
+
+/// Every kind of node in the expression graph.
+///
+/// `Const` and `Sym` are leaves; the others take one, two or three operands.
+/// Comparisons and logical operations return `1.0` for true and `0.0` for false.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[repr(u8)]
+pub enum Op {
+    /// A numeric constant.
+    Const,
+    /// A named symbol (a free variable of the graph).
+    Sym,
+    Neg,
+    Sq,
+    Sqrt,
+    Exp,
+    Log,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Sinh,
+    Cosh,
+    Tanh,
+    Abs,
+    Sign,
+    Not,
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+    Atan2,
+    Min,
+    Max,
+    Lt,
+    Le,
+    Eq,
+    Ne,
+    And,
+    Or,
+    /// `a ⊛ b`: `a * b`, except that it is exactly `0` whenever `a == 0` (even if `b` is
+    /// NaN or infinite). Automatic differentiation uses it for chain-rule products below a
+    /// branch (`if_else`, `min`, `max`) so that the branch not taken never poisons
+    /// derivatives with NaN.
+    StrongMul,
+    /// `if_else(c, a, b)`: `a` where `c != 0`, else `b`; the other branch never leaks NaN.
+    IfElse,
+}
+
+impl Op {
+    /// Number of operands.
+    pub fn arity(self) -> usize {
+        use Op::*;
+        match self {
+            Const | Sym => 0,
+            Neg | Sq | Sqrt | Exp | Log | Sin | Cos | Tan | Asin | Acos | Atan | Sinh | Cosh
+            | Tanh | Abs | Sign | Not => 1,
+            Add | Sub | Mul | Div | Pow | Atan2 | Min | Max | Lt | Le | Eq | Ne | And | Or
+            | StrongMul => 2,
+            IfElse => 3,
+        }
+    }
+
+    /// Whether swapping the two operands leaves the value unchanged.
+    pub fn is_commutative(self) -> bool {
+        use Op::*;
+        matches!(self, Add | Mul | Min | Max | Eq | Ne | And | Or)
+    }
+
+    /// Operations whose derivative is identically zero (piecewise constant results).
+    pub fn has_zero_derivative(self) -> bool {
+        use Op::*;
+        matches!(self, Sign | Not | Lt | Le | Eq | Ne | And | Or)
+    }
+
+    /// Operations that select one operand at run time: adjoints below them may be an exact zero.
+    pub fn is_selection(self) -> bool {
+        matches!(self, Op::IfElse | Op::Min | Op::Max)
+    }
+
+    /// Evaluates a unary operation.
+    #[inline(always)]
+    pub fn eval1(self, a: f64) -> f64 {
+        use Op::*;
+        match self {
+            Neg => -a,
+            Sq => a * a,
+            Sqrt => a.sqrt(),
+            Exp => a.exp(),
+            Log => a.ln(),
+            Sin => a.sin(),
+            Cos => a.cos(),
+            Tan => a.tan(),
+            Asin => a.asin(),
+            Acos => a.acos(),
+            Atan => a.atan(),
+            Sinh => a.sinh(),
+            Cosh => a.cosh(),
+            Tanh => a.tanh(),
+            Abs => a.abs(),
+            Sign => sign(a),
+            Not => b2f(a == 0.0),
+            _ => unreachable!("eval1 on {self:?}"),
+        }
+    }
+
+    /// Evaluates a binary operation.
+    #[inline(always)]
+    pub fn eval2(self, a: f64, b: f64) -> f64 {
+        use Op::*;
+        match self {
+            Add => a + b,
+            Sub => a - b,
+            Mul => a * b,
+            Div => a / b,
+            Pow => pow(a, b),
+            Atan2 => a.atan2(b),
+            Min => a.min(b),
+            Max => a.max(b),
+            Lt => b2f(a < b),
+            Le => b2f(a <= b),
+            Eq => b2f(a == b),
+            Ne => b2f(a != b),
+            And => b2f(a != 0.0 && b != 0.0),
+            Or => b2f(a != 0.0 || b != 0.0),
+            StrongMul => strong_mul(a, b),
+            _ => unreachable!("eval2 on {self:?}"),
+        }
+    }
+
+    /// The function name used by `Display` and the parser, for function-call syntax.
+    pub fn name(self) -> &'static str {
+        use Op::*;
+        match self {
+            Const => "const",
+            Sym => "sym",
+            Neg => "neg",
+            Sq => "sq",
+            Sqrt => "sqrt",
+            Exp => "exp",
+            Log => "log",
+            Sin => "sin",
+            Cos => "cos",
+            Tan => "tan",
+            Asin => "asin",
+            Acos => "acos",
+            Atan => "atan",
+            Sinh => "sinh",
+            Cosh => "cosh",
+            Tanh => "tanh",
+            Abs => "abs",
+            Sign => "sign",
+            Not => "not",
+            Add => "add",
+            Sub => "sub",
+            Mul => "mul",
+            Div => "div",
+            Pow => "pow",
+            Atan2 => "atan2",
+            Min => "min",
+            Max => "max",
+            Lt => "lt",
+            Le => "le",
+            Eq => "eq",
+            Ne => "ne",
+            And => "and",
+            Or => "or",
+            StrongMul => "strong_mul",
+            IfElse => "if_else",
+        }
+    }
+
+    /// All operations with operands, for the parser's name lookup.
+    pub(crate) const WITH_OPERANDS: [Op; 33] = {
+        use Op::*;
+        [
+            Neg, Sq, Sqrt, Exp, Log, Sin, Cos, Tan, Asin, Acos, Atan, Sinh, Cosh, Tanh, Abs, Sign,
+            Not, Add, Sub, Mul, Div, Pow, Atan2, Min, Max, Lt, Le, Eq, Ne, And, Or, StrongMul,
+            IfElse,
+        ]
+    };
+}
+
+#[inline(always)]
+fn b2f(b: bool) -> f64 {
+    if b {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// `sign(x)`: −1, 0 or 1 (NaN stays NaN).
+#[inline(always)]
+pub fn sign(a: f64) -> f64 {
+    if a > 0.0 {
+        1.0
+    } else if a < 0.0 {
+        -1.0
+    } else {
+        a * 0.0
+    }
+}
+
+/// `a ⊛ b` (see [`Op::StrongMul`]).
+#[inline(always)]
+pub fn strong_mul(a: f64, b: f64) -> f64 {
+    if a == 0.0 {
+        0.0
+    } else {
+        a * b
+    }
+}
+
+/// Power with an integer fast path (exact for integer exponents, defined for negative bases).
+#[inline(always)]
+pub fn pow(a: f64, b: f64) -> f64 {
+    if b == b.trunc() && b.abs() <= 64.0 {
+        a.powi(b as i32)
+    } else {
+        a.powf(b)
+    }
+}
+
+/// `if_else` on numbers.
+#[inline(always)]
+pub fn select(c: f64, a: f64, b: f64) -> f64 {
+    if c != 0.0 {
+        a
+    } else {
+        b
+    }
+}

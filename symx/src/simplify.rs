@@ -1,0 +1,180 @@
+//! Node construction with constant folding and cheap local simplifications.
+//!
+//! Every new node goes through [`Graph::unary`], [`Graph::binary`] or [`Graph::if_else`],
+//! which fold constant operands, apply identities such as `x + 0 = x`, `x·1 = x`,
+//! `x·0 = 0`, `−(−x) = x`, `x − x = 0`, put commutative operands in a canonical order and
+//! finally hash-cons the node. The rules are local: none looks deeper than the operands'
+//! own operation.
+use crate::graph::{Graph, Node};
+use crate::op::Op;
+
+pub(crate) const ZERO: u32 = 0;
+pub(crate) const ONE: u32 = 1;
+
+impl Graph {
+    /// Creates `op(a)`, simplified.
+    pub fn unary(&mut self, op: Op, a: u32) -> u32 {
+        debug_assert_eq!(op.arity(), 1);
+        if let Some(v) = self.value(a) {
+            return self.constant(op.eval1(v));
+        }
+        let na = self.node(a);
+        match op {
+            Op::Neg if na.op == Op::Neg => return na.args[0],
+            Op::Neg if na.op == Op::Sub => {
+                return self.binary(Op::Sub, na.args[1], na.args[0]);
+            }
+            Op::Sq if na.op == Op::Neg || na.op == Op::Abs => return self.unary(Op::Sq, na.args[0]),
+            Op::Abs if matches!(na.op, Op::Abs | Op::Sq | Op::Exp | Op::Sqrt) => return a,
+            Op::Abs if na.op == Op::Neg => return self.unary(Op::Abs, na.args[0]),
+            _ => {}
+        }
+        self.intern(Node {
+            op,
+            args: [a, 0, 0],
+        })
+    }
+
+    /// Creates `op(a, b)`, simplified.
+    pub fn binary(&mut self, op: Op, a: u32, b: u32) -> u32 {
+        debug_assert_eq!(op.arity(), 2);
+        let (va, vb) = (self.value(a), self.value(b));
+        if let (Some(x), Some(y)) = (va, vb) {
+            return self.constant(op.eval2(x, y));
+        }
+        let is = |v: Option<f64>, c: f64| v == Some(c);
+        match op {
+            Op::Add => {
+                if is(va, 0.0) {
+                    return b;
+                }
+                if is(vb, 0.0) {
+                    return a;
+                }
+                if self.node(b).op == Op::Neg {
+                    return self.binary(Op::Sub, a, self.node(b).args[0]);
+                }
+                if self.node(a).op == Op::Neg {
+                    return self.binary(Op::Sub, b, self.node(a).args[0]);
+                }
+            }
+            Op::Sub => {
+                if a == b {
+                    return ZERO;
+                }
+                if is(vb, 0.0) {
+                    return a;
+                }
+                if is(va, 0.0) {
+                    return self.unary(Op::Neg, b);
+                }
+                if self.node(b).op == Op::Neg {
+                    return self.binary(Op::Add, a, self.node(b).args[0]);
+                }
+            }
+            Op::Mul => {
+                if is(va, 0.0) || is(vb, 0.0) {
+                    return ZERO;
+                }
+                if is(va, 1.0) {
+                    return b;
+                }
+                if is(vb, 1.0) {
+                    return a;
+                }
+                if is(va, -1.0) {
+                    return self.unary(Op::Neg, b);
+                }
+                if is(vb, -1.0) {
+                    return self.unary(Op::Neg, a);
+                }
+                if a == b {
+                    return self.unary(Op::Sq, a);
+                }
+            }
+            Op::StrongMul => {
+                if is(va, 0.0) || is(vb, 0.0) {
+                    return ZERO;
+                }
+                if is(va, 1.0) {
+                    return b;
+                }
+                if is(vb, 1.0) {
+                    return a;
+                }
+                // A non-zero constant factor cannot be the exact zero the operation guards.
+                if va.is_some() {
+                    return self.binary(Op::Mul, a, b);
+                }
+            }
+            Op::Div => {
+                if is(vb, 1.0) {
+                    return a;
+                }
+                if is(va, 0.0) {
+                    return ZERO;
+                }
+                if a == b {
+                    return ONE;
+                }
+                if is(vb, -1.0) {
+                    return self.unary(Op::Neg, a);
+                }
+            }
+            Op::Pow => {
+                if is(vb, 0.0) {
+                    return ONE;
+                }
+                if is(vb, 1.0) {
+                    return a;
+                }
+                if is(vb, 2.0) {
+                    return self.unary(Op::Sq, a);
+                }
+                if is(vb, 0.5) {
+                    return self.unary(Op::Sqrt, a);
+                }
+                if is(va, 1.0) {
+                    return ONE;
+                }
+            }
+            Op::Min | Op::Max | Op::And | Op::Or if a == b => return a,
+            Op::Le | Op::Eq if a == b => return ONE,
+            Op::Lt | Op::Ne if a == b => return ZERO,
+            _ => {}
+        }
+        let (a, b) = if op.is_commutative() && a > b {
+            (b, a)
+        } else {
+            (a, b)
+        };
+        self.intern(Node {
+            op,
+            args: [a, b, 0],
+        })
+    }
+
+    /// Creates `if_else(c, a, b)`, simplified.
+    pub fn if_else(&mut self, c: u32, a: u32, b: u32) -> u32 {
+        if let Some(v) = self.value(c) {
+            return if v != 0.0 { a } else { b };
+        }
+        if a == b {
+            return a;
+        }
+        self.intern(Node {
+            op: Op::IfElse,
+            args: [c, a, b],
+        })
+    }
+
+    /// Creates a node with the given operation and operands, simplified.
+    pub fn make(&mut self, op: Op, args: &[u32]) -> u32 {
+        match args.len() {
+            1 => self.unary(op, args[0]),
+            2 => self.binary(op, args[0], args[1]),
+            3 => self.if_else(args[0], args[1], args[2]),
+            _ => unreachable!("make({op:?}) with {} operands", args.len()),
+        }
+    }
+}
