@@ -1,1 +1,16 @@
-//! Quadruped gap-crossing planner.
+//! Quadruped gap crossing: the flagship model of symnlp.
+//!
+//! A quadruped, modelled as two compass bipeds joined by a massless prismatic link, must
+//! walk from a start to a goal configuration across a gap in the ground, in `n_step`
+//! quasi-static four-contact stances (specification: `docs/gap-crossing.md`, equations
+//! (1)–(11) of Roscia & Sodano). This crate holds:
+//!
+//! - [`scenario`]: the problem's numbers (serde, defaults, validation, `--set` overrides);
+//! - [`plan`]: the solution file (JSON) and the flat variable layout, 30 numbers per stance;
+//! - [`gait`]: initial guesses (standing still, the crawl-gait heuristic) and the crawl
+//!   schedule;
+//! - [`check`]: the independent checker, recomputing every residual from a solution file
+//!   with plain `f64` arithmetic (no symbolic or solver code);
+//! - [`render`]: hand-written SVG plots of a plan and of solver convergence.
+
+pub mod scenario;

@@ -1,0 +1,217 @@
+//! Scenario files: defaults, unknown fields, invalid values and their messages.
+
+use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
+use std::path::Path;
+
+fn toml(text: &str) -> Result<Scenario, ScenarioError> {
+    Scenario::parse(text, "toml", Path::new("test.toml"))
+}
+
+fn json(text: &str) -> Result<Scenario, ScenarioError> {
+    Scenario::parse(text, "json", Path::new("test.json"))
+}
+
+/// Parses and validates; returns the error message (panics if accepted).
+fn rejected(text: &str) -> String {
+    let err = match toml(text) {
+        Err(e) => e,
+        Ok(s) => s.validate().expect_err("scenario should be rejected"),
+    };
+    err.to_string()
+}
+
+#[test]
+fn defaults_equal_the_spec_table() {
+    let s = Scenario::default();
+    assert_eq!(s.n_step, 60);
+    assert_eq!((s.masses.b, s.masses.f), (50.0, 50.0));
+    assert_eq!(s.gravity, 9.81);
+    assert_eq!(s.start.com.b, [0.0, 0.5, 0.5]);
+    assert_eq!(s.start.com.f, [2.0, 0.5, 0.5]);
+    assert_eq!(s.start.feet.br, [0.0, 0.0, 0.0]);
+    assert_eq!(s.start.feet.bl, [0.0, 1.0, 0.0]);
+    assert_eq!(s.start.feet.fr, [2.0, 0.0, 0.0]);
+    assert_eq!(s.start.feet.fl, [2.0, 1.0, 0.0]);
+    assert_eq!(s.goal.b, [3.0, 0.5, 0.5]);
+    assert_eq!(s.goal.f, [5.0, 0.5, 0.5]);
+    assert_eq!(s.gap.min, 2.25);
+    assert_eq!(s.gap.max, 2.35);
+    assert_eq!(s.gap.depth, 1.0);
+    assert_eq!(s.gap.steepness, 1e6);
+    assert_eq!(s.gap.margin, 0.03);
+    assert_eq!(s.friction.mu, 0.5);
+    assert_eq!(s.friction.f_thr, 10.0);
+    assert_eq!(s.weights.com, 1000.0);
+    assert_eq!(s.weights.force, 0.001);
+    assert_eq!(s.leg_length_sq, 0.5);
+    assert_eq!(s.step_radius_sq, 0.09);
+    assert_eq!((s.same_side_sq.min, s.same_side_sq.max), (1.0, 9.0));
+    assert_eq!((s.same_biped_sq.min, s.same_biped_sq.max), (0.25, 2.25));
+    assert_eq!(s.gait, Gait::Free);
+    s.validate().expect("the default scenario is valid");
+}
+
+#[test]
+fn empty_files_give_the_defaults() {
+    assert_eq!(toml("").unwrap(), Scenario::default());
+    assert_eq!(json("{}").unwrap(), Scenario::default());
+}
+
+#[test]
+fn full_json_round_trip() {
+    let s = Scenario::default();
+    let text = serde_json::to_string_pretty(&s).unwrap();
+    assert_eq!(json(&text).unwrap(), s);
+}
+
+#[test]
+fn partial_files_keep_other_defaults() {
+    let s = toml("n_step = 30\ngait = \"crawl\"\n[goal]\nF = [5.0, 0.7, 0.5]\n").unwrap();
+    assert_eq!(s.n_step, 30);
+    assert_eq!(s.gait, Gait::Crawl);
+    assert_eq!(s.goal.f, [5.0, 0.7, 0.5]);
+    assert_eq!(s.goal.b, [3.0, 0.5, 0.5]);
+    let s = json(r#"{"gap": {"depth": 2}}"#).unwrap();
+    assert_eq!(s.gap.depth, 2.0);
+    assert_eq!(s.gap.min, 2.25);
+}
+
+#[test]
+fn unknown_fields_are_rejected_by_name() {
+    let e = toml("n_stpe = 30").unwrap_err().to_string();
+    assert!(e.contains("unknown field `n_stpe`"), "{e}");
+    let e = toml("[gap]\nwidht = 0.1").unwrap_err().to_string();
+    assert!(e.contains("`gap.widht`") && e.contains("margin"), "{e}");
+    let e = json(r#"{"start": {"feet": {"XR": [0,0,0]}}}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`start.feet.XR`"), "{e}");
+}
+
+#[test]
+fn wrong_types_are_rejected_by_name() {
+    let e = toml("[gap]\nmin = \"wide\"").unwrap_err().to_string();
+    assert!(
+        e.contains("gap.min") && e.contains("expected a number"),
+        "{e}"
+    );
+    let e = toml("n_step = 2.5").unwrap_err().to_string();
+    assert!(e.contains("n_step") && e.contains("integer"), "{e}");
+    let e = toml("[goal]\nB = [1.0, 2.0]").unwrap_err().to_string();
+    assert!(e.contains("goal.B") && e.contains("3 numbers"), "{e}");
+    let e = toml("[gap]\nmin = nan").unwrap_err().to_string();
+    assert!(e.contains("gap.min") && e.contains("finite"), "{e}");
+    let e = toml("gait = \"trot\"").unwrap_err().to_string();
+    assert!(e.contains("trot") && e.contains("crawl"), "{e}");
+}
+
+#[test]
+fn invalid_values_are_rejected_with_field_and_value() {
+    let cases: &[(&str, &[&str])] = &[
+        ("[masses]\nB = 0.0", &["masses.B", "positive", "0"]),
+        ("[masses]\nF = -5.0", &["masses.F", "positive", "-5"]),
+        ("[gap]\nmin = 2.4", &["gap.min", "less than gap.max", "2.4"]),
+        ("[gap]\nmin = 2.35", &["gap.min", "less than gap.max"]),
+        ("n_step = 1", &["n_step", "at least 2", "1"]),
+        ("[friction]\nmu = 0.0", &["friction.mu", "positive"]),
+        (
+            "[friction]\nmu = -0.1",
+            &["friction.mu", "positive", "-0.1"],
+        ),
+        (
+            "[gap]\nmargin = -0.01",
+            &["gap.margin", "negative", "-0.01"],
+        ),
+        ("gravity = inf", &["gravity", "finite"]),
+    ];
+    for (text, needles) in cases {
+        let msg = rejected(text);
+        for n in *needles {
+            assert!(msg.contains(n), "for {text:?}: message {msg:?} lacks {n:?}");
+        }
+    }
+}
+
+#[test]
+fn non_finite_values_set_in_code_are_rejected() {
+    let mut s = Scenario::default();
+    s.goal.b[1] = f64::NAN;
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("goal.B[1]") && e.contains("finite"), "{e}");
+}
+
+#[test]
+fn start_violating_the_equations_is_rejected() {
+    // (11): CoM too high above its feet.
+    let e = rejected("[start.com]\nB = [0.0, 0.5, 0.6]");
+    assert!(
+        e.contains("(11)") && e.contains("start.feet.BR") && e.contains("foot BR"),
+        "{e}"
+    );
+    // (3): a foot in the air.
+    let e = rejected("[start.feet]\nBL = [0.0, 1.0, 0.01]");
+    assert!(
+        e.contains("(3)") && e.contains("start.feet.BL") && e.contains("0.01"),
+        "{e}"
+    );
+    // (6)/(7): front feet too far ahead (also breaks nothing else: CoM moved with them).
+    let e = rejected(
+        "[start.com]\nF = [4.5, 0.5, 0.5]\n[start.feet]\nFR = [4.5, 0.0, 0.0]\nFL = [4.5, 1.0, 0.0]\n[gap]\nmin = 5.0\nmax = 5.1",
+    );
+    assert!(e.contains("(6)") && e.contains("(7)"), "{e}");
+    // (8): back feet too close; keep (11) satisfied by lowering nothing: CoM at the
+    // midpoint height sqrt(0.5 - 0.2^2) = sqrt(0.46).
+    let z = 0.46f64.sqrt();
+    let e = rejected(&format!(
+        "[start.com]\nB = [0.0, 0.5, {z}]\n[start.feet]\nBR = [0.0, 0.3, 0.0]\nBL = [0.0, 0.7, 0.0]"
+    ));
+    assert!(e.contains("(8)") && !e.contains("(11)"), "{e}");
+    // A foot in the widened gap (the gap moved under the front feet).
+    let e = rejected("[gap]\nmin = 1.98\nmax = 2.1\ndepth = 0.0");
+    assert!(
+        e.contains("widened gap") && e.contains("start.feet.FR") && e.contains("FL"),
+        "{e}"
+    );
+}
+
+#[test]
+fn overrides_use_dotted_paths() {
+    let mut s = Scenario::default();
+    s.apply_overrides(&[
+        "gap.min=2.0",
+        "n_step=30",
+        "gait=crawl",
+        "start.feet.BR[1]=0.0",
+    ])
+    .unwrap();
+    assert_eq!((s.gap.min, s.n_step, s.gait), (2.0, 30, Gait::Crawl));
+    let e = s.apply_overrides(&["gap.minn=1"]).unwrap_err().to_string();
+    assert!(e.contains("gap.minn"), "{e}");
+    let e = s.apply_overrides(&["gap.min"]).unwrap_err().to_string();
+    assert!(e.contains("key=value"), "{e}");
+}
+
+#[test]
+fn files_by_extension() {
+    let dir = std::env::temp_dir().join(format!("gap_crossing_scn_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let t = dir.join("s.toml");
+    std::fs::write(&t, "n_step = 12").unwrap();
+    assert_eq!(Scenario::load(&t).unwrap().n_step, 12);
+    let j = dir.join("s.json");
+    std::fs::write(&j, r#"{"n_step": 13}"#).unwrap();
+    assert_eq!(Scenario::load(&j).unwrap().n_step, 13);
+    let y = dir.join("s.yaml");
+    std::fs::write(&y, "n_step: 13").unwrap();
+    assert!(Scenario::load(&y)
+        .unwrap_err()
+        .to_string()
+        .contains("extension"));
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "n_step = 1").unwrap();
+    assert!(Scenario::load(&bad)
+        .unwrap_err()
+        .to_string()
+        .contains("n_step"));
+    std::fs::remove_dir_all(&dir).ok();
+}
