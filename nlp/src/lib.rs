@@ -1,15 +1,21 @@
 //! Nonlinear programs: problem builder and solvers (work in progress).
 
+pub mod compiled;
+pub mod constraint;
 pub mod error;
 pub mod ipm;
 pub mod kkt;
 pub mod log;
 pub mod numeric;
 pub mod options;
+pub mod problem;
 pub mod scaling;
 pub mod solution;
 
+pub use compiled::Compiled;
+pub use constraint::{bounded, Constraint, Relation};
 pub use error::SolveError;
+pub use problem::{Block, BuildError, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
 pub use numeric::NumericNlp;
