@@ -338,6 +338,19 @@ impl IndexMut<usize> for Matrix {
     }
 }
 
+/// Ranges of entries (column-major): `v[1..3]` is a slice of a vector's entries.
+macro_rules! range_index {
+    ($($range:ty),*) => {$(
+        impl Index<$range> for Matrix {
+            type Output = [Expr];
+            fn index(&self, r: $range) -> &[Expr] {
+                &self.data[r]
+            }
+        }
+    )*};
+}
+range_index!(Range<usize>, std::ops::RangeFrom<usize>, std::ops::RangeTo<usize>, std::ops::RangeInclusive<usize>, std::ops::RangeFull);
+
 impl From<Vec<Expr>> for Matrix {
     fn from(v: Vec<Expr>) -> Matrix {
         Matrix::from_vec(v)
