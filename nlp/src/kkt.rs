@@ -11,6 +11,8 @@
 //! faer has no inertia API, so the inertia is counted from the signs of D (Sylvester's law
 //! of inertia). Unpivoted LDLᵀ needs `dc > 0` on every row (see docs/dependencies.md).
 
+#![allow(clippy::needless_range_loop)]
+
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltParams, LdltRegularization};
 use faer::sparse::linalg::cholesky::{

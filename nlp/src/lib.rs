@@ -15,6 +15,7 @@ pub mod solution;
 pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
 pub use error::SolveError;
+pub use ipm::Ipm;
 pub use problem::{Block, BuildError, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};

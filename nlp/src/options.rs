@@ -1,6 +1,8 @@
 //! Options of the interior-point solver. Names and defaults follow IPOPT where the concept
 //! is the same.
 
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use serde::{Deserialize, Serialize};
 
 use crate::error::SolveError;
@@ -120,9 +122,6 @@ pub struct IpmOptions {
     pub bound_mult_init_val: f64,
     /// Least-squares multipliers larger than this are discarded (set to 0). Default 1e3.
     pub constr_mult_init_max: f64,
-    /// Use the warm-start initialisation in [`Ipm::solve_warm`](crate::ipm::Ipm::solve_warm).
-    /// Default false (then only the primal point of the previous solution is reused).
-    pub warm_start_init_point: bool,
     /// Absolute bound push for warm starts. Default 1e-3.
     pub warm_start_bound_push: f64,
     /// Relative bound push for warm starts. Default 1e-3.
@@ -133,7 +132,8 @@ pub struct IpmOptions {
     pub warm_start_slack_bound_frac: f64,
     /// Minimum bound multiplier for warm starts. Default 1e-3.
     pub warm_start_mult_bound_push: f64,
-    /// Initial μ for warm starts (IPOPT users set mu_init small). Default 1e-6.
+    /// Initial μ for [`Ipm::solve_warm`](crate::ipm::Ipm::solve_warm) (IPOPT users set
+    /// mu_init small when warm starting). Default 1e-6.
     pub warm_start_mu_init: f64,
     // ---------- line search ----------
     /// Maximum number of second-order corrections. Default 4.
@@ -158,6 +158,9 @@ pub struct IpmOptions {
     pub gamma_theta: f64,
     /// γ_α: safety factor for the minimal step size. Default 0.05.
     pub alpha_min_frac: f64,
+    /// κ_d: weight of the linear damping term for variables bounded on one side only.
+    /// Default 1e-5.
+    pub kappa_d: f64,
     /// Backtracking factor. Default 0.5.
     pub alpha_red_factor: f64,
     /// κ_Σ: bound-multiplier safeguard. Default 1e10.
@@ -252,7 +255,6 @@ impl Default for IpmOptions {
             bound_relax_factor: 1e-8,
             bound_mult_init_val: 1.0,
             constr_mult_init_max: 1e3,
-            warm_start_init_point: false,
             warm_start_bound_push: 1e-3,
             warm_start_bound_frac: 1e-3,
             warm_start_slack_bound_push: 1e-3,
@@ -270,6 +272,7 @@ impl Default for IpmOptions {
             gamma_phi: 1e-8,
             gamma_theta: 1e-5,
             alpha_min_frac: 0.05,
+            kappa_d: 1e-5,
             alpha_red_factor: 0.5,
             kappa_sigma: 1e10,
             tiny_step_tol: 10.0 * f64::EPSILON,
@@ -377,6 +380,7 @@ impl IpmOptions {
             constr_mult_init_max,
             tiny_step_tol,
             tiny_step_y_tol,
+            kappa_d,
             jacobian_regularization_value,
             jacobian_regularization_exponent,
             resto_proximity_weight

@@ -136,6 +136,8 @@ pub struct Solution {
     pub dual_inf: f64,
     /// Unscaled complementarity (max-norm).
     pub compl: f64,
+    /// Human-readable detail about the outcome (e.g. which callback returned NaN).
+    pub message: String,
     /// Statistics.
     pub stats: Stats,
 }

@@ -1,1 +1,426 @@
-//! Interior-point method (IPOPT algorithm).
+//! Interior-point method: IPOPT's primal-dual barrier algorithm with a filter line search
+//! (Wächter & Biegler, Math. Prog. 106:25–57, 2006).
+//!
+//! Layout: [`reduced`] (fixed variables removed, scaling, evaluation counters),
+//! `core` (iteration, KKT step with inertia correction, line search with second-order
+//! corrections), [`filter`], [`barrier`] (μ updates), `restoration` (ℓ1 restoration
+//! phase solved by the same core).
+
+#![allow(clippy::needless_range_loop)]
+
+pub mod barrier;
+mod core;
+pub mod filter;
+pub(crate) mod reduced;
+mod restoration;
+
+use std::time::Instant;
+
+use crate::error::SolveError;
+use crate::numeric::NumericNlp;
+use crate::options::{IpmOptions, ScalingMethod};
+use crate::scaling::gradient_scale;
+use crate::solution::{Solution, Stats, Status};
+
+use self::core::{Core, Setup, Shared, Start};
+use self::reduced::Reduced;
+
+/// The interior-point solver.
+#[derive(Debug, Clone, Default)]
+pub struct Ipm {
+    /// Options (IPOPT names and defaults).
+    pub options: IpmOptions,
+}
+
+struct Validated {
+    x_l: Vec<f64>,
+    x_u: Vec<f64>,
+    g_l: Vec<f64>,
+    g_u: Vec<f64>,
+    x0: Vec<f64>,
+}
+
+fn validate(nlp: &dyn NumericNlp, options: &IpmOptions) -> Result<Validated, SolveError> {
+    options.validate()?;
+    let n = nlp.n();
+    let m = nlp.m();
+    let jac = nlp.jac_g_sparsity();
+    if jac.nrows() != m || jac.ncols() != n {
+        return Err(SolveError::WrongSize(format!(
+            "Jacobian pattern is {}x{}, expected {m}x{n}",
+            jac.nrows(),
+            jac.ncols()
+        )));
+    }
+    let hess = nlp.hess_l_sparsity();
+    if hess.nrows() != n || hess.ncols() != n {
+        return Err(SolveError::WrongSize(format!(
+            "Hessian pattern is {}x{}, expected {n}x{n}",
+            hess.nrows(),
+            hess.ncols()
+        )));
+    }
+    for c in 0..n {
+        for &r in hess.row_idx_of_col_raw(c) {
+            if r < c {
+                return Err(SolveError::WrongSize(format!(
+                    "Hessian pattern entry ({r}, {c}) is above the diagonal; give the lower triangle"
+                )));
+            }
+        }
+    }
+    let mut v = Validated {
+        x_l: vec![0.0; n],
+        x_u: vec![0.0; n],
+        g_l: vec![0.0; m],
+        g_u: vec![0.0; m],
+        x0: vec![0.0; n],
+    };
+    nlp.bounds(&mut v.x_l, &mut v.x_u, &mut v.g_l, &mut v.g_u);
+    nlp.initial_point(&mut v.x0);
+    let check = |what: &'static str,
+                 l: &[f64],
+                 u: &[f64],
+                 name: &dyn Fn(usize) -> String|
+     -> Result<(), SolveError> {
+        for i in 0..l.len() {
+            for (value, bad) in [
+                (l[i], l[i].is_nan() || l[i] == f64::INFINITY),
+                (u[i], u[i].is_nan() || u[i] == f64::NEG_INFINITY),
+            ] {
+                if bad {
+                    return Err(SolveError::InvalidBound {
+                        what,
+                        index: i,
+                        name: name(i),
+                        value,
+                    });
+                }
+            }
+            if l[i] > u[i] {
+                return Err(if what == "variable" {
+                    SolveError::InconsistentVariableBounds {
+                        index: i,
+                        name: name(i),
+                        lower: l[i],
+                        upper: u[i],
+                    }
+                } else {
+                    SolveError::InconsistentConstraintBounds {
+                        index: i,
+                        name: name(i),
+                        lower: l[i],
+                        upper: u[i],
+                    }
+                });
+            }
+        }
+        Ok(())
+    };
+    check("variable", &v.x_l, &v.x_u, &|i| nlp.variable_name(i))?;
+    check("constraint", &v.g_l, &v.g_u, &|i| nlp.constraint_name(i))?;
+    for (i, &x) in v.x0.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(SolveError::InvalidInitialPoint {
+                index: i,
+                name: nlp.variable_name(i),
+                value: x,
+            });
+        }
+    }
+    Ok(v)
+}
+
+impl Ipm {
+    /// A solver with the given options.
+    pub fn new(options: IpmOptions) -> Self {
+        Ipm { options }
+    }
+
+    /// Solves from the problem's initial point.
+    pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
+        self.run(nlp, None)
+    }
+
+    /// Warm start from a previous solution (IPOPT's `warm_start_init_point = yes`): x, λ,
+    /// z_L, z_U are reused, pushed into the interior with the `warm_start_*` options, and
+    /// μ starts at `warm_start_mu_init`.
+    pub fn solve_warm(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        previous: &Solution,
+    ) -> Result<Solution, SolveError> {
+        let (n, m) = (nlp.n(), nlp.m());
+        for (what, len, expected) in [
+            ("previous.x", previous.x.len(), n),
+            ("previous.lambda", previous.lambda.len(), m),
+            ("previous.z_l", previous.z_l.len(), n),
+            ("previous.z_u", previous.z_u.len(), n),
+        ] {
+            if len != expected {
+                return Err(SolveError::WrongSize(format!(
+                    "{what} has length {len}, expected {expected}"
+                )));
+            }
+        }
+        for (i, &x) in previous.x.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(SolveError::InvalidInitialPoint {
+                    index: i,
+                    name: nlp.variable_name(i),
+                    value: x,
+                });
+            }
+        }
+        self.run(nlp, Some(previous))
+    }
+
+    fn run(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        warm: Option<&Solution>,
+    ) -> Result<Solution, SolveError> {
+        let start_time = Instant::now();
+        let opts = &self.options;
+        let mut v = validate(nlp, opts)?;
+        if let Some(prev) = warm {
+            v.x0.copy_from_slice(&prev.x);
+        }
+        let mut red = Reduced::new(nlp, &v.x_l, &v.x_u, &v.g_l, &v.g_u, &v.x0);
+        let mut shared = Shared {
+            stats: Stats::default(),
+            start: start_time,
+            iter: 0,
+        };
+        let n = red.free.len();
+        let m = red.rows.len();
+        let n_eq = red.g_l.iter().zip(&red.g_u).filter(|(l, u)| l == u).count();
+        // Scaling at the starting point.
+        if opts.nlp_scaling_method == ScalingMethod::GradientBased && n > 0 {
+            let x0 = red.x0.clone();
+            let gmax = red.unscaled_grad_max(&x0);
+            red.obj_scale = opts.obj_scaling_factor
+                * gradient_scale(
+                    gmax,
+                    opts.nlp_scaling_max_gradient,
+                    opts.nlp_scaling_min_value,
+                );
+            if m > 0 {
+                let mut rmax = vec![0.0; m];
+                red.unscaled_jac_row_max(&x0, &mut rmax);
+                for k in 0..m {
+                    red.g_scale[k] = gradient_scale(
+                        rmax[k],
+                        opts.nlp_scaling_max_gradient,
+                        opts.nlp_scaling_min_value,
+                    );
+                }
+            }
+        } else {
+            red.obj_scale = opts.obj_scaling_factor;
+        }
+        let (status, w, y, zl, zu, message) = if n == 0 {
+            // Everything fixed: nothing to optimise; feasibility is checked below.
+            (
+                Status::SolveSucceeded,
+                vec![],
+                vec![0.0; m],
+                vec![],
+                vec![],
+                String::from("all variables are fixed"),
+            )
+        } else if n_eq > n {
+            (
+                Status::NotEnoughDegreesOfFreedom,
+                red.x0.clone(),
+                vec![0.0; m],
+                vec![0.0; n],
+                vec![0.0; n],
+                format!("{n_eq} equality constraints but only {n} free variables"),
+            )
+        } else {
+            let start = match warm {
+                None => Start::Cold,
+                Some(prev) => Start::Warm {
+                    y: red
+                        .rows
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &i)| prev.lambda[i] * red.obj_scale / red.g_scale[k])
+                        .collect(),
+                    zl: red
+                        .free
+                        .iter()
+                        .map(|&j| prev.z_l[j] * red.obj_scale)
+                        .collect(),
+                    zu: red
+                        .free
+                        .iter()
+                        .map(|&j| prev.z_u[j] * red.obj_scale)
+                        .collect(),
+                },
+            };
+            let setup = Setup {
+                mu_init: if warm.is_some() {
+                    opts.warm_start_mu_init
+                } else {
+                    opts.mu_init
+                },
+                bound_relax_factor: opts.bound_relax_factor,
+                in_resto: false,
+                obj_scale: red.obj_scale,
+                g_scale: red.g_scale.clone(),
+                mu_strategy: opts.mu_strategy,
+            };
+            match Core::new(&mut red, opts, &setup) {
+                Err(msg) => (
+                    Status::InternalError,
+                    red.x0.clone(),
+                    vec![0.0; m],
+                    vec![0.0; n],
+                    vec![0.0; n],
+                    msg,
+                ),
+                Ok(mut core) => {
+                    let out = core.run(&mut shared, start);
+                    (
+                        out.status,
+                        out.w[..n].to_vec(),
+                        out.y,
+                        out.zl[..n].to_vec(),
+                        out.zu[..n].to_vec(),
+                        out.message,
+                    )
+                }
+            }
+        };
+        let mut sol = finish(&mut red, &v, status, &w, &y, &zl, &zu, message);
+        if n == 0 && sol.constr_viol > opts.constr_viol_tol {
+            sol.status = Status::InfeasibleProblemDetected;
+        }
+        let counters = red.counters.clone();
+        let mut stats = shared.stats;
+        stats.iterations = shared.iter;
+        stats.n_eval_f = counters.f;
+        stats.n_eval_grad_f = counters.grad_f;
+        stats.n_eval_g = counters.g;
+        stats.n_eval_jac_g = counters.jac_g;
+        stats.n_eval_hess_l = counters.hess_l;
+        stats.eval_seconds = counters.seconds;
+        stats.total_seconds = start_time.elapsed().as_secs_f64();
+        stats.other_seconds =
+            (stats.total_seconds - stats.eval_seconds - stats.factor_seconds).max(0.0);
+        stats.obj_scaling = red.obj_scale;
+        sol.stats = stats;
+        if opts.print_level >= 3 {
+            print!("{}", crate::log::format_summary(&sol));
+            if !sol.message.is_empty() {
+                println!("{}", sol.message);
+            }
+        }
+        Ok(sol)
+    }
+}
+
+/// Builds the user-level solution from the reduced, scaled iterate.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    red: &mut Reduced<'_>,
+    v: &Validated,
+    status: Status,
+    w: &[f64],
+    y: &[f64],
+    zl: &[f64],
+    zu: &[f64],
+    message: String,
+) -> Solution {
+    let n_user = v.x_l.len();
+    let m_user = v.g_l.len();
+    let mut x = red.x_full.clone();
+    for (k, &j) in red.free.iter().enumerate() {
+        if k < w.len() {
+            x[j] = w[k];
+        }
+    }
+    let os = red.obj_scale;
+    let mut lambda = vec![0.0; m_user];
+    for (k, &i) in red.rows.iter().enumerate() {
+        lambda[i] = y.get(k).copied().unwrap_or(0.0) * red.g_scale[k] / os;
+    }
+    let mut z_l = vec![0.0; n_user];
+    let mut z_u = vec![0.0; n_user];
+    for (k, &j) in red.free.iter().enumerate() {
+        z_l[j] = zl.get(k).copied().unwrap_or(0.0) / os;
+        z_u[j] = zu.get(k).copied().unwrap_or(0.0) / os;
+    }
+    let user = red.user();
+    let t = Instant::now();
+    let objective = user.eval_f(&x);
+    let mut grad = vec![0.0; n_user];
+    user.eval_grad_f(&x, &mut grad);
+    let mut g = vec![0.0; m_user];
+    user.eval_g(&x, &mut g);
+    let jp = user.jac_g_sparsity().clone();
+    let mut jv = vec![0.0; jp.row_idx().len()];
+    user.eval_jac_g(&x, &mut jv);
+    let secs = t.elapsed().as_secs_f64();
+    red.counters.f += 1;
+    red.counters.grad_f += 1;
+    red.counters.g += 1;
+    red.counters.jac_g += 1;
+    red.counters.seconds += secs;
+    // r = ∇f + Jᵀλ
+    let mut r = grad;
+    for c in 0..n_user {
+        for p in jp.col_range(c) {
+            r[c] += jv[p] * lambda[jp.row_idx()[p]];
+        }
+    }
+    let mut dual_inf: f64 = 0.0;
+    for j in 0..n_user {
+        if v.x_l[j] == v.x_u[j] {
+            // Fixed variable: its bound multipliers absorb the gradient.
+            z_l[j] = r[j].max(0.0);
+            z_u[j] = (-r[j]).max(0.0);
+        }
+        dual_inf = dual_inf.max((r[j] - z_l[j] + z_u[j]).abs());
+    }
+    let mut constr_viol: f64 = 0.0;
+    let mut compl: f64 = 0.0;
+    for j in 0..n_user {
+        constr_viol = constr_viol.max(v.x_l[j] - x[j]).max(x[j] - v.x_u[j]);
+        if v.x_l[j] != v.x_u[j] {
+            if v.x_l[j].is_finite() {
+                compl = compl.max(((x[j] - v.x_l[j]) * z_l[j]).abs());
+            }
+            if v.x_u[j].is_finite() {
+                compl = compl.max(((v.x_u[j] - x[j]) * z_u[j]).abs());
+            }
+        }
+    }
+    for i in 0..m_user {
+        constr_viol = constr_viol.max(v.g_l[i] - g[i]).max(g[i] - v.g_u[i]);
+        if v.g_l[i] != v.g_u[i] {
+            if v.g_l[i].is_finite() {
+                compl = compl.max(((g[i] - v.g_l[i]) * (-lambda[i]).max(0.0)).abs());
+            }
+            if v.g_u[i].is_finite() {
+                compl = compl.max(((v.g_u[i] - g[i]) * lambda[i].max(0.0)).abs());
+            }
+        }
+    }
+    Solution {
+        status,
+        x,
+        lambda,
+        z_l,
+        z_u,
+        g,
+        objective,
+        constr_viol: constr_viol.max(0.0),
+        dual_inf,
+        compl,
+        message,
+        stats: Stats::default(),
+    }
+}

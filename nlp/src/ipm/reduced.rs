@@ -1,0 +1,301 @@
+//! The user's NLP as the interior-point core sees it: fixed variables removed
+//! (IPOPT's `fixed_variable_treatment = make_parameter`), rows without bounds dropped,
+//! gradient-based scaling applied, evaluations counted and timed.
+
+#![allow(clippy::needless_range_loop)]
+
+use std::time::Instant;
+
+use faer::sparse::SymbolicSparseColMat;
+
+use crate::numeric::NumericNlp;
+
+/// The problem interface of the core: a [`NumericNlp`] plus a hook that the restoration
+/// phase uses to stop its inner iteration.
+pub(crate) trait IpmProblem: NumericNlp {
+    /// Called after each accepted inner iterate `w = [x; s]`; `true` stops the loop.
+    fn restoration_accepts(&mut self, _w: &[f64]) -> bool {
+        false
+    }
+}
+
+/// Evaluation counters and time spent in user callbacks.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct EvalCounters {
+    pub f: usize,
+    pub grad_f: usize,
+    pub g: usize,
+    pub jac_g: usize,
+    pub hess_l: usize,
+    pub seconds: f64,
+}
+
+pub(crate) struct Reduced<'a> {
+    user: &'a mut dyn NumericNlp,
+    /// Free variable indices (user numbering).
+    pub free: Vec<usize>,
+    /// Kept row indices (user numbering).
+    pub rows: Vec<usize>,
+    jac: SymbolicSparseColMat<usize>,
+    jmap: Vec<usize>,
+    hess: SymbolicSparseColMat<usize>,
+    hmap: Vec<usize>,
+    pub x_l: Vec<f64>,
+    pub x_u: Vec<f64>,
+    /// Unscaled bounds of the kept rows.
+    pub g_l: Vec<f64>,
+    pub g_u: Vec<f64>,
+    pub x0: Vec<f64>,
+    pub obj_scale: f64,
+    pub g_scale: Vec<f64>,
+    pub x_full: Vec<f64>,
+    g_full: Vec<f64>,
+    jac_full: Vec<f64>,
+    hess_full: Vec<f64>,
+    lam_full: Vec<f64>,
+    grad_full: Vec<f64>,
+    pub counters: EvalCounters,
+}
+
+impl<'a> Reduced<'a> {
+    /// `x_l..g_u` are the validated user bounds, `x0` the user starting point.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        user: &'a mut dyn NumericNlp,
+        x_l: &[f64],
+        x_u: &[f64],
+        g_l: &[f64],
+        g_u: &[f64],
+        x0: &[f64],
+    ) -> Self {
+        let n_user = x_l.len();
+        let m_user = g_l.len();
+        let free: Vec<usize> = (0..n_user).filter(|&j| x_l[j] != x_u[j]).collect();
+        let rows: Vec<usize> = (0..m_user)
+            .filter(|&i| g_l[i] > f64::NEG_INFINITY || g_u[i] < f64::INFINITY)
+            .collect();
+        let mut col_new = vec![usize::MAX; n_user];
+        for (k, &j) in free.iter().enumerate() {
+            col_new[j] = k;
+        }
+        let mut row_new = vec![usize::MAX; m_user];
+        for (k, &i) in rows.iter().enumerate() {
+            row_new[i] = k;
+        }
+        let (jac, jmap) = {
+            let pat = user.jac_g_sparsity();
+            sub_pattern(pat, &free, &row_new, rows.len(), false)
+        };
+        let (hess, hmap) = {
+            let pat = user.hess_l_sparsity();
+            sub_pattern(pat, &free, &col_new, free.len(), true)
+        };
+        let mut x_full = x0.to_vec();
+        for j in 0..n_user {
+            if x_l[j] == x_u[j] {
+                x_full[j] = x_l[j];
+            }
+        }
+        let jac_len = user.jac_g_sparsity().row_idx().len();
+        let hess_len = user.hess_l_sparsity().row_idx().len();
+        Reduced {
+            free: free.clone(),
+            jac,
+            jmap,
+            hess,
+            hmap,
+            x_l: free.iter().map(|&j| x_l[j]).collect(),
+            x_u: free.iter().map(|&j| x_u[j]).collect(),
+            g_l: rows.iter().map(|&i| g_l[i]).collect(),
+            g_u: rows.iter().map(|&i| g_u[i]).collect(),
+            x0: free.iter().map(|&j| x0[j]).collect(),
+            obj_scale: 1.0,
+            g_scale: vec![1.0; rows.len()],
+            rows,
+            x_full,
+            g_full: vec![0.0; m_user],
+            jac_full: vec![0.0; jac_len],
+            hess_full: vec![0.0; hess_len],
+            lam_full: vec![0.0; m_user],
+            grad_full: vec![0.0; n_user],
+            counters: EvalCounters::default(),
+            user,
+        }
+    }
+
+    /// The user problem.
+    pub fn user(&mut self) -> &mut dyn NumericNlp {
+        self.user
+    }
+
+    fn set_x(&mut self, x: &[f64]) {
+        for (k, &j) in self.free.iter().enumerate() {
+            self.x_full[j] = x[k];
+        }
+    }
+
+    /// Unscaled gradient (reduced) at the reduced point `x` (used for scaling).
+    pub fn unscaled_grad_max(&mut self, x: &[f64]) -> f64 {
+        self.set_x(x);
+        let t = Instant::now();
+        self.user.eval_grad_f(&self.x_full, &mut self.grad_full);
+        self.counters.grad_f += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        self.free
+            .iter()
+            .map(|&j| self.grad_full[j].abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Unscaled row max-norms of the reduced Jacobian at `x` (used for scaling).
+    pub fn unscaled_jac_row_max(&mut self, x: &[f64], out: &mut [f64]) {
+        self.set_x(x);
+        let t = Instant::now();
+        self.user.eval_jac_g(&self.x_full, &mut self.jac_full);
+        self.counters.jac_g += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for c in 0..self.jac.ncols() {
+            for p in self.jac.col_range(c) {
+                let r = self.jac.row_idx()[p];
+                let v = self.jac_full[self.jmap[p]].abs();
+                if v.is_finite() {
+                    out[r] = out[r].max(v);
+                } else {
+                    out[r] = f64::NAN;
+                }
+            }
+        }
+    }
+}
+
+/// Sub-pattern of `pat` restricted to columns `cols` (old indices, in new order) and rows
+/// with `row_new[r] != usize::MAX`. Returns the pattern and, per new storage position,
+/// the old storage position. With `lower`, entries are put in the lower triangle of the
+/// new numbering (the reordering is monotone, so this is automatic).
+fn sub_pattern(
+    pat: &SymbolicSparseColMat<usize>,
+    cols: &[usize],
+    row_new: &[usize],
+    nrows: usize,
+    _lower: bool,
+) -> (SymbolicSparseColMat<usize>, Vec<usize>) {
+    let mut col_ptr = vec![0usize];
+    let mut row_idx = Vec::new();
+    let mut map = Vec::new();
+    for &c in cols {
+        let mut entries: Vec<(usize, usize)> = Vec::new();
+        if c < pat.ncols() {
+            for p in pat.col_range(c) {
+                let r = pat.row_idx()[p];
+                if r < row_new.len() && row_new[r] != usize::MAX {
+                    entries.push((row_new[r], p));
+                }
+            }
+        }
+        entries.sort_unstable();
+        entries.dedup_by_key(|e| e.0);
+        for (r, p) in entries {
+            row_idx.push(r);
+            map.push(p);
+        }
+        col_ptr.push(row_idx.len());
+    }
+    (
+        SymbolicSparseColMat::new_checked(nrows, cols.len(), col_ptr, None, row_idx),
+        map,
+    )
+}
+
+impl NumericNlp for Reduced<'_> {
+    fn n(&self) -> usize {
+        self.free.len()
+    }
+    fn m(&self) -> usize {
+        self.rows.len()
+    }
+    fn bounds(&self, x_l: &mut [f64], x_u: &mut [f64], g_l: &mut [f64], g_u: &mut [f64]) {
+        x_l.copy_from_slice(&self.x_l);
+        x_u.copy_from_slice(&self.x_u);
+        for k in 0..self.rows.len() {
+            g_l[k] = self.g_l[k] * self.g_scale[k];
+            g_u[k] = self.g_u[k] * self.g_scale[k];
+        }
+    }
+    fn initial_point(&self, x: &mut [f64]) {
+        x.copy_from_slice(&self.x0);
+    }
+    fn jac_g_sparsity(&self) -> &SymbolicSparseColMat<usize> {
+        &self.jac
+    }
+    fn hess_l_sparsity(&self) -> &SymbolicSparseColMat<usize> {
+        &self.hess
+    }
+    fn eval_f(&mut self, x: &[f64]) -> f64 {
+        self.set_x(x);
+        let t = Instant::now();
+        let f = self.user.eval_f(&self.x_full);
+        self.counters.f += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        f * self.obj_scale
+    }
+    fn eval_grad_f(&mut self, x: &[f64], grad: &mut [f64]) {
+        self.set_x(x);
+        let t = Instant::now();
+        self.user.eval_grad_f(&self.x_full, &mut self.grad_full);
+        self.counters.grad_f += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        for (k, &j) in self.free.iter().enumerate() {
+            grad[k] = self.grad_full[j] * self.obj_scale;
+        }
+    }
+    fn eval_g(&mut self, x: &[f64], g: &mut [f64]) {
+        self.set_x(x);
+        let t = Instant::now();
+        self.user.eval_g(&self.x_full, &mut self.g_full);
+        self.counters.g += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        for (k, &i) in self.rows.iter().enumerate() {
+            g[k] = self.g_full[i] * self.g_scale[k];
+        }
+    }
+    fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]) {
+        self.set_x(x);
+        let t = Instant::now();
+        self.user.eval_jac_g(&self.x_full, &mut self.jac_full);
+        self.counters.jac_g += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        for c in 0..self.jac.ncols() {
+            for p in self.jac.col_range(c) {
+                let r = self.jac.row_idx()[p];
+                values[p] = self.jac_full[self.jmap[p]] * self.g_scale[r];
+            }
+        }
+    }
+    fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]) {
+        self.set_x(x);
+        for (k, &i) in self.rows.iter().enumerate() {
+            self.lam_full[i] = lambda[k] * self.g_scale[k];
+        }
+        let t = Instant::now();
+        self.user.eval_hess_l(
+            &self.x_full,
+            obj_factor * self.obj_scale,
+            &self.lam_full,
+            &mut self.hess_full,
+        );
+        self.counters.hess_l += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        for (p, &q) in self.hmap.iter().enumerate() {
+            values[p] = self.hess_full[q];
+        }
+    }
+    fn variable_name(&self, i: usize) -> String {
+        self.user.variable_name(self.free[i])
+    }
+    fn constraint_name(&self, i: usize) -> String {
+        self.user.constraint_name(self.rows[i])
+    }
+}
+
+impl IpmProblem for Reduced<'_> {}

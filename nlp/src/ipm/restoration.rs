@@ -1,0 +1,425 @@
+//! IPOPT's ℓ1 feasibility restoration phase, solved by the same interior-point core
+//! recursively:
+//!
+//! min ρ Σ (p + n) + ζ/2 ‖D_R (x − x_R)‖²   s.t.  g_l ≤ g(x) − p + n ≤ g_u,  x_l ≤ x ≤ x_u,
+//! p, n ≥ 0,
+//!
+//! with ζ = resto_proximity_weight·√μ and D_R = diag(min(1, 1/|x_R|)). The inner loop stops
+//! as soon as the original infeasibility is reduced by κ_resto and the point is acceptable
+//! to the original filter. If the restoration problem converges instead, the original
+//! problem is locally infeasible (unless that point happens to be feasible).
+
+#![allow(clippy::needless_range_loop, clippy::result_large_err)]
+
+use faer::sparse::SymbolicSparseColMat;
+
+use crate::ipm::core::{barrier_value, Core, Outcome, Setup, Shared, Start};
+use crate::ipm::filter::Filter;
+use crate::ipm::reduced::IpmProblem;
+use crate::numeric::NumericNlp;
+use crate::options::MuStrategy;
+use crate::solution::Status;
+
+struct Resto<'a> {
+    outer: &'a mut dyn IpmProblem,
+    n: usize,
+    m: usize,
+    rho: f64,
+    zeta: f64,
+    dr2: Vec<f64>,
+    xr: Vec<f64>,
+    jac: SymbolicSparseColMat<usize>,
+    nnz_j_orig: usize,
+    hess: SymbolicSparseColMat<usize>,
+    hmap: Vec<usize>,
+    hdiag: Vec<usize>,
+    x_l: Vec<f64>,
+    x_u: Vec<f64>,
+    g_l: Vec<f64>,
+    g_u: Vec<f64>,
+    x0: Vec<f64>,
+    hbuf: Vec<f64>,
+    // acceptance test data (copied from the outer core)
+    slack_of_row: Vec<usize>,
+    g_eq: Vec<f64>,
+    wl: Vec<f64>,
+    wu: Vec<f64>,
+    has_l: Vec<bool>,
+    has_u: Vec<bool>,
+    kappa_d: f64,
+    mu_outer: f64,
+    filter: Filter,
+    theta_target: f64,
+    theta_max: f64,
+    gbuf: Vec<f64>,
+    wbuf: Vec<f64>,
+}
+
+impl NumericNlp for Resto<'_> {
+    fn n(&self) -> usize {
+        self.n + 2 * self.m
+    }
+    fn m(&self) -> usize {
+        self.m
+    }
+    fn bounds(&self, x_l: &mut [f64], x_u: &mut [f64], g_l: &mut [f64], g_u: &mut [f64]) {
+        x_l.copy_from_slice(&self.x_l);
+        x_u.copy_from_slice(&self.x_u);
+        g_l.copy_from_slice(&self.g_l);
+        g_u.copy_from_slice(&self.g_u);
+    }
+    fn initial_point(&self, x: &mut [f64]) {
+        x.copy_from_slice(&self.x0);
+    }
+    fn jac_g_sparsity(&self) -> &SymbolicSparseColMat<usize> {
+        &self.jac
+    }
+    fn hess_l_sparsity(&self) -> &SymbolicSparseColMat<usize> {
+        &self.hess
+    }
+    fn eval_f(&mut self, x: &[f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let pen: f64 = x[n..n + 2 * m].iter().sum();
+        let mut prox = 0.0;
+        for j in 0..n {
+            let d = x[j] - self.xr[j];
+            prox += self.dr2[j] * d * d;
+        }
+        self.rho * pen + 0.5 * self.zeta * prox
+    }
+    fn eval_grad_f(&mut self, x: &[f64], grad: &mut [f64]) {
+        let n = self.n;
+        for j in 0..n {
+            grad[j] = self.zeta * self.dr2[j] * (x[j] - self.xr[j]);
+        }
+        grad[n..].iter_mut().for_each(|v| *v = self.rho);
+    }
+    fn eval_g(&mut self, x: &[f64], g: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        self.outer.eval_g(&x[..n], g);
+        for i in 0..m {
+            g[i] += -x[n + i] + x[n + m + i];
+        }
+    }
+    fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        let k = self.nnz_j_orig;
+        self.outer.eval_jac_g(&x[..n], &mut values[..k]);
+        values[k..k + m].iter_mut().for_each(|v| *v = -1.0);
+        values[k + m..k + 2 * m].iter_mut().for_each(|v| *v = 1.0);
+    }
+    fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]) {
+        let n = self.n;
+        self.outer.eval_hess_l(&x[..n], 0.0, lambda, &mut self.hbuf);
+        values.iter_mut().for_each(|v| *v = 0.0);
+        for (p, &q) in self.hmap.iter().enumerate() {
+            values[q] += self.hbuf[p];
+        }
+        for j in 0..n {
+            values[self.hdiag[j]] += obj_factor * self.zeta * self.dr2[j];
+        }
+    }
+    fn variable_name(&self, i: usize) -> String {
+        let (n, m) = (self.n, self.m);
+        if i < n {
+            self.outer.variable_name(i)
+        } else if i < n + m {
+            format!("p[{}]", i - n)
+        } else {
+            format!("n[{}]", i - n - m)
+        }
+    }
+    fn constraint_name(&self, i: usize) -> String {
+        self.outer.constraint_name(i)
+    }
+}
+
+impl IpmProblem for Resto<'_> {
+    fn restoration_accepts(&mut self, w: &[f64]) -> bool {
+        let (n, m) = (self.n, self.m);
+        let x = &w[..n];
+        let s = &w[n + 2 * m..];
+        self.outer.eval_g(x, &mut self.gbuf);
+        if self.gbuf.iter().any(|v| !v.is_finite()) {
+            return false;
+        }
+        let mut theta = 0.0;
+        for i in 0..m {
+            let k = self.slack_of_row[i];
+            let c = if k == usize::MAX {
+                self.gbuf[i] - self.g_eq[i]
+            } else {
+                self.gbuf[i] - s[k]
+            };
+            theta += c.abs();
+        }
+        if theta > self.theta_target || theta > self.theta_max {
+            return false;
+        }
+        let f = self.outer.eval_f(x);
+        if !f.is_finite() {
+            return false;
+        }
+        self.wbuf[..n].copy_from_slice(x);
+        self.wbuf[n..].copy_from_slice(s);
+        let phi = barrier_value(
+            &self.wbuf,
+            f,
+            self.mu_outer,
+            self.kappa_d,
+            &self.wl,
+            &self.wu,
+            &self.has_l,
+            &self.has_u,
+        );
+        phi.is_finite() && self.filter.acceptable(theta, phi)
+    }
+}
+
+/// Runs a restoration phase from the outer core's current iterate. On success the outer
+/// core continues from the restored point; otherwise the final outcome is returned.
+pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Outcome> {
+    let (n, m, ni) = (core.n, core.m, core.ni);
+    let opts = core.opts.clone();
+    let mu = core.mu.max(inf_norm(&core.c));
+    let rho = opts.resto_penalty_parameter;
+    // Initial p, n (IPOPT's closed form: c − p + n = 0, complementarity μ).
+    let mut pv = vec![0.0; m];
+    let mut nv = vec![0.0; m];
+    for i in 0..m {
+        let c = core.c[i];
+        let a = (mu - rho * c) / (2.0 * rho);
+        let nn = a + (a * a + mu * c / (2.0 * rho)).sqrt();
+        nv[i] = nn.max(1e-300);
+        pv[i] = (c + nn).max(1e-300);
+    }
+    let xr: Vec<f64> = core.w[..n].to_vec();
+    let dr2: Vec<f64> = xr
+        .iter()
+        .map(|x| (1.0f64).min(1.0 / x.abs()).powi(2))
+        .collect();
+    // Patterns.
+    let jac_o = core.nlp.jac_g_sparsity().clone();
+    let nnz_j_orig = jac_o.row_idx().len();
+    let (jac, hess, hmap, hdiag) = {
+        let mut cp: Vec<usize> = jac_o.col_ptr()[..=n].to_vec();
+        let mut ri: Vec<usize> = Vec::with_capacity(nnz_j_orig + 2 * m);
+        for j in 0..n {
+            ri.extend(jac_o.row_idx_of_col_raw(j).iter().copied());
+        }
+        // Compact in case the original pattern had gaps.
+        cp.clear();
+        cp.push(0);
+        let mut acc = 0;
+        for j in 0..n {
+            acc += jac_o.row_idx_of_col_raw(j).len();
+            cp.push(acc);
+        }
+        for i in 0..m {
+            ri.push(i);
+            cp.push(ri.len());
+        }
+        for i in 0..m {
+            ri.push(i);
+            cp.push(ri.len());
+        }
+        let jac = SymbolicSparseColMat::new_checked(m, n + 2 * m, cp, None, ri);
+        let h_o = core.nlp.hess_l_sparsity();
+        let mut hcp = vec![0usize];
+        let mut hri = Vec::new();
+        let mut hmap = vec![0usize; h_o.row_idx().len()];
+        let mut hdiag = vec![0usize; n];
+        for j in 0..n {
+            let mut rows: Vec<usize> = h_o.row_idx_of_col_raw(j).to_vec();
+            rows.push(j);
+            rows.sort_unstable();
+            rows.dedup();
+            let base = hri.len();
+            for p in h_o.col_range(j) {
+                let r = h_o.row_idx()[p];
+                hmap[p] = base + rows.binary_search(&r).unwrap_or(0);
+            }
+            hdiag[j] = base + rows.binary_search(&j).unwrap_or(0);
+            hri.extend(rows);
+            hcp.push(hri.len());
+        }
+        for _ in 0..2 * m {
+            hcp.push(hri.len());
+        }
+        let hess = SymbolicSparseColMat::new_checked(n + 2 * m, n + 2 * m, hcp, None, hri);
+        (jac, hess, hmap, hdiag)
+    };
+    let hbuf_len = core.nlp.hess_l_sparsity().row_idx().len();
+    let mut x_l = vec![0.0; n + 2 * m];
+    let mut x_u = vec![f64::INFINITY; n + 2 * m];
+    x_l[..n].copy_from_slice(&core.wl[..n]);
+    x_u[..n].copy_from_slice(&core.wu[..n]);
+    let mut g_l = vec![0.0; m];
+    let mut g_u = vec![0.0; m];
+    for i in 0..m {
+        let k = core.slack_of_row[i];
+        if k == usize::MAX {
+            g_l[i] = core.g_eq[i];
+            g_u[i] = core.g_eq[i];
+        } else {
+            g_l[i] = core.wl[n + k];
+            g_u[i] = core.wu[n + k];
+        }
+    }
+    let mut x0 = xr.clone();
+    x0.extend_from_slice(&pv);
+    x0.extend_from_slice(&nv);
+    // Full inner iterate: w = [x, p, n, s].
+    let nwi = n + 2 * m + ni;
+    let mut w = x0.clone();
+    w.extend_from_slice(&core.w[n..]);
+    let mut zl = vec![0.0; nwi];
+    let mut zu = vec![0.0; nwi];
+    for j in 0..n {
+        zl[j] = core.zl[j].min(rho);
+        zu[j] = core.zu[j].min(rho);
+    }
+    for i in 0..m {
+        zl[n + i] = mu / pv[i];
+        zl[n + m + i] = mu / nv[i];
+    }
+    for k in 0..ni {
+        zl[n + 2 * m + k] = core.zl[n + k].min(rho);
+        zu[n + 2 * m + k] = core.zu[n + k].min(rho);
+    }
+    let theta = core.theta();
+    let theta_max = core.theta_max();
+    let resto = Resto {
+        n,
+        m,
+        rho,
+        zeta: opts.resto_proximity_weight * mu.sqrt(),
+        dr2,
+        xr,
+        jac,
+        nnz_j_orig,
+        hess,
+        hmap,
+        hdiag,
+        x_l,
+        x_u,
+        g_l,
+        g_u,
+        x0,
+        hbuf: vec![0.0; hbuf_len],
+        slack_of_row: core.slack_of_row.clone(),
+        g_eq: core.g_eq.clone(),
+        wl: core.wl.clone(),
+        wu: core.wu.clone(),
+        has_l: core.has_l.clone(),
+        has_u: core.has_u.clone(),
+        kappa_d: opts.kappa_d,
+        mu_outer: core.mu,
+        filter: core.filter.clone(),
+        theta_target: opts.required_infeasibility_reduction * theta,
+        theta_max,
+        gbuf: vec![0.0; m],
+        wbuf: vec![0.0; n + ni],
+        outer: &mut *core.nlp,
+    };
+    let mut resto = resto;
+    let setup = Setup {
+        mu_init: mu,
+        bound_relax_factor: 0.0,
+        in_resto: true,
+        obj_scale: 1.0,
+        g_scale: vec![1.0; m],
+        mu_strategy: MuStrategy::Monotone,
+    };
+    let outcome = {
+        let mut inner_opts = opts.clone();
+        inner_opts.acceptable_iter = 0;
+        inner_opts.start_with_resto = false;
+        let mut inner = match Core::new(&mut resto, &inner_opts, &setup) {
+            Ok(c) => c,
+            Err(msg) => {
+                return Err(Outcome {
+                    status: Status::RestorationFailed,
+                    w: core.w.clone(),
+                    y: core.y.clone(),
+                    zl: core.zl.clone(),
+                    zu: core.zu.clone(),
+                    message: msg,
+                    resto_converged: false,
+                })
+            }
+        };
+        inner.run(
+            shared,
+            Start::Exact {
+                w,
+                y: vec![0.0; m],
+                zl,
+                zu,
+            },
+        )
+    };
+    drop(resto);
+    // Map the inner point back: x = w[..n], s = w[n+2m..].
+    let mut w_o = outcome.w[..n].to_vec();
+    w_o.extend_from_slice(&outcome.w[n + 2 * m..]);
+    let mut zl_o = outcome.zl[..n].to_vec();
+    zl_o.extend_from_slice(&outcome.zl[n + 2 * m..]);
+    let mut zu_o = outcome.zu[..n].to_vec();
+    zu_o.extend_from_slice(&outcome.zu[n + 2 * m..]);
+    let fail = |core: &Core<'_>, status: Status, msg: String| Outcome {
+        status,
+        w: core.w.clone(),
+        y: core.y.clone(),
+        zl: core.zl.clone(),
+        zu: core.zu.clone(),
+        message: msg,
+        resto_converged: false,
+    };
+    match outcome.status {
+        Status::SolveSucceeded => {
+            if let Err(msg) = core.restart_from(&w_o, &zl_o, &zu_o) {
+                return Err(fail(core, Status::RestorationFailed, msg));
+            }
+            if outcome.resto_converged {
+                // The restoration problem converged: a minimiser of the infeasibility.
+                let viol = core
+                    .c
+                    .iter()
+                    .zip(core_g_scale(core))
+                    .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s));
+                if viol > opts.constr_viol_tol {
+                    return Err(fail(
+                        core,
+                        Status::InfeasibleProblemDetected,
+                        format!(
+                            "restoration converged to a point of local infeasibility (constraint violation {viol:.3e})"
+                        ),
+                    ));
+                }
+                // Feasible but not acceptable to the filter: restart the filter.
+                core.filter.reset();
+            }
+            Ok(())
+        }
+        Status::MaximumIterationsExceeded | Status::MaximumWallTimeExceeded => {
+            let _ = core.restart_from(&w_o, &zl_o, &zu_o);
+            Err(fail(core, outcome.status, outcome.message))
+        }
+        Status::InvalidNumberDetected => {
+            Err(fail(core, Status::RestorationFailed, outcome.message))
+        }
+        _ => {
+            let _ = core.restart_from(&w_o, &zl_o, &zu_o);
+            Err(fail(core, Status::RestorationFailed, outcome.message))
+        }
+    }
+}
+
+fn core_g_scale<'c>(core: &'c Core<'_>) -> &'c [f64] {
+    core.g_scale()
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |a, &b| a.max(b.abs()))
+}
