@@ -1,0 +1,219 @@
+//! From a scenario to a checked-ready plan: guess, build, compile, solve, read back.
+//!
+//! - `crawl` gait: one solve of the scheduled problem (order BR, FR, BL, FL).
+//! - `free` gait: (i) the lifted complementarity problem, solved with increasing penalty
+//!   `π` until `Σ_{i<j} s_i s_j` is below [`COMPLEMENTARITY_TOL`] at every transition;
+//!   this chooses which foot moves when; (ii) the scheduled problem for that choice,
+//!   warm-started from (i), which makes (10) hold exactly (non-moving feet share variables).
+use crate::gait;
+use crate::model::{self, Formulation, ModelError, PENALTY};
+use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
+use crate::scenario::{Foot, Gait, Scenario};
+use crate::terrain::{GapTerrain, Terrain};
+use nlp::ipm::Ipm;
+use nlp::{BuildError, IpmOptions, IterationRecord, NumericNlp, Solution, SolveError, Status};
+use std::time::Instant;
+
+/// Complementarity residual below which the free gait's first phase stops raising `π`.
+pub const COMPLEMENTARITY_TOL: f64 = 1e-10;
+
+/// Penalty values tried in turn by the free gait's first phase.
+pub const PENALTIES: [f64; 4] = [1e2, 1e4, 1e6, 1e8];
+
+/// Which back end solves the problem.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Backend {
+    /// The interior-point method.
+    #[default]
+    Ipm,
+    /// The SQP method (not available yet).
+    Sqp,
+}
+
+/// Options of a planning run.
+#[derive(Clone, Debug, Default)]
+pub struct Settings {
+    /// Solver back end.
+    pub backend: Backend,
+    /// Interior-point options (tolerances, print level, limits).
+    pub ipm: IpmOptions,
+}
+
+/// One solver run within a plan's solve (the free gait has several).
+#[derive(Clone, Debug)]
+pub struct Phase {
+    /// What this run solved.
+    pub name: String,
+    /// The solver's status.
+    pub status: Status,
+    /// Iteration records, IPOPT columns.
+    pub records: Vec<IterationRecord>,
+    /// Residual of (10) at the end of the run: max over transitions of `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²`.
+    pub complementarity: f64,
+}
+
+/// The result of planning.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The solution file (the spec's schema).
+    pub file: SolutionFile,
+    /// The solver runs, in order.
+    pub phases: Vec<Phase>,
+}
+
+/// What can stop a planning run (a failed solve is an `Outcome` with a failing status).
+#[derive(Debug, thiserror::Error)]
+pub enum PlanningError {
+    #[error("building the model: {0}")]
+    Model(#[from] ModelError),
+    #[error("compiling the model: {0}")]
+    Build(#[from] BuildError),
+    #[error("solver input: {0}")]
+    Solve(#[from] SolveError),
+    #[error("reading the plan: {0}")]
+    Plan(#[from] PlanError),
+    #[error("the {0:?} back end is not available yet (use --solver ipm)")]
+    Unavailable(Backend),
+}
+
+/// Residual of (10) for a flat plan: the largest `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²` over transitions.
+pub fn complementarity_residual(s: &Scenario, x: &[f64]) -> f64 {
+    (1..s.n_step)
+        .map(|k| {
+            let d: Vec<f64> = Foot::ALL.iter().map(|&i| step_sq(x, k, i)).collect();
+            let mut r = 0.0;
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    r += d[a] * d[b];
+                }
+            }
+            r
+        })
+        .fold(0.0, f64::max)
+}
+
+fn step_sq(x: &[f64], k: usize, i: Foot) -> f64 {
+    let (a, b) = (foot_offset(k - 1, i), foot_offset(k, i));
+    (0..3).map(|d| (x[b + d] - x[a + d]).powi(2)).sum()
+}
+
+/// The foot that moves most at each transition of a flat plan.
+pub fn schedule_of(s: &Scenario, x: &[f64]) -> Vec<Foot> {
+    (1..s.n_step)
+        .map(|k| {
+            Foot::ALL
+                .into_iter()
+                .max_by(|&a, &b| step_sq(x, k, a).total_cmp(&step_sq(x, k, b)))
+                .unwrap_or(Foot::BR)
+        })
+        .collect()
+}
+
+struct Run {
+    solution: Solution,
+    flat: Vec<f64>,
+}
+
+fn run(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    formulation: &Formulation,
+    guess: &[f64],
+    settings: &Settings,
+    phases: &mut Vec<Phase>,
+    name: &str,
+) -> Result<Run, PlanningError> {
+    let model = model::build(s, terrain, formulation, guess)?;
+    let mut compiled = model.problem.compile()?;
+    let ipm = Ipm::new(settings.ipm.clone());
+    let mut best: Option<Run> = None;
+    let penalties: &[f64] = if model.has_penalty { &PENALTIES } else { &[0.0] };
+    for &penalty in penalties {
+        if model.has_penalty {
+            compiled.set_parameter(PENALTY, &[penalty])?;
+        }
+        let solution = match &best {
+            Some(prev) => {
+                compiled.set_initial_point(&prev.solution.x)?;
+                ipm.solve(&mut compiled)?
+            }
+            None => ipm.solve(&mut compiled)?,
+        };
+        let flat = model.problem.evaluate(&model.layout, &solution.x)?;
+        let complementarity = complementarity_residual(s, &flat);
+        phases.push(Phase {
+            name: if model.has_penalty { format!("{name}, penalty {penalty:e}") } else { name.to_string() },
+            status: solution.status,
+            records: solution.stats.records.clone(),
+            complementarity,
+        });
+        let done = !solution.status.is_success() || complementarity <= COMPLEMENTARITY_TOL;
+        best = Some(Run { solution, flat });
+        if done {
+            break;
+        }
+    }
+    Ok(best.expect("at least one penalty is tried"))
+}
+
+/// Plans scenario `s` (its `gait` field chooses the formulation) on the spec's gap terrain.
+pub fn plan(s: &Scenario, settings: &Settings) -> Result<Outcome, PlanningError> {
+    plan_on(s, &GapTerrain { gap: s.gap }, settings)
+}
+
+/// Plans scenario `s` on any terrain.
+pub fn plan_on(s: &Scenario, terrain: &dyn Terrain, settings: &Settings) -> Result<Outcome, PlanningError> {
+    if settings.backend != Backend::Ipm {
+        return Err(PlanningError::Unavailable(settings.backend));
+    }
+    let started = Instant::now();
+    let mut phases = Vec::new();
+    let guess = gait::crawl(s);
+    let last = match s.gait {
+        Gait::Crawl => {
+            let f = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
+            run(s, terrain, &f, &guess, settings, &mut phases, "crawl gait")?
+        }
+        Gait::Free => {
+            let choice = run(s, terrain, &Formulation::Complementarity, &guess, settings, &mut phases, "free gait: choose the steps")?;
+            if !choice.solution.status.is_success() {
+                choice
+            } else {
+                let f = Formulation::Scheduled(schedule_of(s, &choice.flat));
+                run(s, terrain, &f, &choice.flat, settings, &mut phases, "free gait: exact steps")?
+            }
+        }
+    };
+    let plan = Plan::from_flat(s, &last.flat)?;
+    let solver = SolverInfo {
+        name: "ipm".into(),
+        status: status_name(last.solution.status).into(),
+        iterations: phases.iter().map(|p| p.records.len().saturating_sub(1)).sum(),
+        objective: plan.cost(s),
+        max_constraint_violation: last.solution.constr_viol,
+        solve_seconds: started.elapsed().as_secs_f64(),
+    };
+    Ok(Outcome { file: SolutionFile::new(s.clone(), solver, plan), phases })
+}
+
+/// The status word written to the solution file (`solved` for success).
+pub fn status_name(status: Status) -> &'static str {
+    match status {
+        Status::SolveSucceeded => "solved",
+        Status::SolvedToAcceptableLevel => "solved_to_acceptable_level",
+        Status::InfeasibleProblemDetected => "local_infeasibility",
+        Status::RestorationFailed => "restoration_failed",
+        Status::MaximumIterationsExceeded => "maximum_iterations_exceeded",
+        Status::MaximumWallTimeExceeded => "maximum_wall_time_exceeded",
+        Status::DivergingIterates => "diverging_iterates",
+        Status::InvalidNumberDetected => "invalid_number_detected",
+        _ => "failed",
+    }
+}
+
+/// The number of variables and constraints of a built model (for summaries).
+pub fn size(s: &Scenario, formulation: &Formulation) -> Result<(usize, usize), PlanningError> {
+    let m = model::build(s, &GapTerrain { gap: s.gap }, formulation, &gait::crawl(s))?;
+    let c = m.problem.compile()?;
+    Ok((c.n(), c.m()))
+}
