@@ -1,0 +1,407 @@
+//! The independent checker.
+//!
+//! Recomputes, from a [`SolutionFile`] alone, every requirement of the spec's section
+//! "What a solved plan must satisfy", with plain `f64` / `nalgebra` arithmetic: no
+//! symbolic expressions and no solver code are involved, so a bug in the model or the
+//! solver cannot hide itself here.
+//!
+//! Labels: `(2)`…`(11)` are the source's equations; `gap` is the keep-out of the widened
+//! gap; `start` is stance 1 = the scenario's start; `goal` is the final CoMs within 0.05 m
+//! of their goals; `crawl` (crawl gait mode only) is a foot moving out of its turn;
+//! `n_step` is a stance count that differs from the scenario's.
+
+use crate::gait;
+use crate::plan::{SolutionFile, Stance};
+use crate::scenario::{dist2, Biped, Foot, Gait, Scenario, Vec3};
+use nalgebra::Vector3;
+use serde::Serialize;
+use std::fmt;
+
+/// Absolute tolerance of every residual, in the units of its equation (spec).
+pub const TOL: f64 = 1e-6;
+
+/// A foot displaced by more than this between consecutive stances has moved (m), for (10).
+pub const MOVE_TOL: f64 = 1e-6;
+
+/// Final CoMs must be within this distance of their goals (m).
+pub const GOAL_TOL: f64 = 0.05;
+
+/// Whether the goal requirement applies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum GoalCheck {
+    /// Required "when n_step allows it": when the spec's crawl heuristic (each foot
+    /// ≤ 0.28 m per move, one foot per transition) reaches both goals within n_step
+    /// stances, which proves the goal reachable. True for the default scenario.
+    #[default]
+    Auto,
+    /// Always required.
+    Required,
+    /// Never checked.
+    Skip,
+}
+
+/// Checker settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Residual tolerance (default [`TOL`]).
+    pub tol: f64,
+    /// Goal requirement (default [`GoalCheck::Auto`]).
+    pub goal: GoalCheck,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            tol: TOL,
+            goal: GoalCheck::Auto,
+        }
+    }
+}
+
+/// One requirement not met.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Violation {
+    /// Label: `(2)`…`(11)`, `gap`, `start`, `goal`, `crawl` or `n_step`.
+    pub equation: String,
+    /// What was checked, in words, with the unit of `amount`.
+    pub name: String,
+    /// Stance, 1-based; for (5), (10) and `crawl`, the first of the two stances compared.
+    pub stance: usize,
+    /// The foot (or feet, or CoM) concerned, when there is one.
+    pub foot: Option<String>,
+    /// By how much the requirement is missed (beyond the tolerance's reference value).
+    pub amount: f64,
+}
+
+impl fmt::Display for Violation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {}: stance {}", self.equation, self.name, self.stance)?;
+        if let Some(foot) = &self.foot {
+            write!(f, ", {foot}")?;
+        }
+        write!(f, ": violated by {:.3e}", self.amount)
+    }
+}
+
+/// The checker's findings.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    /// Every requirement not met, in stance order within each check.
+    pub violations: Vec<Violation>,
+    /// Number of stances checked.
+    pub stances: usize,
+    /// Number of foot moves (a foot displaced by more than [`MOVE_TOL`] between stances).
+    pub moves: usize,
+    /// Largest residual of the (2)–(11) checks, whether or not within tolerance
+    /// (mixed units: N, N·m, m, m²).
+    pub max_residual: f64,
+    /// Whether the goal requirement was checked.
+    pub goal_checked: bool,
+}
+
+impl Report {
+    /// True when nothing is violated.
+    pub fn ok(&self) -> bool {
+        self.violations.is_empty()
+    }
+
+    /// The distinct labels of the violations, sorted.
+    pub fn equations(&self) -> Vec<String> {
+        let mut e: Vec<String> = self.violations.iter().map(|v| v.equation.clone()).collect();
+        e.sort();
+        e.dedup();
+        e
+    }
+
+    /// One-line summary.
+    pub fn summary(&self) -> String {
+        let goal = if self.goal_checked {
+            "goals reached"
+        } else {
+            "goal not required"
+        };
+        if self.ok() {
+            format!(
+                "OK: {} stances, {} foot moves, {goal}, largest residual {:.2e} (tolerance {TOL:.0e})",
+                self.stances, self.moves, self.max_residual
+            )
+        } else {
+            format!(
+                "FAILED: {} violations ({}) in {} stances",
+                self.violations.len(),
+                self.equations().join(", "),
+                self.stances
+            )
+        }
+    }
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for v in &self.violations {
+            writeln!(f, "{v}")?;
+        }
+        write!(f, "{}", self.summary())
+    }
+}
+
+fn v3(a: Vec3) -> Vector3<f64> {
+    Vector3::from(a)
+}
+
+fn inf_norm(v: Vector3<f64>) -> f64 {
+    v.iter().fold(
+        0.0f64,
+        |m, x| if x.is_nan() { f64::NAN } else { m.max(x.abs()) },
+    )
+}
+
+struct Checker<'a> {
+    s: &'a Scenario,
+    tol: f64,
+    out: Vec<Violation>,
+    max_residual: f64,
+}
+
+impl Checker<'_> {
+    /// Records `amount` (how far past its bound a residual is); a violation when it
+    /// exceeds the tolerance or is NaN.
+    fn test(&mut self, eq: &str, name: &str, stance: usize, foot: Option<String>, amount: f64) {
+        if amount.is_nan() || amount > self.max_residual {
+            self.max_residual = amount;
+        }
+        if amount.is_nan() || amount > self.tol {
+            self.out.push(Violation {
+                equation: eq.to_string(),
+                name: name.to_string(),
+                stance,
+                foot,
+                amount,
+            });
+        }
+    }
+
+    fn stance(&mut self, k: usize, st: &Stance) {
+        let s = self.s;
+        let m = s.masses.total();
+        let w = (v3(st.com.b) * s.masses.b + v3(st.com.f) * s.masses.f) / m;
+        // (2) static balance.
+        let mut force = v3(s.gravity_vector()) * m;
+        let mut moment = Vector3::zeros();
+        for i in Foot::ALL {
+            let f = v3(st.forces.get(i));
+            force += f;
+            moment += (v3(st.feet.get(i)) - w).cross(&f);
+        }
+        self.test("(2)", "force balance (N)", k, None, inf_norm(force));
+        self.test("(2)", "moment balance (N·m)", k, None, inf_norm(moment));
+        for i in Foot::ALL {
+            let p = st.feet.get(i);
+            let name = Some(i.name().to_string());
+            // (3) on the terrain: f_env = h(x) − z = 0.
+            let f_env = s.gap.height(p[0]) - p[2];
+            self.test(
+                "(3)",
+                "foot on terrain |h(x) − z| (m)",
+                k,
+                name.clone(),
+                f_env.abs(),
+            );
+            // (4) friction cone about the terrain normal.
+            let n = v3(s.gap.normal(p[0]));
+            let f = v3(st.forces.get(i));
+            let fn_ = f.dot(&n);
+            let ft = (f - n * fn_).norm();
+            self.test(
+                "(4)",
+                "normal force below F_thr (N)",
+                k,
+                name.clone(),
+                s.friction.f_thr - fn_,
+            );
+            self.test(
+                "(4)",
+                "tangential force above μ·normal (N)",
+                k,
+                name.clone(),
+                ft - s.friction.mu * fn_,
+            );
+            // (11) rigid legs.
+            let j = i.biped();
+            let l2 = dist2(st.com.get(j), p);
+            self.test(
+                "(11)",
+                &format!("leg length ‖r_{j} − r_foot‖² − {} (m²)", s.leg_length_sq),
+                k,
+                name.clone(),
+                (l2 - s.leg_length_sq).abs(),
+            );
+            // Keep-out of the widened gap (distance inside it).
+            let (lo, hi) = s.gap.keep_out();
+            let inside = (p[0] - lo).min(hi - p[0]);
+            if p[0].is_nan() || inside > 0.0 {
+                self.test("gap", "foot inside the widened gap by (m)", k, name, inside);
+            }
+        }
+        // (6)–(9) foot distances.
+        let pairs = [
+            ("(6)", Foot::BR, Foot::FR, s.same_side_sq),
+            ("(7)", Foot::BL, Foot::FL, s.same_side_sq),
+            ("(8)", Foot::BR, Foot::BL, s.same_biped_sq),
+            ("(9)", Foot::FR, Foot::FL, s.same_biped_sq),
+        ];
+        for (eq, a, b, bounds) in pairs {
+            let d2 = dist2(st.feet.get(a), st.feet.get(b));
+            let what = Some(format!("{a}–{b}"));
+            self.test(
+                eq,
+                &format!("squared distance below {} (m²)", bounds.min),
+                k,
+                what.clone(),
+                bounds.min - d2,
+            );
+            self.test(
+                eq,
+                &format!("squared distance above {} (m²)", bounds.max),
+                k,
+                what,
+                d2 - bounds.max,
+            );
+        }
+    }
+
+    /// (5), (10) and the crawl schedule between stances k and k+1 (1-based k).
+    fn transition(&mut self, k: usize, a: &Stance, b: &Stance, scheduled: Option<Foot>) -> usize {
+        let s = self.s;
+        let mut moved = Vec::new();
+        for i in Foot::ALL {
+            let d2 = dist2(a.feet.get(i), b.feet.get(i));
+            self.test(
+                "(5)",
+                &format!("step length ‖Δr‖² above {} (m²)", s.step_radius_sq),
+                k,
+                Some(i.name().to_string()),
+                d2 - s.step_radius_sq,
+            );
+            let d = d2.sqrt();
+            if d.is_nan() || d > MOVE_TOL {
+                moved.push((i, d));
+            }
+        }
+        if moved.len() > 1 {
+            let mut ds: Vec<f64> = moved.iter().map(|m| m.1).collect();
+            ds.sort_by(|x, y| y.total_cmp(x));
+            let feet: Vec<&str> = moved.iter().map(|m| m.0.name()).collect();
+            self.out.push(Violation {
+                equation: "(10)".into(),
+                name: format!("{} feet move at once; second-largest move (m)", moved.len()),
+                stance: k,
+                foot: Some(feet.join("+")),
+                amount: ds[1],
+            });
+        }
+        if let Some(turn) = scheduled {
+            for &(i, d) in &moved {
+                if i != turn {
+                    self.out.push(Violation {
+                        equation: "crawl".into(),
+                        name: format!("foot moves out of turn ({turn}'s turn) by (m)"),
+                        stance: k,
+                        foot: Some(i.name().to_string()),
+                        amount: d,
+                    });
+                }
+            }
+        }
+        moved.len()
+    }
+}
+
+/// Checks a solution file with the default [`Options`].
+pub fn check(file: &SolutionFile) -> Report {
+    check_with(file, &Options::default())
+}
+
+/// Checks a solution file: every requirement of the spec's list, each stance, each foot.
+pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
+    let s = &file.scenario;
+    let st = &file.stances;
+    let mut c = Checker {
+        s,
+        tol: opts.tol,
+        out: Vec::new(),
+        max_residual: 0.0,
+    };
+    if st.len() != s.n_step {
+        c.out.push(Violation {
+            equation: "n_step".into(),
+            name: format!(
+                "stance count differs from the scenario's n_step {}",
+                s.n_step
+            ),
+            stance: st.len(),
+            foot: None,
+            amount: (st.len() as f64 - s.n_step as f64).abs(),
+        });
+    }
+    for (k, stance) in st.iter().enumerate() {
+        c.stance(k + 1, stance);
+    }
+    let schedule = gait::crawl_schedule(st.len());
+    let mut moves = 0;
+    for k in 0..st.len().saturating_sub(1) {
+        let turn = (s.gait == Gait::Crawl).then(|| schedule[k]);
+        moves += c.transition(k + 1, &st[k], &st[k + 1], turn);
+    }
+    let max_residual = c.max_residual;
+    let mut out = c.out;
+    let tol = opts.tol;
+    if let Some(first) = st.first() {
+        let mut start = |what: String, got: Vec3, want: Vec3| {
+            let d = inf_norm(v3(got) - v3(want));
+            if d.is_nan() || d > tol {
+                out.push(Violation {
+                    equation: "start".into(),
+                    name: "stance 1 differs from the scenario's start by (m)".into(),
+                    stance: 1,
+                    foot: Some(what),
+                    amount: d,
+                });
+            }
+        };
+        for j in Biped::ALL {
+            start(format!("CoM {j}"), first.com.get(j), s.start.com.get(j));
+        }
+        for i in Foot::ALL {
+            start(i.name().to_string(), first.feet.get(i), s.start.feet.get(i));
+        }
+    }
+    let goal_checked = match opts.goal {
+        GoalCheck::Required => true,
+        GoalCheck::Skip => false,
+        GoalCheck::Auto => gait::crawl_stances_to_goal(s, GOAL_TOL, s.n_step).is_some(),
+    };
+    if goal_checked {
+        if let Some(last) = st.last() {
+            for j in Biped::ALL {
+                let d = dist2(last.com.get(j), s.goal.get(j)).sqrt();
+                if d.is_nan() || d > GOAL_TOL {
+                    out.push(Violation {
+                        equation: "goal".into(),
+                        name: format!("final CoM farther than {GOAL_TOL} m from its goal by (m)"),
+                        stance: st.len(),
+                        foot: Some(format!("CoM {j}")),
+                        amount: d - GOAL_TOL,
+                    });
+                }
+            }
+        }
+    }
+    Report {
+        violations: out,
+        stances: st.len(),
+        moves,
+        max_residual,
+        goal_checked,
+    }
+}
