@@ -13,4 +13,12 @@
 //!   with plain `f64` arithmetic (no symbolic or solver code);
 //! - [`render`]: hand-written SVG plots of a plan and of solver convergence.
 
+pub mod check;
+pub mod gait;
+pub mod model;
+pub mod plan;
+pub mod render;
 pub mod scenario;
+pub mod solve;
+
+pub mod terrain;

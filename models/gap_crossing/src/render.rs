@@ -1,0 +1,756 @@
+//! Plots as plain, hand-written SVG (no plotting crate).
+//!
+//! - [`plan_svg`]: top view (x–y) of every stance — feet, CoMs and the support polygon
+//!   coloured by stance index, the gap and its safety margin shaded — above a side view
+//!   (x–z) with the terrain profile, feet, CoMs and legs. Both views use equal scales on
+//!   their two axes, so distances and leg geometry read true.
+//! - [`convergence_svg`]: objective, primal infeasibility and complementarity residual
+//!   per iteration on a log scale.
+
+use crate::plan::SolutionFile;
+use crate::scenario::{Biped, Foot, Scenario, Vec3};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write;
+
+/// One solver iteration, as plotted by [`convergence_svg`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IterRecord {
+    /// Iteration number.
+    pub iter: usize,
+    /// Objective value (plotted as |objective|).
+    pub objective: f64,
+    /// Primal infeasibility (largest constraint violation).
+    pub inf_pr: f64,
+    /// Complementarity residual (e.g. largest product of (10), or the barrier's).
+    pub compl: f64,
+}
+
+/// Width of every figure (px).
+const WIDTH: f64 = 1000.0;
+const MARGIN_L: f64 = 70.0;
+const MARGIN_R: f64 = 170.0;
+const FONT: &str = "font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\"";
+
+/// Viridis-like colour ramp, t in [0, 1] → `#rrggbb`.
+pub fn ramp(t: f64) -> String {
+    const STOPS: [[f64; 3]; 6] = [
+        [68.0, 1.0, 84.0],
+        [65.0, 68.0, 135.0],
+        [42.0, 120.0, 142.0],
+        [34.0, 168.0, 132.0],
+        [122.0, 209.0, 81.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (STOPS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - i as f64;
+    let c: Vec<u8> = (0..3)
+        .map(|a| (STOPS[i][a] * (1.0 - f) + STOPS[i + 1][a] * f).round() as u8)
+        .collect();
+    format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// A "nice" tick step (1, 2 or 5 × 10ⁿ) giving about `target` ticks over `span`.
+fn nice_step(span: f64, target: f64) -> f64 {
+    if !span.is_finite() || span <= 0.0 {
+        return 1.0;
+    }
+    let raw = span / target;
+    let p = 10f64.powf(raw.log10().floor());
+    let m = raw / p;
+    let n = if m < 1.5 {
+        1.0
+    } else if m < 3.5 {
+        2.0
+    } else if m < 7.5 {
+        5.0
+    } else {
+        10.0
+    };
+    n * p
+}
+
+fn ticks(lo: f64, hi: f64, target: f64) -> Vec<f64> {
+    let step = nice_step(hi - lo, target);
+    let mut t = (lo / step).ceil() * step;
+    let mut out = Vec::new();
+    while t <= hi + step * 1e-9 && out.len() < 100 {
+        out.push(if t.abs() < step * 1e-9 { 0.0 } else { t });
+        t += step;
+    }
+    out
+}
+
+fn fmt_tick(v: f64, step: f64) -> String {
+    let decimals = if step >= 1.0 {
+        0
+    } else {
+        (-step.log10()).ceil() as usize
+    };
+    format!("{v:.decimals$}")
+}
+
+/// A linear map from data to pixels for one panel with equal scales on both axes.
+struct Panel {
+    x0: f64,
+    y0: f64,
+    /// Data range.
+    xr: (f64, f64),
+    yr: (f64, f64),
+    scale: f64,
+}
+
+impl Panel {
+    fn px(&self, x: f64) -> f64 {
+        self.x0 + (x - self.xr.0) * self.scale
+    }
+    fn py(&self, y: f64) -> f64 {
+        self.y0 + (self.yr.1 - y) * self.scale
+    }
+    fn w(&self) -> f64 {
+        (self.xr.1 - self.xr.0) * self.scale
+    }
+    fn h(&self) -> f64 {
+        (self.yr.1 - self.yr.0) * self.scale
+    }
+
+    /// Frame, grid, ticks and axis labels.
+    fn axes(&self, svg: &mut String, xlabel: &str, ylabel: &str, title: &str) {
+        let (w, h) = (self.w(), self.h());
+        let _ = writeln!(
+            svg,
+            r##"<rect x="{:.1}" y="{:.1}" width="{w:.1}" height="{h:.1}" fill="white" stroke="#333" stroke-width="1"/>"##,
+            self.x0, self.y0
+        );
+        let xs = nice_step(self.xr.1 - self.xr.0, 12.0);
+        for t in ticks(self.xr.0, self.xr.1, 12.0) {
+            let x = self.px(t);
+            let _ = writeln!(
+                svg,
+                r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#ddd" stroke-width="0.6"/><line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#333"/><text x="{x:.1}" y="{:.1}" font-size="11" text-anchor="middle" {FONT}>{}</text>"##,
+                self.y0,
+                self.y0 + h,
+                self.y0 + h,
+                self.y0 + h + 5.0,
+                self.y0 + h + 17.0,
+                fmt_tick(t, xs)
+            );
+        }
+        let ys = nice_step(self.yr.1 - self.yr.0, (h / 40.0).max(2.0));
+        for t in ticks(self.yr.0, self.yr.1, (h / 40.0).max(2.0)) {
+            let y = self.py(t);
+            let _ = writeln!(
+                svg,
+                r##"<line x1="{:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#ddd" stroke-width="0.6"/><line x1="{:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#333"/><text x="{:.1}" y="{:.1}" font-size="11" text-anchor="end" {FONT}>{}</text>"##,
+                self.x0,
+                self.x0 + w,
+                self.x0 - 5.0,
+                self.x0,
+                self.x0 - 8.0,
+                y + 4.0,
+                fmt_tick(t, ys)
+            );
+        }
+        let _ = writeln!(
+            svg,
+            r#"<text x="{:.1}" y="{:.1}" font-size="12" text-anchor="middle" {FONT}>{}</text>"#,
+            self.x0 + w / 2.0,
+            self.y0 + h + 34.0,
+            esc(xlabel)
+        );
+        let (lx, ly) = (self.x0 - 45.0, self.y0 + h / 2.0);
+        let _ = writeln!(
+            svg,
+            r#"<text x="{lx:.1}" y="{ly:.1}" font-size="12" text-anchor="middle" transform="rotate(-90 {lx:.1} {ly:.1})" {FONT}>{}</text>"#,
+            esc(ylabel)
+        );
+        let _ = writeln!(
+            svg,
+            r#"<text x="{:.1}" y="{:.1}" font-size="13" font-weight="bold" {FONT}>{}</text>"#,
+            self.x0,
+            self.y0 - 8.0,
+            esc(title)
+        );
+    }
+
+    fn clip(&self, svg: &mut String, id: &str) {
+        let _ = writeln!(
+            svg,
+            r#"<clipPath id="{id}"><rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}"/></clipPath>"#,
+            self.x0,
+            self.y0,
+            self.w(),
+            self.h()
+        );
+    }
+}
+
+/// Marker for a foot (circle for back feet, square for front) or CoM (diamond).
+fn foot_marker(svg: &mut String, x: f64, y: f64, foot: Foot, colour: &str) {
+    match foot.biped() {
+        Biped::B => {
+            let _ = writeln!(
+                svg,
+                r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{colour}" stroke="black" stroke-width="0.4"/>"#
+            );
+        }
+        Biped::F => {
+            let _ = writeln!(
+                svg,
+                r#"<rect x="{:.1}" y="{:.1}" width="7" height="7" fill="{colour}" stroke="black" stroke-width="0.4"/>"#,
+                x - 3.5,
+                y - 3.5
+            );
+        }
+    }
+}
+
+fn com_marker(svg: &mut String, x: f64, y: f64, colour: &str) {
+    let _ = writeln!(
+        svg,
+        r#"<path d="M{:.1},{y:.1} L{x:.1},{:.1} L{:.1},{y:.1} L{x:.1},{:.1} Z" fill="{colour}" stroke="black" stroke-width="0.4"/>"#,
+        x - 5.0,
+        y - 5.0,
+        x + 5.0,
+        y + 5.0
+    );
+}
+
+fn goal_marker(svg: &mut String, x: f64, y: f64, label: &str) {
+    let _ = writeln!(
+        svg,
+        r##"<circle cx="{x:.1}" cy="{y:.1}" r="8" fill="none" stroke="#d62728" stroke-width="1.6"/><line x1="{:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#d62728"/><line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#d62728"/><text x="{:.1}" y="{:.1}" font-size="11" fill="#d62728" {FONT}>{}</text>"##,
+        x - 11.0,
+        x + 11.0,
+        y - 11.0,
+        y + 11.0,
+        x + 10.0,
+        y - 10.0,
+        esc(label)
+    );
+}
+
+/// Terrain sample points: uniform, plus points hugging each gap edge so the steep atan
+/// edges are drawn as edges.
+fn terrain_xs(s: &Scenario, lo: f64, hi: f64) -> Vec<f64> {
+    let mut xs: Vec<f64> = (0..=400)
+        .map(|i| lo + (hi - lo) * i as f64 / 400.0)
+        .collect();
+    let w = 5.0 / s.gap.steepness.max(1e-9);
+    for e in [s.gap.min, s.gap.max] {
+        for d in [-20.0, -5.0, -1.0, 0.0, 1.0, 5.0, 20.0] {
+            let x = e + d * w;
+            if x > lo && x < hi {
+                xs.push(x);
+            }
+        }
+    }
+    xs.sort_by(f64::total_cmp);
+    xs
+}
+
+/// The plan figure (top view above side view) of a solution file.
+pub fn plan_svg(file: &SolutionFile) -> String {
+    let s = &file.scenario;
+    let st = &file.stances;
+    let n = st.len().max(1);
+    let colour = |k: usize| {
+        ramp(if n > 1 {
+            k as f64 / (n - 1) as f64
+        } else {
+            0.0
+        })
+    };
+
+    // Data ranges over every point drawn.
+    let mut pts: Vec<Vec3> = Vec::new();
+    for x in st {
+        pts.extend(x.feet.to_array());
+        pts.push(x.com.b);
+        pts.push(x.com.f);
+    }
+    pts.extend(s.start.feet.to_array());
+    pts.push(s.goal.b);
+    pts.push(s.goal.f);
+    let finite = |v: &f64| v.is_finite();
+    let xs: Vec<f64> = pts.iter().map(|p| p[0]).filter(finite).collect();
+    let ys: Vec<f64> = pts.iter().map(|p| p[1]).filter(finite).collect();
+    let zs: Vec<f64> = pts.iter().map(|p| p[2]).filter(finite).collect();
+    let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (gl, gh) = s.gap.keep_out();
+    let xr = (min(&xs).min(gl) - 0.4, max(&xs).max(gh) + 0.4);
+    let yr = (min(&ys) - 0.3, max(&ys) + 0.3);
+    let shown_depth = s.gap.depth.min(1.0);
+    let zr = (
+        min(&zs).max(-shown_depth - 0.2).min(-shown_depth) - 0.1,
+        max(&zs) + 0.15,
+    );
+    let scale = (WIDTH - MARGIN_L - MARGIN_R) / (xr.1 - xr.0);
+    let top = Panel {
+        x0: MARGIN_L,
+        y0: 70.0,
+        xr,
+        yr,
+        scale,
+    };
+    let side = Panel {
+        x0: MARGIN_L,
+        y0: top.y0 + top.h() + 80.0,
+        xr,
+        yr: zr,
+        scale,
+    };
+    let height = side.y0 + side.h() + 50.0;
+
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{height:.0}" viewBox="0 0 {WIDTH} {height:.0}">"#
+    );
+    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        svg,
+        r#"<text x="{MARGIN_L}" y="24" font-size="16" font-weight="bold" {FONT}>Gap crossing: {} stances, gait {}, solver {} ({}), objective {:.4e}</text>"#,
+        st.len(),
+        s.gait,
+        esc(&file.solver.name),
+        esc(&file.solver.status),
+        file.solver.objective
+    );
+    let _ = writeln!(
+        svg,
+        r##"<text x="{MARGIN_L}" y="42" font-size="12" fill="#555" {FONT}>gap x ∈ ({}, {}) m, depth {} m, margin {} m; squares = front feet, circles = back feet, diamonds = CoMs; colour = stance</text>"##,
+        s.gap.min, s.gap.max, s.gap.depth, s.gap.margin
+    );
+    let _ = writeln!(svg, "<defs>");
+    top.clip(&mut svg, "clip-top");
+    side.clip(&mut svg, "clip-side");
+    let _ = writeln!(svg, "</defs>");
+
+    // ---- Top view.
+    top.axes(&mut svg, "x (m)", "y (m)", "Top view (x–y)");
+    let _ = writeln!(svg, r##"<g clip-path="url(#clip-top)">"##);
+    let band = |svg: &mut String, p: &Panel, a: f64, b: f64, fill: &str, op: f64| {
+        let _ = writeln!(
+            svg,
+            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{fill}" fill-opacity="{op}"/>"#,
+            p.px(a),
+            p.y0,
+            (p.px(b) - p.px(a)).max(0.5),
+            p.h()
+        );
+    };
+    band(&mut svg, &top, gl, gh, "#d62728", 0.15);
+    band(&mut svg, &top, s.gap.min, s.gap.max, "#7f1d1d", 0.45);
+    // Foot trails (thin grey) and CoM paths.
+    for i in Foot::ALL {
+        let path: Vec<String> = st
+            .iter()
+            .map(|x| {
+                format!(
+                    "{:.1},{:.1}",
+                    top.px(x.feet.get(i)[0]),
+                    top.py(x.feet.get(i)[1])
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            svg,
+            r##"<polyline points="{}" fill="none" stroke="#999" stroke-width="0.8"/>"##,
+            path.join(" ")
+        );
+    }
+    for j in Biped::ALL {
+        let path: Vec<String> = st
+            .iter()
+            .map(|x| {
+                format!(
+                    "{:.1},{:.1}",
+                    top.px(x.com.get(j)[0]),
+                    top.py(x.com.get(j)[1])
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            svg,
+            r##"<polyline points="{}" fill="none" stroke="#444" stroke-width="1" stroke-dasharray="3,2"/>"##,
+            path.join(" ")
+        );
+    }
+    // Support polygons BR → FR → FL → BL.
+    for (k, x) in st.iter().enumerate() {
+        let poly: Vec<String> = [Foot::BR, Foot::FR, Foot::FL, Foot::BL]
+            .iter()
+            .map(|&i| {
+                format!(
+                    "{:.1},{:.1}",
+                    top.px(x.feet.get(i)[0]),
+                    top.py(x.feet.get(i)[1])
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            svg,
+            r#"<polygon points="{}" fill="{c}" fill-opacity="0.02" stroke="{c}" stroke-opacity="0.5" stroke-width="0.8"/>"#,
+            poly.join(" "),
+            c = colour(k)
+        );
+    }
+    for (k, x) in st.iter().enumerate() {
+        for i in Foot::ALL {
+            let p = x.feet.get(i);
+            foot_marker(&mut svg, top.px(p[0]), top.py(p[1]), i, &colour(k));
+        }
+        for j in Biped::ALL {
+            let p = x.com.get(j);
+            com_marker(&mut svg, top.px(p[0]), top.py(p[1]), &colour(k));
+        }
+    }
+    for j in Biped::ALL {
+        let g = s.goal.get(j);
+        goal_marker(&mut svg, top.px(g[0]), top.py(g[1]), &format!("goal {j}"));
+    }
+    let _ = writeln!(svg, "</g>");
+
+    // ---- Side view.
+    side.axes(&mut svg, "x (m)", "z (m)", "Side view (x–z)");
+    let _ = writeln!(svg, r##"<g clip-path="url(#clip-side)">"##);
+    band(&mut svg, &side, gl, gh, "#d62728", 0.12);
+    let tx = terrain_xs(s, xr.0, xr.1);
+    let mut d = format!("M{:.1},{:.1}", side.px(xr.0), side.py(zr.0));
+    for &x in &tx {
+        let _ = write!(
+            d,
+            " L{:.2},{:.2}",
+            side.px(x),
+            side.py(s.gap.height(x).max(zr.0))
+        );
+    }
+    let _ = write!(d, " L{:.1},{:.1} Z", side.px(xr.1), side.py(zr.0));
+    let _ = writeln!(
+        svg,
+        r##"<path d="{d}" fill="#c8b08a" stroke="#6b4f2a" stroke-width="1.2"/>"##
+    );
+    for (k, x) in st.iter().enumerate() {
+        let c = colour(k);
+        for i in Foot::ALL {
+            let (p, q) = (x.com.get(i.biped()), x.feet.get(i));
+            let _ = writeln!(
+                svg,
+                r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{c}" stroke-opacity="0.35" stroke-width="0.8"/>"#,
+                side.px(p[0]),
+                side.py(p[2]),
+                side.px(q[0]),
+                side.py(q[2])
+            );
+        }
+    }
+    for (k, x) in st.iter().enumerate() {
+        let c = colour(k);
+        for i in Foot::ALL {
+            let p = x.feet.get(i);
+            foot_marker(&mut svg, side.px(p[0]), side.py(p[2]), i, &c);
+        }
+        for j in Biped::ALL {
+            let p = x.com.get(j);
+            com_marker(&mut svg, side.px(p[0]), side.py(p[2]), &c);
+        }
+    }
+    for j in Biped::ALL {
+        let g = s.goal.get(j);
+        goal_marker(&mut svg, side.px(g[0]), side.py(g[2]), &format!("goal {j}"));
+    }
+    if s.gap.depth > shown_depth {
+        let _ = writeln!(
+            svg,
+            r#"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="middle" {FONT}>depth {} m (cut)</text>"#,
+            side.px((s.gap.min + s.gap.max) / 2.0),
+            side.py(zr.0) - 4.0,
+            s.gap.depth
+        );
+    }
+    let _ = writeln!(svg, "</g>");
+
+    // ---- Legend: colour bar and markers.
+    let lx = WIDTH - MARGIN_R + 25.0;
+    let ly = top.y0;
+    let _ = writeln!(
+        svg,
+        r#"<text x="{lx}" y="{:.1}" font-size="12" font-weight="bold" {FONT}>stance</text>"#,
+        ly + 4.0
+    );
+    let bar_h = 160.0;
+    let _ = writeln!(
+        svg,
+        r#"<defs><linearGradient id="ramp" x1="0" y1="1" x2="0" y2="0">"#
+    );
+    for i in 0..=10 {
+        let _ = writeln!(
+            svg,
+            r#"<stop offset="{:.2}" stop-color="{}"/>"#,
+            i as f64 / 10.0,
+            ramp(i as f64 / 10.0)
+        );
+    }
+    let _ = writeln!(svg, "</linearGradient></defs>");
+    let _ = writeln!(
+        svg,
+        r##"<rect x="{lx}" y="{:.1}" width="16" height="{bar_h}" fill="url(#ramp)" stroke="#333" stroke-width="0.6"/>"##,
+        ly + 14.0
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="{:.1}" y="{:.1}" font-size="11" {FONT}>{}</text><text x="{:.1}" y="{:.1}" font-size="11" {FONT}>1</text>"#,
+        lx + 22.0,
+        ly + 24.0,
+        st.len(),
+        lx + 22.0,
+        ly + 14.0 + bar_h
+    );
+    let mut y = ly + bar_h + 40.0;
+    let grey = "#bbbbbb";
+    let items: [(&str, u8); 5] = [
+        ("back foot (BR, BL)", 0),
+        ("front foot (FR, FL)", 1),
+        ("CoM (B, F)", 2),
+        ("goal CoM", 3),
+        ("gap / margin", 4),
+    ];
+    for (label, kind) in items {
+        match kind {
+            0 => foot_marker(&mut svg, lx + 8.0, y, Foot::BR, grey),
+            1 => foot_marker(&mut svg, lx + 8.0, y, Foot::FR, grey),
+            2 => com_marker(&mut svg, lx + 8.0, y, grey),
+            3 => {
+                let _ = writeln!(
+                    svg,
+                    r##"<circle cx="{:.1}" cy="{y:.1}" r="6" fill="none" stroke="#d62728" stroke-width="1.6"/>"##,
+                    lx + 8.0
+                );
+            }
+            _ => {
+                let _ = writeln!(
+                    svg,
+                    r##"<rect x="{lx}" y="{:.1}" width="8" height="12" fill="#7f1d1d" fill-opacity="0.45"/><rect x="{:.1}" y="{:.1}" width="8" height="12" fill="#d62728" fill-opacity="0.15"/>"##,
+                    y - 6.0,
+                    lx + 8.0,
+                    y - 6.0
+                );
+            }
+        }
+        let _ = writeln!(
+            svg,
+            r#"<text x="{:.1}" y="{:.1}" font-size="11" {FONT}>{label}</text>"#,
+            lx + 22.0,
+            y + 4.0
+        );
+        y += 22.0;
+    }
+    let _ = writeln!(svg, "</svg>");
+    svg
+}
+
+/// The convergence figure: |objective|, primal infeasibility and complementarity
+/// residual per iteration, log-scale y axis. Non-positive or non-finite values are left
+/// out (the line breaks there).
+pub fn convergence_svg(records: &[IterRecord], title: &str) -> String {
+    let height = 480.0;
+    let (x0, y0) = (MARGIN_L + 10.0, 50.0);
+    let (w, h) = (WIDTH - x0 - 230.0, height - y0 - 60.0);
+    type Get = fn(&IterRecord) -> f64;
+    let series: [(&str, &str, Get); 3] = [
+        ("|objective|", "#1f77b4", |r| r.objective.abs()),
+        ("constraint violation (inf_pr)", "#d62728", |r| r.inf_pr),
+        ("complementarity residual", "#2ca02c", |r| r.compl),
+    ];
+    let vals: Vec<f64> = records
+        .iter()
+        .flat_map(|r| series.iter().map(move |s| (s.2)(r)))
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    let (mut lo, mut hi) = if vals.is_empty() {
+        (-1.0, 1.0)
+    } else {
+        (
+            vals.iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+                .log10()
+                .floor(),
+            vals.iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max)
+                .log10()
+                .ceil(),
+        )
+    };
+    if hi <= lo {
+        hi = lo + 1.0;
+        lo -= 1.0;
+    }
+    let it_max = records.iter().map(|r| r.iter).max().unwrap_or(1).max(1) as f64;
+    let it_min = records.iter().map(|r| r.iter).min().unwrap_or(0) as f64;
+    let it_span = (it_max - it_min).max(1.0);
+    let px = |i: f64| x0 + (i - it_min) / it_span * w;
+    let py = |v: f64| y0 + (hi - v.log10()) / (hi - lo) * h;
+
+    let mut svg = String::new();
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{height}" viewBox="0 0 {WIDTH} {height}">"#
+    );
+    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        svg,
+        r#"<text x="{x0}" y="28" font-size="16" font-weight="bold" {FONT}>{}</text>"#,
+        esc(title)
+    );
+    let _ = writeln!(
+        svg,
+        r##"<rect x="{x0}" y="{y0}" width="{w}" height="{h}" fill="white" stroke="#333"/>"##
+    );
+    // Decade ticks (every k-th decade when there are many).
+    let decades = (hi - lo) as i64;
+    let every = ((decades as f64) / 12.0).ceil().max(1.0) as i64;
+    for e in (lo as i64)..=(hi as i64) {
+        let y = py(10f64.powi(e as i32));
+        let _ = writeln!(
+            svg,
+            r##"<line x1="{x0}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#ddd" stroke-width="0.6"/>"##,
+            x0 + w
+        );
+        if (e - lo as i64) % every == 0 {
+            let _ = writeln!(
+                svg,
+                r##"<line x1="{:.1}" y1="{y:.1}" x2="{x0}" y2="{y:.1}" stroke="#333"/><text x="{:.1}" y="{:.1}" font-size="11" text-anchor="end" {FONT}>1e{e}</text>"##,
+                x0 - 5.0,
+                x0 - 8.0,
+                y + 4.0
+            );
+        }
+    }
+    let step = nice_step(it_span, 10.0).max(1.0);
+    for t in ticks(it_min, it_max, 10.0) {
+        if (t / step).fract().abs() > 1e-9 {
+            continue;
+        }
+        let x = px(t);
+        let _ = writeln!(
+            svg,
+            r##"<line x1="{x:.1}" y1="{y0}" x2="{x:.1}" y2="{:.1}" stroke="#eee" stroke-width="0.6"/><line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#333"/><text x="{x:.1}" y="{:.1}" font-size="11" text-anchor="middle" {FONT}>{}</text>"##,
+            y0 + h,
+            y0 + h,
+            y0 + h + 5.0,
+            y0 + h + 18.0,
+            t as i64
+        );
+    }
+    let _ = writeln!(
+        svg,
+        r#"<text x="{:.1}" y="{:.1}" font-size="12" text-anchor="middle" {FONT}>iteration</text>"#,
+        x0 + w / 2.0,
+        y0 + h + 38.0
+    );
+    let (lx, ly) = (x0 - 55.0, y0 + h / 2.0);
+    let _ = writeln!(
+        svg,
+        r#"<text x="{lx:.1}" y="{ly:.1}" font-size="12" text-anchor="middle" transform="rotate(-90 {lx:.1} {ly:.1})" {FONT}>value (log scale)</text>"#
+    );
+    for (si, (label, colour, get)) in series.iter().enumerate() {
+        let mut d = String::new();
+        let mut pen_up = true;
+        for r in records {
+            let v = get(r);
+            if v.is_finite() && v > 0.0 {
+                let _ = write!(
+                    d,
+                    "{}{:.1},{:.1} ",
+                    if pen_up { "M" } else { "L" },
+                    px(r.iter as f64),
+                    py(v)
+                );
+                pen_up = false;
+            } else {
+                pen_up = true;
+            }
+        }
+        if !d.is_empty() {
+            let _ = writeln!(
+                svg,
+                r#"<path d="{}" fill="none" stroke="{colour}" stroke-width="1.6"/>"#,
+                d.trim_end()
+            );
+        }
+        let ly = y0 + 10.0 + 22.0 * si as f64;
+        let lx = x0 + w + 15.0;
+        let _ = writeln!(
+            svg,
+            r#"<line x1="{lx:.1}" y1="{ly:.1}" x2="{:.1}" y2="{ly:.1}" stroke="{colour}" stroke-width="2.5"/><text x="{:.1}" y="{:.1}" font-size="11" {FONT}>{label}</text>"#,
+            lx + 20.0,
+            lx + 25.0,
+            ly + 4.0
+        );
+    }
+    if records.is_empty() {
+        let _ = writeln!(
+            svg,
+            r##"<text x="{:.1}" y="{:.1}" font-size="14" text-anchor="middle" fill="#777" {FONT}>no iterations recorded</text>"##,
+            x0 + w / 2.0,
+            y0 + h / 2.0
+        );
+    }
+    let _ = writeln!(svg, "</svg>");
+    svg
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ramp_ends() {
+        assert_eq!(ramp(0.0), "#440154");
+        assert_eq!(ramp(1.0), "#fde725");
+        assert_eq!(ramp(f64::NAN), "#440154");
+    }
+
+    #[test]
+    fn nice_ticks() {
+        assert_eq!(nice_step(6.0, 12.0), 0.5);
+        assert_eq!(ticks(-0.4, 1.3, 4.0), vec![0.0, 0.5, 1.0]);
+    }
+
+    #[test]
+    fn convergence_handles_zeros_and_empty() {
+        let r = [
+            IterRecord {
+                iter: 0,
+                objective: -3.0,
+                inf_pr: 1.0,
+                compl: 0.0,
+            },
+            IterRecord {
+                iter: 1,
+                objective: 2.0,
+                inf_pr: 1e-9,
+                compl: 1e-3,
+            },
+        ];
+        let s = convergence_svg(&r, "t");
+        assert!(s.starts_with("<svg") && s.trim_end().ends_with("</svg>"));
+        assert!(!s.contains("NaN") && !s.contains("\"inf"));
+        assert!(convergence_svg(&[], "t").contains("no iterations"));
+    }
+}
