@@ -982,21 +982,21 @@ impl<'p> Core<'p> {
 
     /// Adaptive μ (called after the KKT matrix is factorised).
     fn update_mu_adaptive(&mut self, shared: &mut Shared, e0: f64) {
-        let o = self.opts.clone();
-        let red = o.adaptive_mu_kkterror_red_fact;
+        let red = self.opts.adaptive_mu_kkterror_red_fact;
         if self.free_mode {
             let ok = self.kkt_refs.is_empty() || self.kkt_refs.iter().any(|&r| e0 <= red * r);
             if !ok {
                 // Switch to the monotone (fixed) mode.
                 self.free_mode = false;
                 let (avg, _) = self.avg_compl(&self.w, &self.zl, &self.zu);
-                self.mu = (o.adaptive_mu_monotone_init_factor * avg).clamp(mu_floor(&o), o.mu_max);
-                self.tau = tau(self.mu, &o);
+                self.mu = (self.opts.adaptive_mu_monotone_init_factor * avg)
+                    .clamp(mu_floor(&self.opts), self.opts.mu_max);
+                self.tau = tau(self.mu, &self.opts);
                 self.filter.reset();
                 return;
             }
             self.kkt_refs.push(e0);
-            if self.kkt_refs.len() > o.adaptive_mu_kkterror_red_iters {
+            if self.kkt_refs.len() > self.opts.adaptive_mu_kkterror_red_iters {
                 self.kkt_refs.remove(0);
             }
         } else {
@@ -1011,7 +1011,7 @@ impl<'p> Core<'p> {
         }
         // Free mode: oracle.
         let (avg, mn) = self.avg_compl(&self.w, &self.zl, &self.zu);
-        let mut mu = match o.mu_oracle {
+        let mut mu = match self.opts.mu_oracle {
             MuOracle::Loqo => loqo_mu(avg, mn),
             MuOracle::Probing => {
                 if self.solve_direction(shared, 0.0, false) {
@@ -1038,10 +1038,10 @@ impl<'p> Core<'p> {
                 }
             }
         };
-        mu = mu.clamp(o.mu_min.max(o.tol * 1e-2), o.mu_max);
+        mu = mu.clamp(self.opts.mu_min.max(self.opts.tol * 1e-2), self.opts.mu_max);
         if mu != self.mu {
             self.mu = mu;
-            self.tau = tau(mu, &o);
+            self.tau = tau(mu, &self.opts);
             self.filter.reset();
         }
     }
