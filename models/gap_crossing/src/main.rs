@@ -1,1 +1,312 @@
-fn main() {}
+//! `gap_crossing`: the quadruped gap-crossing planner's command line.
+//!
+//! Exit codes: 0 success; 1 `check` found violations; 2 any error (bad arguments, bad
+//! files, invalid scenario, not yet implemented). Errors go to stderr.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use gap_crossing::check::{self, GoalCheck, Options};
+use gap_crossing::gait;
+use gap_crossing::plan::{write_atomic, PlanError, SolutionFile, SolverInfo};
+use gap_crossing::render::{self, IterRecord};
+use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Quadruped gap-crossing footstep and force planner.
+///
+/// With no subcommand, `solve` runs with its defaults (the spec's default scenario).
+#[derive(Parser, Debug)]
+#[command(name = "gap_crossing", version, args_conflicts_with_subcommands = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    solve: SolveArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Solve a scenario; writes DIR/solution.json, DIR/plan.svg, DIR/convergence.svg.
+    Solve(SolveArgs),
+    /// Check a solution file independently; prints each violation, exits 1 on any.
+    Check(CheckArgs),
+    /// Redraw the SVGs of a solution file.
+    Render(RenderArgs),
+    /// Solve a grid of scenarios in parallel and summarise.
+    Sweep(SweepArgs),
+    /// Write an initial guess (not a solution) as a plan file, with its plan.svg.
+    Guess(GuessArgs),
+}
+
+/// Scenario selection shared by `solve` and `guess`.
+#[derive(Args, Debug, Default)]
+struct ScenarioArgs {
+    /// Scenario file (.toml or .json); missing fields take the spec's defaults.
+    #[arg(long, value_name = "FILE")]
+    scenario: Option<PathBuf>,
+    /// Gait mode, overriding the scenario's `gait`.
+    #[arg(long, value_enum)]
+    gait: Option<GaitArg>,
+    /// Override one scenario value by dotted path, e.g. `--set gap.min=2.0 --set n_step=30`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(Args, Debug, Default)]
+struct SolveArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    out: PathBuf,
+    /// Solver: interior point (`ipm`) or SQP (`sqp`).
+    #[arg(long, value_enum)]
+    solver: Option<SolverArg>,
+}
+
+#[derive(Args, Debug)]
+struct CheckArgs {
+    /// Solution file (JSON, the spec's schema).
+    file: PathBuf,
+    /// Goal requirement: `auto` = required when n_step allows it (the crawl heuristic
+    /// reaches the goals in n_step stances); `required`; `skip`.
+    #[arg(long, value_enum, default_value_t = GoalArg::Auto)]
+    goal: GoalArg,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// Solution file (JSON).
+    file: PathBuf,
+    /// Output directory (default: the solution file's directory). Writes plan.svg, and
+    /// convergence.svg when a convergence.json (iteration records) sits beside FILE.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+struct SweepArgs {
+    /// Grid file describing the scenarios to solve.
+    #[arg(long, value_name = "FILE")]
+    grid: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct GuessArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// Which guess.
+    #[arg(long, value_enum, default_value_t = GuessKind::Crawl)]
+    kind: GuessKind,
+    /// Output directory; writes guess.json and plan.svg.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    out: PathBuf,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum GaitArg {
+    Free,
+    Crawl,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum SolverArg {
+    Ipm,
+    Sqp,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum GoalArg {
+    Auto,
+    Required,
+    Skip,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum GuessKind {
+    Standing,
+    Crawl,
+}
+
+#[derive(Debug, thiserror::Error)]
+enum CliError {
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: not a list of iteration records: {message}")]
+    Records { path: PathBuf, message: String },
+    #[error("solution file {path}: its scenario is invalid: {source}")]
+    FileScenario {
+        path: PathBuf,
+        source: ScenarioError,
+    },
+    #[error("{0}: not yet implemented: the symbolic model lands with issue 5")]
+    NotImplemented(&'static str),
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
+    move |source| CliError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Reads the scenario (file or defaults), applies `--gait` and `--set`, validates.
+fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
+    let mut s = match &a.scenario {
+        Some(p) => Scenario::load(p)?,
+        None => Scenario::default(),
+    };
+    s.apply_overrides(&a.set)?;
+    if let Some(g) = a.gait {
+        s.gait = match g {
+            GaitArg::Free => Gait::Free,
+            GaitArg::Crawl => Gait::Crawl,
+        };
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
+    // Validate everything the user gave before saying the solver is missing, so that
+    // scenario mistakes are reported now. Nothing is written.
+    let _s = scenario(&a.scenario)?;
+    let _ = a.solver;
+    Err(CliError::NotImplemented("solve"))
+}
+
+fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
+    std::fs::metadata(&a.grid).map_err(io(&a.grid))?;
+    Err(CliError::NotImplemented("sweep"))
+}
+
+fn check_cmd(a: &CheckArgs) -> Result<ExitCode, CliError> {
+    let file = SolutionFile::read(&a.file)?;
+    file.scenario
+        .validate()
+        .map_err(|source| CliError::FileScenario {
+            path: a.file.clone(),
+            source,
+        })?;
+    let goal = match a.goal {
+        GoalArg::Auto => GoalCheck::Auto,
+        GoalArg::Required => GoalCheck::Required,
+        GoalArg::Skip => GoalCheck::Skip,
+    };
+    let report = check::check_with(
+        &file,
+        &Options {
+            goal,
+            ..Options::default()
+        },
+    );
+    println!("{report}");
+    Ok(if report.ok() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn write_file(path: &Path, text: &str) -> Result<(), CliError> {
+    write_atomic(path, text.as_bytes()).map_err(io(path))
+}
+
+fn render_cmd(a: &RenderArgs) -> Result<ExitCode, CliError> {
+    let file = SolutionFile::read(&a.file)?;
+    let dir = match &a.out {
+        Some(d) => d.clone(),
+        None => a
+            .file
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from(".")),
+    };
+    let records_path = a.file.with_file_name("convergence.json");
+    let records: Option<Vec<IterRecord>> = if records_path.exists() {
+        let text = std::fs::read_to_string(&records_path).map_err(io(&records_path))?;
+        Some(serde_json::from_str(&text).map_err(|e| CliError::Records {
+            path: records_path.clone(),
+            message: e.to_string(),
+        })?)
+    } else {
+        None
+    };
+    std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+    let plan = dir.join("plan.svg");
+    write_file(&plan, &render::plan_svg(&file))?;
+    println!("wrote {}", plan.display());
+    if let Some(r) = records {
+        let conv = dir.join("convergence.svg");
+        let title = format!(
+            "Convergence: solver {} ({}), {} iterations",
+            file.solver.name, file.solver.status, file.solver.iterations
+        );
+        write_file(&conv, &render::convergence_svg(&r, &title))?;
+        println!("wrote {}", conv.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn guess_cmd(a: &GuessArgs) -> Result<ExitCode, CliError> {
+    let s = scenario(&a.scenario)?;
+    let (plan, name) = match a.kind {
+        GuessKind::Standing => (
+            gap_crossing::plan::Plan::from_flat(&s, &gait::standing(&s))?,
+            "standing",
+        ),
+        GuessKind::Crawl => (gait::crawl_plan(&s), "crawl"),
+    };
+    let info = SolverInfo {
+        name: "guess".into(),
+        status: format!("initial_guess_{name}"),
+        iterations: 0,
+        objective: plan.cost(&s),
+        max_constraint_violation: 0.0,
+        solve_seconds: 0.0,
+    };
+    let mut file = SolutionFile::new(s, info, plan);
+    // A guess has no solver measure of infeasibility: record the checker's largest
+    // residual instead.
+    let report = check::check(&file);
+    file.solver.max_constraint_violation = report.max_residual.max(0.0);
+    std::fs::create_dir_all(&a.out).map_err(io(&a.out))?;
+    let json = a.out.join("guess.json");
+    file.write(&json)?;
+    let svg = a.out.join("plan.svg");
+    write_file(&svg, &render::plan_svg(&file))?;
+    println!(
+        "wrote {} and {} ({name} guess, cost {:.4e}); checker: {}",
+        json.display(),
+        svg.display(),
+        file.solver.objective,
+        report.summary()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        None => solve(&cli.solve),
+        Some(Command::Solve(a)) => solve(a),
+        Some(Command::Check(a)) => check_cmd(a),
+        Some(Command::Render(a)) => render_cmd(a),
+        Some(Command::Sweep(a)) => sweep(a),
+        Some(Command::Guess(a)) => guess_cmd(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! The binary: exit codes and messages of `check`, `render`, `guess`, `solve`, `sweep`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_gap_crossing");
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("binary runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// A fresh directory per test.
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("gap_crossing_cli_{}_{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The spec's example stance, twice, with goal = start: a valid plan.
+fn valid_json() -> serde_json::Value {
+    let stance = serde_json::json!({
+        "com":    { "B": [0.0, 0.5, 0.5], "F": [2.0, 0.5, 0.5] },
+        "feet":   { "BR": [0,0,0], "BL": [0,1,0], "FR": [2,0,0], "FL": [2,1,0] },
+        "forces": { "BR": [0,0,245.25], "BL": [0,0,245.25], "FR": [0,0,245.25], "FL": [0,0,245.25] }
+    });
+    serde_json::json!({
+        "scenario": { "n_step": 2, "goal": { "B": [0.0, 0.5, 0.5], "F": [2.0, 0.5, 0.5] } },
+        "solver": { "name": "ipm", "status": "solved", "iterations": 0, "objective": 0.0,
+                    "max_constraint_violation": 0.0, "solve_seconds": 0.0 },
+        "stances": [stance.clone(), stance]
+    })
+}
+
+fn write(dir: &Path, name: &str, v: &serde_json::Value) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, serde_json::to_string_pretty(v).unwrap()).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn check_passes_a_valid_plan() {
+    let d = tmp("valid");
+    let f = write(&d, "solution.json", &valid_json());
+    let out = run(&["check", &f]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    assert!(
+        text(&out.stdout).starts_with("OK: 2 stances"),
+        "{}",
+        text(&out.stdout)
+    );
+}
+
+#[test]
+fn check_reports_each_violation_and_exits_1() {
+    let d = tmp("violations");
+    let mut v = valid_json();
+    // Stance 2: CoM B raised so both back legs are 1e-4 m² too long; FR loses 10 N.
+    v["stances"][1]["com"]["B"][2] = serde_json::json!(0.2501f64.sqrt());
+    v["stances"][1]["forces"]["FR"][2] = serde_json::json!(235.25);
+    let f = write(&d, "bad.json", &v);
+    let out = run(&["check", &f]);
+    assert_eq!(out.status.code(), Some(1));
+    let s = text(&out.stdout);
+    let lines: Vec<&str> = s.lines().collect();
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("(11)") && l.contains("stance 2") && l.contains("BR")),
+        "{s}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("(11)") && l.contains("BL")),
+        "{s}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("(2) force balance") && l.contains("1.000e1")),
+        "{s}"
+    );
+    assert!(lines.last().unwrap().starts_with("FAILED"), "{s}");
+}
+
+#[test]
+fn check_goal_modes() {
+    let d = tmp("goal");
+    let mut v = valid_json();
+    v["scenario"]["goal"]["B"] = serde_json::json!([0.3, 0.5, 0.5]);
+    let f = write(&d, "g.json", &v);
+    // 0.3 m in one stance is out of the crawl heuristic's reach: auto skips the goal.
+    assert_eq!(run(&["check", &f]).status.code(), Some(0));
+    assert_eq!(
+        run(&["check", "--goal", "required", &f]).status.code(),
+        Some(1)
+    );
+}
+
+#[test]
+fn check_errors_exit_2_with_the_reason() {
+    let d = tmp("errors");
+    let out = run(&["check", d.join("missing.json").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("missing.json"),
+        "{}",
+        text(&out.stderr)
+    );
+
+    let mut v = valid_json();
+    v["stances"][0]["feat"] = serde_json::json!(1);
+    let f = write(&d, "unknown.json", &v);
+    let out = run(&["check", &f]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("feat"), "{}", text(&out.stderr));
+
+    let mut v = valid_json();
+    v["scenario"]["gap"] = serde_json::json!({ "min": 3.0 });
+    let f = write(&d, "invalid.json", &v);
+    let out = run(&["check", &f]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("gap.min"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn solve_and_sweep_are_not_implemented_yet() {
+    let d = tmp("solve");
+    let out_dir = d.join("out");
+    let out = run(&["solve", "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("not yet implemented"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!out_dir.exists(), "nothing is written");
+    // No subcommand = solve.
+    let out = run(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("not yet implemented"));
+    let grid = write(&d, "grid.json", &serde_json::json!({}));
+    let out = run(&["sweep", "--grid", &grid]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("not yet implemented"));
+}
+
+#[test]
+fn scenario_errors_come_first() {
+    let out = run(&["solve", "--set", "gap.widht=0.2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("gap.widht"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = run(&["--set", "n_step=1"]);
+    assert!(
+        text(&out.stderr).contains("n_step"),
+        "{}",
+        text(&out.stderr)
+    );
+    let d = tmp("scenario_file");
+    let p = d.join("s.toml");
+    std::fs::write(&p, "[friction]\nmu = 0").unwrap();
+    let out = run(&["solve", "--scenario", p.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("friction.mu"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn guess_then_check_then_render() {
+    let d = tmp("guess");
+    let out = run(&["guess", "--out", d.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let g = d.join("guess.json");
+    assert_eq!(run(&["check", g.to_str().unwrap()]).status.code(), Some(0));
+    let svg = std::fs::read_to_string(d.join("plan.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("Top view") && svg.contains("Side view"));
+
+    // render into another directory; with iteration records beside the file it also
+    // draws convergence.svg.
+    let records = serde_json::json!([
+        { "iter": 0, "objective": 3e5, "inf_pr": 1.0, "compl": 0.1 },
+        { "iter": 1, "objective": 2e5, "inf_pr": 1e-9, "compl": 1e-10 }
+    ]);
+    write(&d, "convergence.json", &records);
+    let r = d.join("redrawn");
+    let out = run(&["render", g.to_str().unwrap(), "--out", r.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(r.join("plan.svg").exists() && r.join("convergence.svg").exists());
+
+    // The standing guess misses the goal.
+    let s = d.join("standing");
+    run(&["guess", "--kind", "standing", "--out", s.to_str().unwrap()]);
+    let out = run(&["check", s.join("guess.json").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stdout).contains("goal"));
+}
