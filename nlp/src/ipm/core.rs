@@ -253,10 +253,13 @@ impl<'p> Core<'p> {
         kkt.min_refinement_steps = opts.min_refinement_steps;
         kkt.max_refinement_steps = opts.max_refinement_steps;
         kkt.residual_ratio_max = opts.residual_ratio_max;
+        // Refinement target: K without the static regularisation of equality rows.
         let mut shift = vec![0.0; n + m];
-        shift[n..]
-            .iter_mut()
-            .for_each(|v| *v = opts.kkt_static_regularization);
+        for i in 0..m {
+            if slack_of_row[i] == usize::MAX {
+                shift[n + i] = opts.kkt_static_regularization;
+            }
+        }
         Ok(Core {
             nlp,
             opts: opts.clone(),
@@ -579,12 +582,11 @@ impl<'p> Core<'p> {
         self.kdx.iter_mut().for_each(|v| *v = 1.0);
         let reg = self.opts.kkt_static_regularization;
         for i in 0..m {
-            self.kdc[i] = reg
-                + if self.slack_of_row[i] == usize::MAX {
-                    0.0
-                } else {
-                    1.0
-                };
+            self.kdc[i] = if self.slack_of_row[i] == usize::MAX {
+                reg
+            } else {
+                1.0
+            };
         }
         // rhs: [−(∇f − z_L + z_U)_x ; −(rhs_s/1) contribution]; with W = I, Σ_s = 1.
         for j in 0..n {
@@ -797,10 +799,11 @@ impl<'p> Core<'p> {
             }
             for i in 0..m {
                 let k = self.slack_of_row[i];
-                self.kdc[i] = static_reg
-                    + self.delta_c
+                // The static regularisation is only needed on equality rows: inequality
+                // rows already carry 1/(Σ_s + δ_w) > 0 from the eliminated slack.
+                self.kdc[i] = self.delta_c
                     + if k == usize::MAX {
-                        0.0
+                        static_reg
                     } else {
                         1.0 / self.ds[k]
                     };
