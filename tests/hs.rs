@@ -232,3 +232,38 @@ fn hs_summary() {
         iterations.len()
     );
 }
+
+/// Prints the IPOPT-style iteration table of the problems named in the environment
+/// variable `HS` (comma-separated), for diagnosing a failure:
+///
+/// ```text
+/// HS=hs013,hs061 cargo test --release --test hs -- --ignored --nocapture hs_log
+/// ```
+#[test]
+#[ignore = "diagnostics: run with HS=<names> --release --ignored --nocapture"]
+fn hs_log() {
+    let wanted = std::env::var("HS").unwrap_or_default();
+    for name in wanted.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let &(name, build) = SUITE
+            .iter()
+            .find(|(n, _)| *n == name)
+            .unwrap_or_else(|| panic!("no problem named {name}"));
+        let case = build().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut compiled = case
+            .problem
+            .compile()
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let options = IpmOptions {
+            print_level: 5,
+            ..IpmOptions::default()
+        };
+        println!("==== {name} (f* = {})", case.f_star);
+        match Ipm::new(options).solve(&mut compiled) {
+            Ok(sol) => println!(
+                "{name}: {:?}, {} iterations, f = {:.12e}, x = {:?}",
+                sol.status, sol.stats.iterations, sol.objective, sol.x
+            ),
+            Err(e) => println!("{name}: error {e}"),
+        }
+    }
+}

@@ -14,6 +14,11 @@ Usage:
 Prints one JSON object per line:
     {"name", "status", "success", "iterations", "objective", "f_star", "seconds"}
 IPOPT options: tol 1e-8 (IPOPT's default), everything else default.
+
+    python3 benches/reference/hs_casadi.py --compare OURS.json IPOPT.json
+
+prints the Markdown comparison table of docs/performance.md from the JSON lines of
+`cargo test --release --test hs -- --ignored --nocapture hs_summary` and of this script.
 """
 import json
 import math
@@ -961,7 +966,41 @@ def solve(name):
     }
 
 
+def compare(ours_path, ipopt_path):
+    import statistics
+
+    def load(path):
+        with open(path) as f:
+            return {r["name"]: r for r in (json.loads(line) for line in f if line.startswith("{"))}
+
+    ours, ipopt = load(ours_path), load(ipopt_path)
+    print("| problem | f* | symnlp status | iter | IPOPT status | iter | objective (symnlp) | Δf vs IPOPT (rel.) |")
+    print("|---|---:|---|---:|---|---:|---:|---:|")
+    for name, o in ours.items():
+        i = ipopt[name]
+        f = o.get("objective", math.nan)
+        diff = abs(f - i["objective"]) / max(1.0, abs(i["objective"]))
+        status = o["status"] + ("" if o.get("matches") in (None, "f*") else f" ({o['matches']} min.)")
+        print(
+            f"| {name} | {o['f_star']:.10g} | {status} | {o.get('iterations', '–')} "
+            f"| {i['status']} | {i['iterations']} | {f:.10g} | {diff:.1e} |"
+        )
+    it_o = [o["iterations"] for o in ours.values() if "iterations" in o]
+    it_i = [i["iterations"] for i in ipopt.values()]
+    print()
+    print(f"median iterations: symnlp {statistics.median(it_o)}, IPOPT {statistics.median(it_i)}; "
+          f"total: symnlp {sum(it_o)}, IPOPT {sum(it_i)}")
+    fewer = sum(ours[n]["iterations"] < ipopt[n]["iterations"] for n in ours)
+    more = sum(ours[n]["iterations"] > ipopt[n]["iterations"] for n in ours)
+    print(f"fewer iterations than IPOPT on {fewer}, as many on {len(ours) - fewer - more}, more on {more}")
+    print(f"solve time, sum over the suite: symnlp {sum(o['seconds'] for o in ours.values()):.4f} s, "
+          f"IPOPT via CasADi {sum(i['seconds'] for i in ipopt.values()):.4f} s")
+
+
 def main():
+    if sys.argv[1:2] == ["--compare"]:
+        compare(sys.argv[2], sys.argv[3])
+        return
     names = sys.argv[1:] or sorted(PROBLEMS)
     for name in names:
         print(json.dumps(solve(name)), flush=True)
