@@ -136,7 +136,11 @@ fn partial(g: &mut Graph, y: u32, k: usize) -> u32 {
             let a2 = g.unary(Op::Sq, a);
             let d = g.binary(Op::Sub, ONE, a2);
             let r = g.unary(Op::Sqrt, d);
-            let num = if n.op == Op::Asin { ONE } else { g.constant(-1.0) };
+            let num = if n.op == Op::Asin {
+                ONE
+            } else {
+                g.constant(-1.0)
+            };
             g.binary(Op::Div, num, r)
         }
         Op::Atan => {
@@ -202,12 +206,17 @@ fn partial(g: &mut Graph, y: u32, k: usize) -> u32 {
     }
 }
 
-/// The condition under which a selection node takes its first value operand.
-fn takes_first(g: &mut Graph, n: crate::graph::Node) -> u32 {
+/// The condition under which selection node `y` takes its first value operand.
+///
+/// For `min`/`max` this is `y == a`: exactly when the evaluated value is the first operand,
+/// including the cases where the other operand is NaN (`f64::min` and `f64::max` return
+/// the number, so the derivative must follow the number too). On ties the first operand
+/// (in the graph's canonical operand order) is taken.
+fn takes_first(g: &mut Graph, y: u32) -> u32 {
+    let n = g.node(y);
     match n.op {
         Op::IfElse => n.args[0],
-        Op::Min => g.binary(Op::Le, n.args[0], n.args[1]),
-        Op::Max => g.binary(Op::Le, n.args[1], n.args[0]),
+        Op::Min | Op::Max => g.binary(Op::Eq, y, n.args[0]),
         _ => unreachable!(),
     }
 }
@@ -250,7 +259,7 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
                 } else {
                     (n.args[0], n.args[1])
                 };
-                let cond = takes_first(g, n);
+                let cond = takes_first(g, v);
                 if s.dep[first as usize] {
                     let c = g.if_else(cond, adj, ZERO);
                     accumulate(g, s, first, c, true);
@@ -313,7 +322,7 @@ fn forward_pass(g: &mut Graph, s: &mut Sweep) {
                     (n.args[0], n.args[1])
                 };
                 let (t1, t2) = (tangent(s, first), tangent(s, second));
-                let cond = takes_first(g, n);
+                let cond = takes_first(g, v);
                 g.if_else(cond, t1, t2)
             }
             Op::StrongMul => {
@@ -403,7 +412,11 @@ pub fn forward(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
         out.iter()
             .map(|&o| {
                 let t = s.value[o as usize];
-                Expr::from_id(if s.dep[o as usize] && t != NONE { t } else { ZERO })
+                Expr::from_id(if s.dep[o as usize] && t != NONE {
+                    t
+                } else {
+                    ZERO
+                })
             })
             .collect()
     }))
@@ -453,7 +466,12 @@ pub fn gradient(f: Expr, inputs: &[Expr]) -> Result<Vec<Expr>, SymxError> {
 
 /// Rows of a Jacobian as `(column, expression)` lists, one reverse sweep per output over its
 /// own cone; with `lower_only`, row `i` keeps only columns `≤ i` (for Hessians).
-fn jacobian_rows(g: &mut Graph, out: &[u32], wrt: &[u32], lower_only: bool) -> Vec<(usize, usize, u32)> {
+fn jacobian_rows(
+    g: &mut Graph,
+    out: &[u32],
+    wrt: &[u32],
+    lower_only: bool,
+) -> Vec<(usize, usize, u32)> {
     let mut s = Sweep::new(g.len());
     s.set_wrt(wrt);
     let mut entries = Vec::new();
@@ -481,10 +499,17 @@ fn jacobian_rows(g: &mut Graph, out: &[u32], wrt: &[u32], lower_only: bool) -> V
     entries
 }
 
-fn sparse_from_entries(nrows: usize, ncols: usize, mut entries: Vec<(usize, usize, u32)>) -> SparseMatrix {
+fn sparse_from_entries(
+    nrows: usize,
+    ncols: usize,
+    mut entries: Vec<(usize, usize, u32)>,
+) -> SparseMatrix {
     entries.sort_unstable_by_key(|&(i, j, _)| (j, i));
     let pattern = pattern_from_entries(nrows, ncols, entries.iter().map(|&(i, j, _)| (i, j)));
-    let values = entries.into_iter().map(|(_, _, e)| Expr::from_id(e)).collect();
+    let values = entries
+        .into_iter()
+        .map(|(_, _, e)| Expr::from_id(e))
+        .collect();
     SparseMatrix::new(pattern, values).expect("pattern and values built together")
 }
 

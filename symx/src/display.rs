@@ -158,7 +158,6 @@ pub fn parse(text: &str, symbols: &[Expr]) -> Result<Expr, SymxError> {
         pos: 0,
         by_name,
         bindings: FxHashMap::default(),
-        depth: 0,
     };
     loop {
         p.skip_ws();
@@ -186,10 +185,27 @@ struct Parser<'a> {
     pos: usize,
     by_name: FxHashMap<String, Expr>,
     bindings: FxHashMap<usize, Expr>,
-    depth: usize,
 }
 
-const MAX_DEPTH: usize = 10_000;
+/// Pending operators of the (non-recursive, shunting-yard) expression parser.
+enum Pending {
+    /// A binary operator `+ - * /`.
+    Infix(u8),
+    /// Prefix minus.
+    Neg,
+    /// An open parenthesis.
+    Paren,
+    /// An open function call with the number of arguments started so far.
+    Call(Op, usize),
+}
+
+fn precedence(c: u8) -> u8 {
+    if matches!(c, b'+' | b'-') {
+        1
+    } else {
+        2
+    }
+}
 
 impl Parser<'_> {
     fn error(&self, msg: &str) -> SymxError {
@@ -233,53 +249,145 @@ impl Parser<'_> {
             .and_then(|t| t.parse().ok())
             .ok_or_else(|| self.error("expected an integer"))
     }
-    fn expr(&mut self) -> Result<Expr, SymxError> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
-            return Err(self.error("expression nested too deeply"));
-        }
-        let mut e = self.term()?;
-        while let Some(c @ (b'+' | b'-')) = self.peek() {
-            self.pos += 1;
-            let r = self.term()?;
-            e = if c == b'+' { e + r } else { e - r };
-        }
-        self.depth -= 1;
-        Ok(e)
-    }
-    fn term(&mut self) -> Result<Expr, SymxError> {
-        let mut e = self.unary()?;
-        while let Some(c @ (b'*' | b'/')) = self.peek() {
-            self.pos += 1;
-            let r = self.unary()?;
-            e = if c == b'*' { e * r } else { e / r };
-        }
-        Ok(e)
-    }
-    fn unary(&mut self) -> Result<Expr, SymxError> {
-        if self.peek() == Some(b'-') {
-            self.pos += 1;
-            return Ok(-self.unary()?);
-        }
-        self.primary()
-    }
-    fn primary(&mut self) -> Result<Expr, SymxError> {
-        match self.peek() {
-            Some(b'(') => {
-                self.pos += 1;
-                let e = self.expr()?;
-                self.expect(b')')?;
-                Ok(e)
+
+    /// Applies the operator on top of `ops` to the operands on top of `out`.
+    fn reduce(&self, ops: &mut Vec<Pending>, out: &mut Vec<Expr>) -> Result<(), SymxError> {
+        let underflow = || self.error("missing operand");
+        match ops.pop() {
+            Some(Pending::Neg) => {
+                let a = out.pop().ok_or_else(underflow)?;
+                out.push(-a);
             }
+            Some(Pending::Infix(c)) => {
+                let b = out.pop().ok_or_else(underflow)?;
+                let a = out.pop().ok_or_else(underflow)?;
+                out.push(match c {
+                    b'+' => a + b,
+                    b'-' => a - b,
+                    b'*' => a * b,
+                    _ => a / b,
+                });
+            }
+            _ => unreachable!("reduce called on a bracket"),
+        }
+        Ok(())
+    }
+
+    /// Reduces every operator above the innermost open bracket.
+    fn reduce_to_bracket(
+        &self,
+        ops: &mut Vec<Pending>,
+        out: &mut Vec<Expr>,
+    ) -> Result<(), SymxError> {
+        while matches!(ops.last(), Some(Pending::Neg | Pending::Infix(_))) {
+            self.reduce(ops, out)?;
+        }
+        Ok(())
+    }
+
+    /// One expression, up to the first character that cannot continue it. Iterative (an
+    /// explicit operator stack), so nesting depth is limited by memory, not by the stack.
+    fn expr(&mut self) -> Result<Expr, SymxError> {
+        let mut out: Vec<Expr> = Vec::new();
+        let mut ops: Vec<Pending> = Vec::new();
+        let mut expect_operand = true;
+        loop {
+            let c = self.peek();
+            if expect_operand {
+                match c {
+                    Some(b'-') => {
+                        self.pos += 1;
+                        ops.push(Pending::Neg);
+                    }
+                    Some(b'(') => {
+                        self.pos += 1;
+                        ops.push(Pending::Paren);
+                    }
+                    _ => {
+                        match self.operand()? {
+                            Operand::Value(e) => {
+                                out.push(e);
+                                expect_operand = false;
+                            }
+                            Operand::Call(op) => {
+                                self.pos += 1; // the '('
+                                ops.push(Pending::Call(op, 1));
+                            }
+                        }
+                    }
+                }
+                continue;
+            }
+            match c {
+                Some(c @ (b'+' | b'-' | b'*' | b'/')) => {
+                    let p = precedence(c);
+                    loop {
+                        match ops.last() {
+                            Some(Pending::Neg) => self.reduce(&mut ops, &mut out)?,
+                            Some(&Pending::Infix(t)) if precedence(t) >= p => {
+                                self.reduce(&mut ops, &mut out)?
+                            }
+                            _ => break,
+                        }
+                    }
+                    self.pos += 1;
+                    ops.push(Pending::Infix(c));
+                    expect_operand = true;
+                }
+                Some(b',') => {
+                    self.reduce_to_bracket(&mut ops, &mut out)?;
+                    match ops.last_mut() {
+                        Some(Pending::Call(_, n)) => *n += 1,
+                        _ => return Err(self.error("',' outside a function call")),
+                    }
+                    self.pos += 1;
+                    expect_operand = true;
+                }
+                Some(b')') => {
+                    self.reduce_to_bracket(&mut ops, &mut out)?;
+                    match ops.pop() {
+                        Some(Pending::Paren) => {}
+                        Some(Pending::Call(op, n)) => {
+                            if n != op.arity() {
+                                return Err(self.error(&format!(
+                                    "'{}' takes {} arguments, got {n}",
+                                    op.name(),
+                                    op.arity()
+                                )));
+                            }
+                            let args: Vec<u32> =
+                                out.split_off(out.len() - n).iter().map(|e| e.id).collect();
+                            out.push(Expr::from_id(graph::with(|g| g.make(op, &args))));
+                        }
+                        _ => return Err(self.error("unbalanced ')'")),
+                    }
+                    self.pos += 1;
+                }
+                _ => break,
+            }
+        }
+        self.reduce_to_bracket(&mut ops, &mut out)?;
+        if !ops.is_empty() {
+            return Err(self.error("expected ')'"));
+        }
+        debug_assert_eq!(out.len(), 1);
+        out.pop()
+            .ok_or_else(|| self.error("expected an expression"))
+    }
+
+    /// A number, symbol, binding use or the name of a call (followed by `(`).
+    fn operand(&mut self) -> Result<Operand, SymxError> {
+        match self.peek() {
             Some(b'@') => {
                 self.pos += 1;
                 let k = self.integer()?;
                 self.bindings
                     .get(&k)
                     .copied()
+                    .map(Operand::Value)
                     .ok_or_else(|| self.error(&format!("unknown binding @{k}")))
             }
-            Some(c) if c.is_ascii_digit() || c == b'.' => self.number(),
+            Some(c) if c.is_ascii_digit() || c == b'.' => self.number().map(Operand::Value),
             Some(c) if c.is_ascii_alphabetic() || c == b'_' => {
                 let start = self.pos;
                 while self.pos < self.s.len() {
@@ -298,21 +406,28 @@ impl Parser<'_> {
                 }
                 let name = String::from_utf8_lossy(&self.s[start..self.pos]).into_owned();
                 if self.peek() == Some(b'(') {
-                    return self.call(&name);
+                    return Op::WITH_OPERANDS
+                        .iter()
+                        .copied()
+                        .find(|op| op.name() == name)
+                        .map(Operand::Call)
+                        .ok_or_else(|| self.error(&format!("unknown function '{name}'")));
                 }
                 match name.as_str() {
-                    "inf" => return Ok(Expr::constant(f64::INFINITY)),
-                    "NaN" => return Ok(Expr::constant(f64::NAN)),
+                    "inf" => return Ok(Operand::Value(Expr::constant(f64::INFINITY))),
+                    "NaN" => return Ok(Operand::Value(Expr::constant(f64::NAN))),
                     _ => {}
                 }
                 self.by_name
                     .get(&name)
                     .copied()
+                    .map(Operand::Value)
                     .ok_or_else(|| self.error(&format!("unknown symbol '{name}'")))
             }
             _ => Err(self.error("expected an expression")),
         }
     }
+
     fn number(&mut self) -> Result<Expr, SymxError> {
         let start = self.pos;
         while self.pos < self.s.len() {
@@ -332,29 +447,9 @@ impl Parser<'_> {
             .map(Expr::constant)
             .ok_or_else(|| self.error("malformed number"))
     }
-    fn call(&mut self, name: &str) -> Result<Expr, SymxError> {
-        let op = Op::WITH_OPERANDS
-            .iter()
-            .copied()
-            .find(|op| op.name() == name)
-            .ok_or_else(|| self.error(&format!("unknown function '{name}'")))?;
-        self.expect(b'(')?;
-        let mut args = Vec::with_capacity(3);
-        loop {
-            args.push(self.expr()?.id);
-            match self.peek() {
-                Some(b',') => self.pos += 1,
-                _ => break,
-            }
-        }
-        self.expect(b')')?;
-        if args.len() != op.arity() {
-            return Err(self.error(&format!(
-                "'{name}' takes {} arguments, got {}",
-                op.arity(),
-                args.len()
-            )));
-        }
-        Ok(Expr::from_id(graph::with(|g| g.make(op, &args))))
-    }
+}
+
+enum Operand {
+    Value(Expr),
+    Call(Op),
 }

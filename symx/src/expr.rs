@@ -68,7 +68,13 @@ impl Expr {
 
     /// The operands of the root operation.
     pub fn operands(self) -> Vec<Expr> {
-        graph::with(|g| g.node(self.id).operands().iter().map(|&a| Expr::from_id(a)).collect())
+        graph::with(|g| {
+            g.node(self.id)
+                .operands()
+                .iter()
+                .map(|&a| Expr::from_id(a))
+                .collect()
+        })
     }
 
     /// The value, if this expression is a constant.
@@ -180,11 +186,13 @@ impl Expr {
     pub fn atan2(self, x: impl Into<Expr>) -> Expr {
         self.bin(Op::Atan2, x)
     }
-    /// Minimum (its derivative follows the smaller operand; `self` on ties).
+    /// Minimum, as `f64::min` (a NaN operand is ignored); its derivative follows the operand
+    /// whose value is returned (on ties, one of the two).
     pub fn min(self, other: impl Into<Expr>) -> Expr {
         self.bin(Op::Min, other)
     }
-    /// Maximum (its derivative follows the larger operand; `self` on ties).
+    /// Maximum, as `f64::max` (a NaN operand is ignored); its derivative follows the operand
+    /// whose value is returned (on ties, one of the two).
     pub fn max(self, other: impl Into<Expr>) -> Expr {
         self.bin(Op::Max, other)
     }
@@ -294,14 +302,18 @@ impl std::iter::Sum for Expr {
     /// Sums as a balanced tree, so that long sums stay shallow.
     fn sum<I: Iterator<Item = Expr>>(iter: I) -> Expr {
         let terms: Vec<u32> = iter.map(|e| e.id).collect();
-        Expr::from_id(graph::with(|g| balanced(g, Op::Add, terms, crate::simplify::ZERO)))
+        Expr::from_id(graph::with(|g| {
+            balanced(g, Op::Add, terms, crate::simplify::ZERO)
+        }))
     }
 }
 
 impl std::iter::Product for Expr {
     fn product<I: Iterator<Item = Expr>>(iter: I) -> Expr {
         let terms: Vec<u32> = iter.map(|e| e.id).collect();
-        Expr::from_id(graph::with(|g| balanced(g, Op::Mul, terms, crate::simplify::ONE)))
+        Expr::from_id(graph::with(|g| {
+            balanced(g, Op::Mul, terms, crate::simplify::ONE)
+        }))
     }
 }
 

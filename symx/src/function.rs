@@ -100,35 +100,65 @@ impl Function {
         self.tape.len()
     }
 
-    fn check(&self, inputs: &[&[f64]], outputs: &[&mut [f64]], work: &[f64], points: usize) -> Result<(), SymxError> {
+    fn check(
+        &self,
+        inputs: &[&[f64]],
+        outputs: &[&mut [f64]],
+        work: &[f64],
+        points: usize,
+    ) -> Result<(), SymxError> {
         let count = |what, expected, got| {
             if expected == got {
                 Ok(())
             } else {
-                Err(SymxError::ArgumentCount { what, expected, got })
+                Err(SymxError::ArgumentCount {
+                    what,
+                    expected,
+                    got,
+                })
             }
         };
         count("inputs", self.input_sizes.len(), inputs.len())?;
         count("outputs", self.output_sizes.len(), outputs.len())?;
         for (index, (&n, x)) in self.input_sizes.iter().zip(inputs).enumerate() {
             if x.len() != n * points {
-                return Err(SymxError::Length { what: "input", index, expected: n * points, got: x.len() });
+                return Err(SymxError::Length {
+                    what: "input",
+                    index,
+                    expected: n * points,
+                    got: x.len(),
+                });
             }
         }
         for (index, (&n, y)) in self.output_sizes.iter().zip(outputs).enumerate() {
             if y.len() != n * points {
-                return Err(SymxError::Length { what: "output", index, expected: n * points, got: y.len() });
+                return Err(SymxError::Length {
+                    what: "output",
+                    index,
+                    expected: n * points,
+                    got: y.len(),
+                });
             }
         }
         if work.len() < self.work_size {
-            return Err(SymxError::Length { what: "work vector", index: 0, expected: self.work_size, got: work.len() });
+            return Err(SymxError::Length {
+                what: "work vector",
+                index: 0,
+                expected: self.work_size,
+                got: work.len(),
+            });
         }
         Ok(())
     }
 
     /// Evaluates at one point: `inputs[k]` has length `input_sizes()[k]`, `outputs[k]` length
     /// `output_sizes()[k]`, `work` at least `work_size()`. Allocates nothing.
-    pub fn eval(&self, inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> Result<(), SymxError> {
+    pub fn eval(
+        &self,
+        inputs: &[&[f64]],
+        outputs: &mut [&mut [f64]],
+        work: &mut [f64],
+    ) -> Result<(), SymxError> {
         self.check(inputs, outputs, work, 1)?;
         // SAFETY: sizes checked above; the tape's indices were bounded at compilation.
         unsafe { self.run(inputs, outputs, work, 0) };
@@ -165,7 +195,13 @@ impl Function {
     /// `inputs`/`outputs` must hold `(p+1)·size` numbers per argument and `work` at least
     /// `work_size` numbers (checked by [`Function::check`]).
     #[inline(always)]
-    unsafe fn run(&self, inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64], p: usize) {
+    unsafe fn run(
+        &self,
+        inputs: &[&[f64]],
+        outputs: &mut [&mut [f64]],
+        work: &mut [f64],
+        p: usize,
+    ) {
         let w = work.as_mut_ptr();
         std::ptr::copy_nonoverlapping(self.constants.as_ptr(), w, self.constants.len());
         let r = |i: u32| *w.add(i as usize);
@@ -215,10 +251,18 @@ impl Function {
     pub fn dependency_sparsity(&self, input: usize, output: usize) -> Result<Sparsity, SymxError> {
         let (n_in, n_out) = (self.input_sizes.len(), self.output_sizes.len());
         if input >= n_in {
-            return Err(SymxError::ArgumentCount { what: "input index bound", expected: n_in, got: input });
+            return Err(SymxError::ArgumentCount {
+                what: "input index bound",
+                expected: n_in,
+                got: input,
+            });
         }
         if output >= n_out {
-            return Err(SymxError::ArgumentCount { what: "output index bound", expected: n_out, got: output });
+            return Err(SymxError::ArgumentCount {
+                what: "output index bound",
+                expected: n_out,
+                got: output,
+            });
         }
         let ncols = self.input_sizes[input];
         let mut bits = vec![0u64; self.work_size];
@@ -259,11 +303,21 @@ impl Function {
                 bits[ins.d as usize] = v;
             }
         }
-        Ok(pattern_from_entries(self.output_sizes[output], ncols, entries))
+        Ok(pattern_from_entries(
+            self.output_sizes[output],
+            ncols,
+            entries,
+        ))
     }
 }
 
 fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Function, SymxError> {
+    // Per-node scratch indexed by node id. Zero-initialised vectors are allocated lazily
+    // by the OS, so a small function in a large graph only touches the pages of its cone.
+    // `seen[id]`: 0 = not visited, else 1 + the node's position in `order`.
+    let n = g.len();
+    let mut seen = vec![0u32; n];
+
     // Where each input symbol is read from.
     let mut source: FxHashMap<u32, (u32, u32)> = FxHashMap::default();
     for (k, x) in inputs.iter().enumerate() {
@@ -272,28 +326,30 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
         }
     }
 
-    // Constants get the first registers.
-    let mut register: FxHashMap<u32, u32> = FxHashMap::default();
+    // Constants get the first registers (their values are copied in before every run).
     let mut constants = Vec::new();
 
     // Depth-first post-order from each output entry; stores follow their node.
     let mut steps: Vec<Step> = Vec::new();
-    let mut visited: FxHashMap<u32, ()> = FxHashMap::default();
     let mut stack: Vec<(u32, u8)> = Vec::new();
+    // Register of each visited node (constants: their constant slot).
+    let mut register: Vec<u32> = Vec::new();
     for (k, y) in outputs.iter().enumerate() {
         for (off, e) in y.iter().enumerate() {
-            stack.push((e.id, 0));
+            if seen[e.id as usize] == 0 {
+                stack.push((e.id, 0));
+            }
             while let Some(&mut (id, ref mut next)) = stack.last_mut() {
                 let node = g.node(id);
                 if *next == 0 {
-                    if visited.contains_key(&id) {
+                    if seen[id as usize] != 0 {
                         stack.pop();
                         continue;
                     }
                     match node.op {
                         Op::Const => {
-                            visited.insert(id, ());
-                            register.insert(id, constants.len() as u32);
+                            register.push(constants.len() as u32);
+                            seen[id as usize] = register.len() as u32;
                             constants.push(node.value().unwrap_or(f64::NAN));
                             stack.pop();
                             continue;
@@ -311,11 +367,12 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
                 if (*next as usize) < operands.len() {
                     let child = operands[*next as usize];
                     *next += 1;
-                    if !visited.contains_key(&child) {
+                    if seen[child as usize] == 0 {
                         stack.push((child, 0));
                     }
                 } else {
-                    visited.insert(id, ());
+                    register.push(u32::MAX);
+                    seen[id as usize] = register.len() as u32;
                     steps.push(Step::Node(id));
                     stack.pop();
                 }
@@ -327,18 +384,20 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
             });
         }
     }
+    // Dense local index of each visited node.
+    let local = |id: u32| seen[id as usize] as usize - 1;
 
-    // Last step that reads each node.
-    let mut last_use: FxHashMap<u32, usize> = FxHashMap::default();
+    // Last step that reads each node (by local index).
+    let mut last_use: Vec<usize> = vec![usize::MAX; register.len()];
     for (s, step) in steps.iter().enumerate() {
         match *step {
             Step::Node(id) => {
                 for &a in g.node(id).operands() {
-                    last_use.insert(a, s);
+                    last_use[local(a)] = s;
                 }
             }
             Step::Store { node, .. } => {
-                last_use.insert(node, s);
+                last_use[local(node)] = s;
             }
         }
     }
@@ -348,14 +407,6 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
     let mut free: Vec<u32> = Vec::new();
     let mut work_size = n_const;
     let mut tape = Vec::with_capacity(steps.len());
-    let release = |node: u32, s: usize, register: &FxHashMap<u32, u32>, free: &mut Vec<u32>| {
-        if last_use.get(&node) == Some(&s) {
-            let r = register[&node];
-            if r >= n_const {
-                free.push(r);
-            }
-        }
-    };
     for (s, step) in steps.iter().enumerate() {
         match *step {
             Step::Node(id) => {
@@ -364,37 +415,58 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
                 let arity = node.op.arity();
                 let mut regs = [0u32; 3];
                 for k in 0..arity {
-                    regs[k] = register[&args[k]];
+                    regs[k] = register[local(args[k])];
                 }
                 // Operands whose last use is here free their registers first, so the
                 // result may take one of them (operands are read before the write).
-                let mut seen = [u32::MAX; 3];
                 for k in 0..arity {
-                    if !seen.contains(&args[k]) {
-                        release(args[k], s, &register, &mut free);
-                        seen[k] = args[k];
+                    let l = local(args[k]);
+                    if last_use[l] == s && regs[k] >= n_const && !regs[..k].contains(&regs[k]) {
+                        free.push(regs[k]);
                     }
                 }
                 let d = free.pop().unwrap_or_else(|| {
                     work_size += 1;
                     work_size - 1
                 });
-                register.insert(id, d);
+                register[local(id)] = d;
                 let ins = if node.op == Op::Sym {
                     let (k, off) = source[&id];
-                    Instr { code: Code::Load, d, a: k, b: off, c: 0 }
+                    Instr {
+                        code: Code::Load,
+                        d,
+                        a: k,
+                        b: off,
+                        c: 0,
+                    }
                 } else {
-                    Instr { code: Code::Calc(node.op), d, a: regs[0], b: regs[1], c: regs[2] }
+                    Instr {
+                        code: Code::Calc(node.op),
+                        d,
+                        a: regs[0],
+                        b: regs[1],
+                        c: regs[2],
+                    }
                 };
                 tape.push(ins);
-                if !last_use.contains_key(&id) {
-                    free.push(d);
-                }
             }
-            Step::Store { output, offset, node } => {
-                let c = register[&node];
-                tape.push(Instr { code: Code::Store, d: 0, a: output, b: offset, c });
-                release(node, s, &register, &mut free);
+            Step::Store {
+                output,
+                offset,
+                node,
+            } => {
+                let l = local(node);
+                let c = register[l];
+                tape.push(Instr {
+                    code: Code::Store,
+                    d: 0,
+                    a: output,
+                    b: offset,
+                    c,
+                });
+                if last_use[l] == s && c >= n_const {
+                    free.push(c);
+                }
             }
         }
     }

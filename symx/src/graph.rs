@@ -21,8 +21,15 @@ pub(crate) struct Node {
 
 impl Node {
     pub fn constant(v: f64) -> Node {
-        // One zero: -0.0 and 0.0 intern to the same node.
-        let v = if v == 0.0 { 0.0 } else { v };
+        // One zero: -0.0 and 0.0 intern to the same node; one NaN (the payload and sign of
+        // a NaN produced by folding, e.g. 0/0, are not printable, so they must not matter).
+        let v = if v == 0.0 {
+            0.0
+        } else if v.is_nan() {
+            f64::NAN
+        } else {
+            v
+        };
         let bits = v.to_bits();
         Node {
             op: Op::Const,

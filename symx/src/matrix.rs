@@ -5,8 +5,8 @@
 //! derivatives. A `Matrix` dereferences to the slice of its entries (column-major), so
 //! it can be passed wherever `&[Expr]` is expected.
 use crate::error::SymxError;
-use crate::sparsity::Sparsity;
 use crate::expr::Expr;
+use crate::sparsity::Sparsity;
 use std::fmt;
 use std::ops::{Add, Deref, DerefMut, Index, IndexMut, Mul, Neg, Range, Sub};
 
@@ -56,7 +56,11 @@ impl Matrix {
     }
 
     /// A matrix from column-major entries; `Err` if the count is not `rows·cols`.
-    pub fn from_column_major(rows: usize, cols: usize, data: Vec<Expr>) -> Result<Matrix, SymxError> {
+    pub fn from_column_major(
+        rows: usize,
+        cols: usize,
+        data: Vec<Expr>,
+    ) -> Result<Matrix, SymxError> {
         if data.len() != rows * cols {
             return Err(SymxError::Dimension {
                 op: "from_column_major",
@@ -122,7 +126,11 @@ impl Matrix {
 
     /// The sub-matrix of the given row and column ranges; `Err` out of range.
     pub fn slice(&self, rows: Range<usize>, cols: Range<usize>) -> Result<Matrix, SymxError> {
-        if rows.end > self.rows || cols.end > self.cols || rows.start > rows.end || cols.start > cols.end {
+        if rows.end > self.rows
+            || cols.end > self.cols
+            || rows.start > rows.end
+            || cols.start > cols.end
+        {
             return Err(SymxError::Dimension {
                 op: "slice",
                 left: self.shape(),
@@ -227,7 +235,12 @@ impl Matrix {
     /// Inner product `Σ aᵢbᵢ` of two matrices of the same shape.
     pub fn dot(&self, other: &Matrix) -> Result<Expr, SymxError> {
         self.same_shape(other, "dot")?;
-        Ok(self.data.iter().zip(&other.data).map(|(&a, &b)| a * b).sum())
+        Ok(self
+            .data
+            .iter()
+            .zip(&other.data)
+            .map(|(&a, &b)| a * b)
+            .sum())
     }
 
     /// Cross product of two 3-vectors.
@@ -286,12 +299,21 @@ impl Matrix {
     }
 
     /// Combines two matrices of the same shape entry by entry.
-    pub fn zip_map(&self, other: &Matrix, mut f: impl FnMut(Expr, Expr) -> Expr) -> Result<Matrix, SymxError> {
+    pub fn zip_map(
+        &self,
+        other: &Matrix,
+        mut f: impl FnMut(Expr, Expr) -> Expr,
+    ) -> Result<Matrix, SymxError> {
         self.same_shape(other, "zip_map")?;
         Ok(Matrix {
             rows: self.rows,
             cols: self.cols,
-            data: self.data.iter().zip(&other.data).map(|(&a, &b)| f(a, b)).collect(),
+            data: self
+                .data
+                .iter()
+                .zip(&other.data)
+                .map(|(&a, &b)| f(a, b))
+                .collect(),
         })
     }
 }
@@ -312,14 +334,24 @@ impl DerefMut for Matrix {
 impl Index<(usize, usize)> for Matrix {
     type Output = Expr;
     fn index(&self, (i, j): (usize, usize)) -> &Expr {
-        assert!(i < self.rows && j < self.cols, "index ({i},{j}) out of range for {}x{} matrix", self.rows, self.cols);
+        assert!(
+            i < self.rows && j < self.cols,
+            "index ({i},{j}) out of range for {}x{} matrix",
+            self.rows,
+            self.cols
+        );
         &self.data[i + j * self.rows]
     }
 }
 
 impl IndexMut<(usize, usize)> for Matrix {
     fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut Expr {
-        assert!(i < self.rows && j < self.cols, "index ({i},{j}) out of range for {}x{} matrix", self.rows, self.cols);
+        assert!(
+            i < self.rows && j < self.cols,
+            "index ({i},{j}) out of range for {}x{} matrix",
+            self.rows,
+            self.cols
+        );
         &mut self.data[i + j * self.rows]
     }
 }
@@ -349,7 +381,13 @@ macro_rules! range_index {
         }
     )*};
 }
-range_index!(Range<usize>, std::ops::RangeFrom<usize>, std::ops::RangeTo<usize>, std::ops::RangeInclusive<usize>, std::ops::RangeFull);
+range_index!(
+    Range<usize>,
+    std::ops::RangeFrom<usize>,
+    std::ops::RangeTo<usize>,
+    std::ops::RangeInclusive<usize>,
+    std::ops::RangeFull
+);
 
 impl From<Vec<Expr>> for Matrix {
     fn from(v: Vec<Expr>) -> Matrix {
@@ -565,7 +603,11 @@ impl fmt::Debug for SparseMatrix {
         let (r, c) = self.shape();
         write!(f, "SparseMatrix {r}x{c}, {} nonzeros: ", self.nnz())?;
         f.debug_list()
-            .entries(self.triplets().iter().map(|(i, j, e)| format!("({i},{j}): {e}")))
+            .entries(
+                self.triplets()
+                    .iter()
+                    .map(|(i, j, e)| format!("({i},{j}): {e}")),
+            )
             .finish()
     }
 }

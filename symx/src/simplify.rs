@@ -24,7 +24,9 @@ impl Graph {
             Op::Neg if na.op == Op::Sub => {
                 return self.binary(Op::Sub, na.args[1], na.args[0]);
             }
-            Op::Sq if na.op == Op::Neg || na.op == Op::Abs => return self.unary(Op::Sq, na.args[0]),
+            Op::Sq if na.op == Op::Neg || na.op == Op::Abs => {
+                return self.unary(Op::Sq, na.args[0])
+            }
             Op::Abs if matches!(na.op, Op::Abs | Op::Sq | Op::Exp | Op::Sqrt) => return a,
             Op::Abs if na.op == Op::Neg => return self.unary(Op::Abs, na.args[0]),
             _ => {}

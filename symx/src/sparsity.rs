@@ -19,14 +19,21 @@ pub type Sparsity = SymbolicSparseColMat<usize>;
 /// A pattern from `(row, column)` entries in any order; duplicates are merged.
 ///
 /// Panics if an entry lies outside `nrows × ncols` (a caller's broken invariant).
-pub fn pattern_from_entries(nrows: usize, ncols: usize, entries: impl IntoIterator<Item = (usize, usize)>) -> Sparsity {
+pub fn pattern_from_entries(
+    nrows: usize,
+    ncols: usize,
+    entries: impl IntoIterator<Item = (usize, usize)>,
+) -> Sparsity {
     let mut e: Vec<(usize, usize)> = entries.into_iter().map(|(i, j)| (j, i)).collect();
     e.sort_unstable();
     e.dedup();
     let mut col_ptr = vec![0usize; ncols + 1];
     let mut row_idx = Vec::with_capacity(e.len());
     for &(j, i) in &e {
-        assert!(i < nrows && j < ncols, "entry ({i},{j}) outside {nrows}x{ncols}");
+        assert!(
+            i < nrows && j < ncols,
+            "entry ({i},{j}) outside {nrows}x{ncols}"
+        );
         col_ptr[j + 1] += 1;
         row_idx.push(i);
     }
@@ -49,15 +56,26 @@ pub fn entries(p: &Sparsity) -> Vec<(usize, usize)> {
 
 /// Whether the pattern holds entry `(i, j)`.
 pub fn contains(p: &Sparsity, i: usize, j: usize) -> bool {
-    j < p.ncols() && p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]].binary_search(&i).is_ok()
+    j < p.ncols()
+        && p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]]
+            .binary_search(&i)
+            .is_ok()
 }
 
 /// The entries of `p` with `row ≥ column`.
 pub fn lower_triangle(p: &Sparsity) -> Sparsity {
-    pattern_from_entries(p.nrows(), p.ncols(), entries(p).into_iter().filter(|&(i, j)| i >= j))
+    pattern_from_entries(
+        p.nrows(),
+        p.ncols(),
+        entries(p).into_iter().filter(|&(i, j)| i >= j),
+    )
 }
 
 /// The largest distance `|i − j|` of any entry (0 for diagonal or empty patterns).
 pub fn bandwidth(p: &Sparsity) -> usize {
-    entries(p).into_iter().map(|(i, j)| i.abs_diff(j)).max().unwrap_or(0)
+    entries(p)
+        .into_iter()
+        .map(|(i, j)| i.abs_diff(j))
+        .max()
+        .unwrap_or(0)
 }
