@@ -9,6 +9,7 @@ use gap_crossing::gait;
 use gap_crossing::plan::{write_atomic, PlanError, SolutionFile, SolverInfo};
 use gap_crossing::render::{self, IterRecord};
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
+use gap_crossing::solve::{self, Backend, PlanningError, Settings};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -146,7 +147,9 @@ enum CliError {
         path: PathBuf,
         source: ScenarioError,
     },
-    #[error("{0}: not yet implemented: the symbolic model lands with issue 5")]
+    #[error(transparent)]
+    Planning(#[from] PlanningError),
+    #[error("{0}: not yet implemented")]
     NotImplemented(&'static str),
 }
 
@@ -175,11 +178,114 @@ fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
 }
 
 fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
-    // Validate everything the user gave before saying the solver is missing, so that
-    // scenario mistakes are reported now. Nothing is written.
-    let _s = scenario(&a.scenario)?;
-    let _ = a.solver;
-    Err(CliError::NotImplemented("solve"))
+    let s = scenario(&a.scenario)?;
+    let mut settings = Settings::default();
+    settings.backend = match a.solver {
+        None | Some(SolverArg::Ipm) => Backend::Ipm,
+        Some(SolverArg::Sqp) => Backend::Sqp,
+    };
+    settings.ipm.print_level = 5;
+    let outcome = solve::plan(&s, &settings)?;
+    let file = &outcome.file;
+    let report = check::check(file);
+
+    // Convergence records of all solver runs, numbered on; (10)'s residual is known at
+    // the end of each run.
+    let mut records = Vec::new();
+    for phase in &outcome.phases {
+        let last = phase.records.len().saturating_sub(1);
+        for (k, r) in phase.records.iter().enumerate() {
+            records.push(IterRecord {
+                iter: records.len(),
+                objective: r.objective,
+                inf_pr: r.inf_pr,
+                compl: if k == last {
+                    phase.complementarity
+                } else {
+                    f64::NAN
+                },
+            });
+        }
+    }
+    let solved = file.solver.status == "solved" && report.ok();
+    if !solved {
+        // Nothing partial is left as if it were a result.
+        eprintln!(
+            "error: no valid plan: solver status {}, checker: {}",
+            file.solver.status,
+            report.summary()
+        );
+        if !report.ok() {
+            eprintln!("{report}");
+        }
+        return Ok(ExitCode::from(1));
+    }
+    std::fs::create_dir_all(&a.out).map_err(io(&a.out))?;
+    let json = a.out.join("solution.json");
+    file.write(&json)?;
+    let conv_json = a.out.join("convergence.json");
+    write_file(
+        &conv_json,
+        &serde_json::to_string_pretty(&records).unwrap_or_default(),
+    )?;
+    write_file(&a.out.join("plan.svg"), &render::plan_svg(file))?;
+    let title = format!(
+        "Convergence: {} gait, {} iterations",
+        s.gait, file.solver.iterations
+    );
+    write_file(
+        &a.out.join("convergence.svg"),
+        &render::convergence_svg(&records, &title),
+    )?;
+
+    let moves = gap_crossing::plan::Plan::from_flat(&s, &file.plan().to_flat())
+        .map(|p| foot_moves(&p))
+        .unwrap_or_default();
+    println!();
+    for phase in &outcome.phases {
+        println!(
+            "  {:<42} {:?}, {} iterations, (10) residual {:.1e}",
+            phase.name,
+            phase.status,
+            phase.records.len().saturating_sub(1),
+            phase.complementarity
+        );
+    }
+    println!("status:     {} ({} gait)", file.solver.status, s.gait);
+    println!("objective:  {:.6e}", file.solver.objective);
+    println!(
+        "steps:      {} of {} transitions move a foot; moves per foot: {}",
+        report.moves,
+        s.n_step - 1,
+        moves
+    );
+    println!("time:       {:.3} s", file.solver.solve_seconds);
+    println!("checker:    {}", report.summary());
+    println!(
+        "wrote {}/{{solution.json, plan.svg, convergence.svg, convergence.json}}",
+        a.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// "BR 15, BL 14, ..." from a plan.
+fn foot_moves(p: &gap_crossing::plan::Plan) -> String {
+    use gap_crossing::scenario::Foot;
+    Foot::ALL
+        .iter()
+        .map(|&i| {
+            let n = p
+                .stances
+                .windows(2)
+                .filter(|w| {
+                    let (a, b) = (w[0].feet.get(i), w[1].feet.get(i));
+                    (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>().sqrt() > 1e-6
+                })
+                .count();
+            format!("{} {n}", i.name())
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {

@@ -49,6 +49,14 @@ pub struct Model {
     pub has_penalty: bool,
 }
 
+/// ε of the smoothed friction cone `√(‖F_t‖² + ε²) ≤ μ F·n` (N): it makes the cone
+/// differentiable at `F_t = 0` and only shrinks it (by at most ε), so a plan that satisfies
+/// the smoothed cone satisfies (4).
+pub const CONE_SMOOTHING: f64 = 1.0;
+
+/// Distance (m) within which a guessed foot x on a keep-out edge counts as on that edge's side.
+pub const KEEP_OUT_SNAP: f64 = 1e-6;
+
 /// Name of the complementarity penalty parameter `π` in the compiled problem.
 pub const PENALTY: &str = "complementarity penalty";
 
@@ -63,7 +71,13 @@ pub enum ModelError {
     ScheduleLength { expected: usize, got: usize },
     /// The guess puts a foot inside a keep-out interval, so no side can be assigned.
     #[error("initial guess puts foot {foot} at stance {stance} inside the keep-out zone ({lo}, {hi}) at x = {x}")]
-    GuessInKeepOut { foot: &'static str, stance: usize, x: f64, lo: f64, hi: f64 },
+    GuessInKeepOut {
+        foot: &'static str,
+        stance: usize,
+        x: f64,
+        lo: f64,
+        hi: f64,
+    },
     /// A problem-definition error from nlp.
     #[error(transparent)]
     Build(#[from] BuildError),
@@ -79,14 +93,25 @@ fn constant3(v: [f64; 3]) -> Matrix {
 
 /// Builds the planner for scenario `s` on `terrain`, with the variables initialised (and
 /// keep-out sides assigned) from `guess` (flat layout, 30 numbers per stance).
-pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, guess: &[f64]) -> Result<Model, ModelError> {
+pub fn build(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    formulation: &Formulation,
+    guess: &[f64],
+) -> Result<Model, ModelError> {
     let n = s.n_step;
     if guess.len() != n * STANCE_LEN {
-        return Err(ModelError::GuessLength { expected: n * STANCE_LEN, got: guess.len() });
+        return Err(ModelError::GuessLength {
+            expected: n * STANCE_LEN,
+            got: guess.len(),
+        });
     }
     if let Formulation::Scheduled(schedule) = formulation {
         if schedule.len() != n - 1 {
-            return Err(ModelError::ScheduleLength { expected: n - 1, got: schedule.len() });
+            return Err(ModelError::ScheduleLength {
+                expected: n - 1,
+                got: schedule.len(),
+            });
         }
     }
     let mut pb = Problem::new();
@@ -129,12 +154,20 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
                 let g = at(foot_offset(k, i));
                 pb.set_initial(&r, g)?;
                 for &(lo, hi) in &keep_out {
-                    if g[0] <= lo {
+                    // A guess on a keep-out edge (a previous solution at its bound, up to
+                    // the solver's bound relaxation) belongs to that edge's side.
+                    if g[0] <= lo + KEEP_OUT_SNAP {
                         pb.set_bounds(&r[0..1], f64::NEG_INFINITY, lo)?;
-                    } else if g[0] >= hi {
+                    } else if g[0] >= hi - KEEP_OUT_SNAP {
                         pb.set_bounds(&r[0..1], hi, f64::INFINITY)?;
                     } else {
-                        return Err(ModelError::GuessInKeepOut { foot: i.name(), stance: label, x: g[0], lo, hi });
+                        return Err(ModelError::GuessInKeepOut {
+                            foot: i.name(),
+                            stance: label,
+                            x: g[0],
+                            lo,
+                            hi,
+                        });
                     }
                 }
                 fk.push(r);
@@ -144,7 +177,8 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
         }
         let f = Foot::ALL.map(|i| {
             let v = pb.variable(&format!("F_{}^{label}", i.name()), 3);
-            pb.set_initial(&v, at(k * STANCE_LEN + 18 + 3 * i.index())).map(|_| v)
+            pb.set_initial(&v, at(k * STANCE_LEN + 18 + 3 * i.index()))
+                .map(|_| v)
         });
         let [f0, f1, f2, f3] = f;
         forces.push([f0?, f1?, f2?, f3?]);
@@ -152,38 +186,44 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
 
     let m_total = s.masses.total();
     let gravity = constant3([0.0, 0.0, -s.gravity]);
-    let mu2 = s.friction.mu * s.friction.mu;
     for k in 0..n {
         let label = k + 1;
         let [rb, rf] = &coms[k];
         // (2) static centroidal balance: forces and moments about the whole-body CoM.
         let total_force = forces[k].iter().fold(&gravity * m_total, |acc, f| acc + f);
-        pb.subject_to_named(&format!("(2) force balance, stance {label}"), total_force.eq(0.0))?;
+        pb.subject_to_named(
+            &format!("(2) force balance, stance {label}"),
+            total_force.eq(0.0),
+        )?;
         let r_w = (rb * s.masses.b + rf * s.masses.f) * (1.0 / m_total);
         let mut moment = Matrix::zeros(3, 1);
         for i in Foot::ALL {
             let arm = &feet[k][i.index()] - &r_w;
             moment = moment + arm.cross(&forces[k][i.index()]).expect("3-vectors");
         }
-        pb.subject_to_named(&format!("(2) moment balance, stance {label}"), moment.eq(0.0))?;
+        pb.subject_to_named(
+            &format!("(2) moment balance, stance {label}"),
+            moment.eq(0.0),
+        )?;
 
         for i in Foot::ALL {
             let r = &feet[k][i.index()];
             let f = &forces[k][i.index()];
             let [hx, hy] = terrain.gradient(r[0], r[1]);
             // (4) friction cone with n = (−h_x, −h_y, 1)/‖·‖: F·n ≥ F_thr and
-            // ‖F_t‖ ≤ μ F·n, the latter squared (valid since F·n > 0):
-            // ‖F‖²‖n_raw‖² − (1 + μ²)(F·n_raw)² ≤ 0.
+            // ‖F_t‖ ≤ μ F·n with F_t = F − (F·n)n, written in the convex smoothed form
+            // √(‖F‖² − (F·n)² + ε²) ≤ μ F·n (conservative by at most ε, see CONE_SMOOTHING).
             let n_raw = vec3(&[-hx, -hy, Expr::one()]);
-            let n_norm2 = n_raw.sumsqr();
-            let f_n_raw = f.dot(&n_raw).expect("3-vectors");
+            let n_norm = n_raw.sumsqr().sqrt();
+            let f_n = f.dot(&n_raw).expect("3-vectors") / n_norm;
             pb.subject_to_named(
                 &format!("(4) normal force {}, stance {label}", i.name()),
-                (f_n_raw - s.friction.f_thr * n_norm2.sqrt()).ge(0.0),
+                f_n.ge(s.friction.f_thr),
             )?;
+            let tangential = (f.sumsqr() - f_n.sq() + CONE_SMOOTHING * CONE_SMOOTHING).sqrt();
             pb.subject_to_named(
                 &format!("(4) friction cone {}, stance {label}", i.name()),
-                (f.sumsqr() * n_norm2 - (1.0 + mu2) * f_n_raw.sq()).le(0.0),
+                (tangential - s.friction.mu * f_n).le(0.0),
             )?;
             if k == 0 || !moved[k][i.index()] {
                 continue;
@@ -197,7 +237,10 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
             // the bounds of its lifted step length instead).
             if let Formulation::Scheduled(_) = formulation {
                 let step = (r - &feet[k - 1][i.index()]).sumsqr();
-                pb.subject_to_named(&format!("(5) step {}, stance {label}", i.name()), step.le(s.step_radius_sq))?;
+                pb.subject_to_named(
+                    &format!("(5) step {}, stance {label}", i.name()),
+                    step.le(s.step_radius_sq),
+                )?;
             }
         }
         if k == 0 {
@@ -216,13 +259,19 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
                 // Both feet still at the start, which the scenario validated.
                 continue;
             }
-            pb.subject_to_named(&format!("{name}, stance {label}"), nlp::bounded(bounds.min, d2, bounds.max))?;
+            pb.subject_to_named(
+                &format!("{name}, stance {label}"),
+                nlp::bounded(bounds.min, d2, bounds.max),
+            )?;
         }
         // (11) rigid legs.
         for i in Foot::ALL {
             let com = if i.biped() == Biped::B { rb } else { rf };
             let d2 = (com - foot(i)).sumsqr();
-            pb.subject_to_named(&format!("(11) leg {}, stance {label}", i.name()), d2.eq(s.leg_length_sq))?;
+            pb.subject_to_named(
+                &format!("(11) leg {}, stance {label}", i.name()),
+                d2.eq(s.leg_length_sq),
+            )?;
         }
     }
 
@@ -242,7 +291,9 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
                     (sk[i.index()] - step).ge(0.0),
                 )?;
                 let (a, b) = (foot_offset(k - 1, i), foot_offset(k, i));
-                init[i.index()] = (0..3).map(|d| (guess[b + d] - guess[a + d]).powi(2)).sum::<f64>();
+                init[i.index()] = (0..3)
+                    .map(|d| (guess[b + d] - guess[a + d]).powi(2))
+                    .sum::<f64>();
             }
             pb.set_initial(&sk, &init)?;
             for a in 0..4 {
@@ -285,7 +336,12 @@ pub fn build(s: &Scenario, terrain: &dyn Terrain, formulation: &Formulation, gue
             layout.extend_from_slice(f);
         }
     }
-    Ok(Model { problem: pb, layout, step_lengths, has_penalty })
+    Ok(Model {
+        problem: pb,
+        layout,
+        step_lengths,
+        has_penalty,
+    })
 }
 
 #[cfg(test)]
@@ -299,7 +355,10 @@ mod tests {
     fn crawl_model(s: &Scenario) -> (Model, Vec<f64>) {
         let guess = gait::crawl(s);
         let f = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
-        (build(s, &GapTerrain { gap: s.gap }, &f, &guess).unwrap(), guess)
+        (
+            build(s, &GapTerrain { gap: s.gap }, &f, &guess).unwrap(),
+            guess,
+        )
     }
 
     /// The symbolic cost (1) at the crawl guess equals the plan's cost computed with plain
@@ -309,12 +368,20 @@ mod tests {
         let s = Scenario::default();
         let (m, guess) = crawl_model(&s);
         let mut c = m.problem.compile().unwrap();
-        let x = m.problem.variables().iter().map(|_| 0.0).collect::<Vec<_>>();
+        let x = m
+            .problem
+            .variables()
+            .iter()
+            .map(|_| 0.0)
+            .collect::<Vec<_>>();
         let mut x0 = x.clone();
         c.initial_point(&mut x0);
         let expected = Plan::from_flat(&s, &guess).unwrap().cost(&s);
         let f = c.eval_f(&x0);
-        assert!((f - expected).abs() <= 1e-12 * expected, "{f} vs {expected}");
+        assert!(
+            (f - expected).abs() <= 1e-12 * expected,
+            "{f} vs {expected}"
+        );
         // The layout read back at the initial point reproduces the guess.
         let flat = m.problem.evaluate(&m.layout, &x0).unwrap();
         assert!(flat.iter().zip(&guess).all(|(a, b)| (a - b).abs() < 1e-12));
@@ -333,7 +400,8 @@ mod tests {
         c.initial_point(&mut x0);
         let mut g = vec![0.0; mm];
         c.eval_g(&x0, &mut g);
-        let (mut xl, mut xu, mut gl, mut gu) = (vec![0.0; n], vec![0.0; n], vec![0.0; mm], vec![0.0; mm]);
+        let (mut xl, mut xu, mut gl, mut gu) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; mm], vec![0.0; mm]);
         c.bounds(&mut xl, &mut xu, &mut gl, &mut gu);
         let geometric = ["(3)", "(5)", "(6)", "(7)", "(8)", "(9)", "(11)"];
         let mut checked = 0;
@@ -341,19 +409,31 @@ mod tests {
             let name = c.constraint_name(i);
             if geometric.iter().any(|p| name.starts_with(p)) {
                 checked += 1;
-                assert!(g[i] >= gl[i] - 1e-9 && g[i] <= gu[i] + 1e-9, "{name}: {} not in [{}, {}]", g[i], gl[i], gu[i]);
+                assert!(
+                    g[i] >= gl[i] - 1e-9 && g[i] <= gu[i] + 1e-9,
+                    "{name}: {} not in [{}, {}]",
+                    g[i],
+                    gl[i],
+                    gu[i]
+                );
             }
         }
         assert!(checked > 500, "only {checked} geometric rows");
         // Keep-out bounds hold at the guess.
-        assert!(x0.iter().zip(xl.iter().zip(&xu)).all(|(x, (l, u))| x >= l && x <= u));
+        assert!(x0
+            .iter()
+            .zip(xl.iter().zip(&xu))
+            .all(|(x, (l, u))| x >= l && x <= u));
     }
 
     /// In the scheduled formulation only the scheduled foot gets new variables: 3 per
     /// transition, plus 6 CoM and 12 force variables per stance.
     #[test]
     fn scheduled_feet_share_variables() {
-        let s = Scenario { n_step: 9, ..Scenario::default() };
+        let s = Scenario {
+            n_step: 9,
+            ..Scenario::default()
+        };
         let (m, _) = crawl_model(&s);
         assert_eq!(m.problem.n_variables(), 8 * (6 + 3) + 9 * 12);
     }

@@ -18,7 +18,7 @@ use std::time::Instant;
 pub const COMPLEMENTARITY_TOL: f64 = 1e-10;
 
 /// Penalty values tried in turn by the free gait's first phase.
-pub const PENALTIES: [f64; 4] = [1e2, 1e4, 1e6, 1e8];
+pub const PENALTIES: [f64; 2] = [1e6, 1e8];
 
 /// Which back end solves the problem.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -109,6 +109,48 @@ pub fn schedule_of(s: &Scenario, x: &[f64]) -> Vec<Foot> {
         .collect()
 }
 
+/// A warm start for the scheduled problem with `schedule` built from a free-gait plan
+/// `flat`: at each transition only the scheduled foot moves, toward where `flat` has it,
+/// at most [`gait::CRAWL_MAX_MOVE`] in x–y, never into a keep-out zone, on the terrain;
+/// CoMs and forces are rebuilt to fit ([`gait::plan_for_footholds`]).
+pub fn scheduled_guess(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    flat: &[f64],
+    schedule: &[Foot],
+) -> Vec<f64> {
+    let mut feet = s.start.feet;
+    let mut footholds = vec![feet];
+    for (t, &i) in schedule.iter().enumerate() {
+        let k = t + 1;
+        let cur = feet.get(i);
+        let o = foot_offset(k, i);
+        let (dx, dy) = (flat[o] - cur[0], flat[o + 1] - cur[1]);
+        let dist = dx.hypot(dy);
+        let scale = if dist > gait::CRAWL_MAX_MOVE {
+            gait::CRAWL_MAX_MOVE / dist
+        } else {
+            1.0
+        };
+        let mut x = cur[0] + dx * scale;
+        let y = cur[1] + dy * scale;
+        for (lo, hi) in terrain.keep_out() {
+            if x > lo && x < hi {
+                // Stay on the side the foot comes from.
+                x = if cur[0] <= lo {
+                    lo - gait::GAP_CLEARANCE
+                } else {
+                    hi + gait::GAP_CLEARANCE
+                };
+            }
+        }
+        *feet.get_mut(i) = [x, y, terrain.height_at(x, y)];
+        footholds.push(feet);
+    }
+    gait::plan_for_footholds(s, &footholds).to_flat()
+}
+
+#[derive(Clone)]
 struct Run {
     solution: Solution,
     flat: Vec<f64>,
@@ -123,37 +165,57 @@ fn run(
     phases: &mut Vec<Phase>,
     name: &str,
 ) -> Result<Run, PlanningError> {
+    if settings.ipm.print_level > 0 {
+        println!("\n== {name}");
+    }
     let model = model::build(s, terrain, formulation, guess)?;
     let mut compiled = model.problem.compile()?;
     let ipm = Ipm::new(settings.ipm.clone());
+    let penalties: &[f64] = if model.has_penalty {
+        &PENALTIES
+    } else {
+        &[0.0]
+    };
+    let mut last: Option<Run> = None;
     let mut best: Option<Run> = None;
-    let penalties: &[f64] = if model.has_penalty { &PENALTIES } else { &[0.0] };
     for &penalty in penalties {
         if model.has_penalty {
             compiled.set_parameter(PENALTY, &[penalty])?;
         }
-        let solution = match &best {
-            Some(prev) => {
-                compiled.set_initial_point(&prev.solution.x)?;
-                ipm.solve(&mut compiled)?
-            }
-            None => ipm.solve(&mut compiled)?,
-        };
+        if let Some(prev) = &last {
+            compiled.set_initial_point(&prev.solution.x)?;
+        }
+        let solution = ipm.solve(&mut compiled)?;
         let flat = model.problem.evaluate(&model.layout, &solution.x)?;
         let complementarity = complementarity_residual(s, &flat);
         phases.push(Phase {
-            name: if model.has_penalty { format!("{name}, penalty {penalty:e}") } else { name.to_string() },
+            name: if model.has_penalty {
+                format!("{name}, penalty {penalty:e}")
+            } else {
+                name.to_string()
+            },
             status: solution.status,
             records: solution.stats.records.clone(),
             complementarity,
         });
-        let done = !solution.status.is_success() || complementarity <= COMPLEMENTARITY_TOL;
-        best = Some(Run { solution, flat });
+        let success = solution.status.is_success();
+        let done = !success || complementarity <= COMPLEMENTARITY_TOL;
+        let this = Run { solution, flat };
+        // Keep the successful run with the lowest objective: a larger penalty can only
+        // make the choice of steps more conservative.
+        if success
+            && best
+                .as_ref()
+                .is_none_or(|b| this.solution.objective < b.solution.objective)
+        {
+            best = Some(this.clone());
+        }
+        last = Some(this);
         if done {
             break;
         }
     }
-    Ok(best.expect("at least one penalty is tried"))
+    Ok(best.or(last).expect("at least one penalty is tried"))
 }
 
 /// Plans scenario `s` (its `gait` field chooses the formulation) on the spec's gap terrain.
@@ -162,7 +224,11 @@ pub fn plan(s: &Scenario, settings: &Settings) -> Result<Outcome, PlanningError>
 }
 
 /// Plans scenario `s` on any terrain.
-pub fn plan_on(s: &Scenario, terrain: &dyn Terrain, settings: &Settings) -> Result<Outcome, PlanningError> {
+pub fn plan_on(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    settings: &Settings,
+) -> Result<Outcome, PlanningError> {
     if settings.backend != Backend::Ipm {
         return Err(PlanningError::Unavailable(settings.backend));
     }
@@ -175,25 +241,66 @@ pub fn plan_on(s: &Scenario, terrain: &dyn Terrain, settings: &Settings) -> Resu
             run(s, terrain, &f, &guess, settings, &mut phases, "crawl gait")?
         }
         Gait::Free => {
-            let choice = run(s, terrain, &Formulation::Complementarity, &guess, settings, &mut phases, "free gait: choose the steps")?;
-            if !choice.solution.status.is_success() {
-                choice
-            } else {
-                let f = Formulation::Scheduled(schedule_of(s, &choice.flat));
-                run(s, terrain, &f, &choice.flat, settings, &mut phases, "free gait: exact steps")?
+            // Two exact candidates, the better one wins: the crawl schedule, and the
+            // schedule chosen by the lifted complementarity problem.
+            let crawl = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
+            let crawl_run = run(
+                s,
+                terrain,
+                &crawl,
+                &guess,
+                settings,
+                &mut phases,
+                "free gait: crawl schedule",
+            )?;
+            let choice = run(
+                s,
+                terrain,
+                &Formulation::Complementarity,
+                &crawl_run.flat,
+                settings,
+                &mut phases,
+                "free gait: choose the steps",
+            )?;
+            let mut best = crawl_run;
+            if choice.solution.status.is_success() {
+                let schedule = schedule_of(s, &choice.flat);
+                let warm = scheduled_guess(s, terrain, &choice.flat, &schedule);
+                let exact = run(
+                    s,
+                    terrain,
+                    &Formulation::Scheduled(schedule),
+                    &warm,
+                    settings,
+                    &mut phases,
+                    "free gait: exact steps",
+                )?;
+                let better = exact.solution.status.is_success()
+                    && (!best.solution.status.is_success()
+                        || exact.solution.objective < best.solution.objective);
+                if better {
+                    best = exact;
+                }
             }
+            best
         }
     };
     let plan = Plan::from_flat(s, &last.flat)?;
     let solver = SolverInfo {
         name: "ipm".into(),
         status: status_name(last.solution.status).into(),
-        iterations: phases.iter().map(|p| p.records.len().saturating_sub(1)).sum(),
+        iterations: phases
+            .iter()
+            .map(|p| p.records.len().saturating_sub(1))
+            .sum(),
         objective: plan.cost(s),
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
     };
-    Ok(Outcome { file: SolutionFile::new(s.clone(), solver, plan), phases })
+    Ok(Outcome {
+        file: SolutionFile::new(s.clone(), solver, plan),
+        phases,
+    })
 }
 
 /// The status word written to the solution file (`solved` for success).

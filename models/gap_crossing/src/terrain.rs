@@ -52,7 +52,8 @@ impl Terrain for GapTerrain {
         if g.depth == 0.0 {
             return [Expr::zero(), Expr::zero()];
         }
-        let dx = smooth_step_slope(x, g.max, g.depth, g.steepness) - smooth_step_slope(x, g.min, g.depth, g.steepness);
+        let dx = smooth_step_slope(x, g.max, g.depth, g.steepness)
+            - smooth_step_slope(x, g.min, g.depth, g.steepness);
         [dx, Expr::zero()]
     }
     fn height_at(&self, x: f64, _y: f64) -> f64 {
@@ -82,7 +83,10 @@ impl Terrain for StepTerrain {
         self.rise * 0.5 + smooth_step(x, self.edge, self.rise, self.steepness)
     }
     fn gradient(&self, x: Expr, _y: Expr) -> [Expr; 2] {
-        [smooth_step_slope(x, self.edge, self.rise, self.steepness), Expr::zero()]
+        [
+            smooth_step_slope(x, self.edge, self.rise, self.steepness),
+            Expr::zero(),
+        ]
     }
     fn height_at(&self, x: f64, _y: f64) -> f64 {
         self.rise * (0.5 + (self.steepness * (x - self.edge)).atan() / PI)
@@ -105,7 +109,12 @@ mod tests {
         let gap = crate::scenario::Scenario::default().gap;
         let terrains: Vec<Box<dyn Terrain>> = vec![
             Box::new(GapTerrain { gap }),
-            Box::new(StepTerrain { edge: 1.0, rise: 0.2, steepness: 50.0, margin: 0.03 }),
+            Box::new(StepTerrain {
+                edge: 1.0,
+                rise: 0.2,
+                steepness: 50.0,
+                margin: 0.03,
+            }),
         ];
         let (x, y) = (Expr::sym("x"), Expr::sym("y"));
         for t in &terrains {
@@ -116,7 +125,11 @@ mod tests {
                 assert!((out[0] - t.height_at(px, 0.3)).abs() < 1e-12);
                 let d = 1e-6;
                 let fd = (t.height_at(px + d, 0.3) - t.height_at(px - d, 0.3)) / (2.0 * d);
-                assert!((out[1] - fd).abs() <= 1e-6 * (1.0 + fd.abs()), "slope at {px}: {} vs {fd}", out[1]);
+                assert!(
+                    (out[1] - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                    "slope at {px}: {} vs {fd}",
+                    out[1]
+                );
                 assert_eq!(out[2], 0.0);
             }
         }

@@ -139,21 +139,41 @@ fn check_errors_exit_2_with_the_reason() {
 }
 
 #[test]
-fn solve_and_sweep_are_not_implemented_yet() {
+fn solve_writes_a_plan_that_check_accepts() {
     let d = tmp("solve");
     let out_dir = d.join("out");
-    let out = run(&["solve", "--out", out_dir.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(2));
+    let out = run(&[
+        "solve",
+        "--gait",
+        "crawl",
+        "--set",
+        "n_step=12",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    for f in [
+        "solution.json",
+        "plan.svg",
+        "convergence.svg",
+        "convergence.json",
+    ] {
+        assert!(out_dir.join(f).exists(), "{f} missing");
+    }
     assert!(
-        text(&out.stderr).contains("not yet implemented"),
+        text(&out.stdout).contains("status:     solved"),
         "{}",
-        text(&out.stderr)
+        text(&out.stdout)
     );
-    assert!(!out_dir.exists(), "nothing is written");
-    // No subcommand = solve.
-    let out = run(&[]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("not yet implemented"));
+    // n_step 12 cannot reach the goals: the checker is told to skip that requirement.
+    let sol = out_dir.join("solution.json");
+    let out = run(&["check", sol.to_str().unwrap(), "--goal", "skip"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+}
+
+#[test]
+fn sweep_is_not_implemented_yet() {
+    let d = tmp("sweep");
     let grid = write(&d, "grid.json", &serde_json::json!({}));
     let out = run(&["sweep", "--grid", &grid]);
     assert_eq!(out.status.code(), Some(2));
