@@ -1,4 +1,165 @@
-use criterion::{criterion_group, criterion_main, Criterion};
-fn bench(_c: &mut Criterion) {}
+//! symx set-up and evaluation on the hanging chain with 1000 links (n = 2002, m = 1000),
+//! the same problem and quantities as benches/reference/symx_eval_casadi.py:
+//!
+//! * set-up: build f and g, ∇f (gradient), ∂g/∂w (sparse Jacobian), the lower triangle of
+//!   ∇²(σf + λᵀg) with σ and λ symbolic, and compile the three `Function`s; each phase is
+//!   timed in a fresh thread (a fresh expression graph, as a new program would have);
+//! * evaluation: one call of each compiled function at the initial guess with σ = 1,
+//!   λᵢ = (i+1)/N, into preallocated outputs and work vector.
+//!
+//! Run: `cargo bench --bench symx_eval` (about a minute). The value checksums printed first
+//! must match the CasADi script's `sum`/`norm2`.
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+use symx::{gradient, jacobian, lagrangian_hessian, Expr, Function, Matrix, SparseMatrix};
+
+#[path = "common/hanging_chain.rs"]
+mod hanging_chain;
+
+const LINKS: usize = 1000;
+
+struct Derivatives {
+    chain: hanging_chain::HangingChain,
+    grad: Vec<Expr>,
+    jac: SparseMatrix,
+    sigma: Expr,
+    lambda: Matrix,
+    hess: SparseMatrix,
+}
+
+fn differentiate(chain: hanging_chain::HangingChain) -> Derivatives {
+    let grad = gradient(chain.f, &chain.w).unwrap();
+    let jac = jacobian(&chain.g, &chain.w).unwrap();
+    let sigma = Expr::sym("sigma");
+    let lambda = Matrix::sym_vec("lambda", chain.g.len());
+    let hess = lagrangian_hessian(chain.f, &chain.g, &chain.w, sigma, &lambda).unwrap();
+    Derivatives {
+        chain,
+        grad,
+        jac,
+        sigma,
+        lambda,
+        hess,
+    }
+}
+
+struct Compiled {
+    grad: Function,
+    jac: Function,
+    hess: Function,
+}
+
+fn compile(d: &Derivatives) -> Compiled {
+    let w = &d.chain.w;
+    Compiled {
+        grad: Function::new(&[w], &[&d.grad]).unwrap(),
+        jac: Function::new(&[w], &[d.jac.values()]).unwrap(),
+        hess: Function::new(&[w, &[d.sigma], &d.lambda], &[d.hess.values()]).unwrap(),
+    }
+}
+
+/// Set-up phases, timed in a fresh thread: (expr, grad_f, jac_g, hess_L, functions).
+fn setup_phases() -> [Duration; 5] {
+    std::thread::spawn(|| {
+        let t0 = Instant::now();
+        let chain = hanging_chain::build(LINKS);
+        let t1 = Instant::now();
+        let grad = gradient(chain.f, &chain.w).unwrap();
+        let t2 = Instant::now();
+        let jac = jacobian(&chain.g, &chain.w).unwrap();
+        let t3 = Instant::now();
+        let sigma = Expr::sym("sigma");
+        let lambda = Matrix::sym_vec("lambda", chain.g.len());
+        let hess = lagrangian_hessian(chain.f, &chain.g, &chain.w, sigma, &lambda).unwrap();
+        let t4 = Instant::now();
+        let d = Derivatives {
+            chain,
+            grad,
+            jac,
+            sigma,
+            lambda,
+            hess,
+        };
+        black_box(compile(&d));
+        let t5 = Instant::now();
+        [t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4]
+    })
+    .join()
+    .unwrap()
+}
+
+fn inputs(links: usize, x0: &[f64]) -> (Vec<f64>, [f64; 1], Vec<f64>) {
+    let lambda = (0..links).map(|i| (i + 1) as f64 / links as f64).collect();
+    (x0.to_vec(), [1.0], lambda)
+}
+
+fn checksums(name: &str, f: &Function, ins: &[&[f64]]) {
+    let out = f.call(ins).unwrap().remove(0);
+    let sum: f64 = out.iter().sum();
+    let norm2 = out.iter().map(|v| v * v).sum::<f64>().sqrt();
+    eprintln!(
+        "{name:7} nnz {:5}  instructions {:6}  work {:6}  sum {sum:.16e}  norm2 {norm2:.16e}",
+        out.len(),
+        f.instruction_count(),
+        f.work_size()
+    );
+}
+
+fn bench(c: &mut Criterion) {
+    let d = differentiate(hanging_chain::build(LINKS));
+    let fns = compile(&d);
+    let (x, sigma, lambda) = inputs(LINKS, &d.chain.x0);
+    let hess_in: [&[f64]; 3] = [&x, &sigma, &lambda];
+    checksums("grad_f", &fns.grad, &[&x]);
+    checksums("jac_g", &fns.jac, &[&x]);
+    checksums("hess_L", &fns.hess, &hess_in);
+
+    let mut group = c.benchmark_group("symx_eval/setup");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(4))
+        .warm_up_time(Duration::from_secs(1));
+    let names = ["expr", "grad_f", "jac_g", "hess_L", "functions", "total"];
+    for (k, name) in names.iter().enumerate() {
+        group.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter_custom(|iters| {
+                (0..iters)
+                    .map(|_| {
+                        let p = setup_phases();
+                        if k < 5 {
+                            p[k]
+                        } else {
+                            p.iter().sum()
+                        }
+                    })
+                    .sum()
+            })
+        });
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("symx_eval/eval");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(3))
+        .warm_up_time(Duration::from_secs(1));
+    for (name, f, ins) in [
+        ("grad_f", &fns.grad, &hess_in[..1]),
+        ("jac_g", &fns.jac, &hess_in[..1]),
+        ("hess_L", &fns.hess, &hess_in[..]),
+    ] {
+        let mut out = vec![0.0; f.output_sizes()[0]];
+        let mut work = vec![0.0; f.work_size()];
+        group.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter(|| {
+                f.eval(black_box(ins), &mut [&mut out], &mut work).unwrap();
+                black_box(&out);
+            })
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(benches, bench);
 criterion_main!(benches);

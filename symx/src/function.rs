@@ -6,6 +6,18 @@
 //! CasADi's SX virtual machine does). Common subexpressions are already single nodes of
 //! the graph, so each is evaluated once. The compiled function owns no graph handles: it is
 //! `Send + Sync`, and evaluation writes only into the caller's work vector.
+//!
+//! The work vector is laid out as
+//! `[inputs | constants | outputs | temporaries]`:
+//! * the inputs are copied in with one `memcpy` per input vector (CasADi instead spends
+//!   one `OP_INPUT` instruction per entry);
+//! * constants and the constant entries of the outputs are one template copied in with one
+//!   `memcpy`;
+//! * each computed output entry is written by its operation straight into its output slot,
+//!   and the slots are copied out with one `memcpy` per output vector (no `OP_OUTPUT`
+//!   instructions);
+//! * only the operations themselves remain on the tape: one byte of opcode and register
+//!   numbers, dispatched by a single `match`.
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::graph::{self, Graph};
@@ -13,19 +25,11 @@ use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
 use rustc_hash::FxHashMap;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Code {
-    /// `w[d] = input[a][b]`
-    Load,
-    /// `output[a][b] = w[c]`
-    Store,
-    /// `w[d] = op(w[a], w[b], w[c])`
-    Calc(Op),
-}
-
+/// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
+/// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`.
 #[derive(Clone, Copy, Debug)]
 struct Instr {
-    code: Code,
+    op: Op,
     d: u32,
     a: u32,
     b: u32,
@@ -48,15 +52,18 @@ struct Instr {
 pub struct Function {
     input_sizes: Vec<usize>,
     output_sizes: Vec<usize>,
+    /// Register of entry 0 of each input (entries are consecutive).
+    input_offsets: Vec<usize>,
+    /// Whether any instruction or output reads input `k` (unread inputs are not copied).
+    input_used: Vec<bool>,
+    /// Register of entry 0 of each output.
+    output_offsets: Vec<usize>,
     tape: Vec<Instr>,
-    /// Values of registers `0..constants.len()`, written at the start of every evaluation.
-    constants: Vec<f64>,
+    /// Values of registers `template_start..template_start + template.len()`: the constants
+    /// followed by the output slots (constant entries hold their value, others 0).
+    template: Vec<f64>,
+    template_start: usize,
     work_size: usize,
-}
-
-enum Step {
-    Node(u32),
-    Store { output: u32, offset: u32, node: u32 },
 }
 
 impl Function {
@@ -203,44 +210,70 @@ impl Function {
         p: usize,
     ) {
         let w = work.as_mut_ptr();
-        std::ptr::copy_nonoverlapping(self.constants.as_ptr(), w, self.constants.len());
-        let r = |i: u32| *w.add(i as usize);
+        for (k, x) in inputs.iter().enumerate() {
+            if *self.input_used.get_unchecked(k) {
+                let n = *self.input_sizes.get_unchecked(k);
+                let at = *self.input_offsets.get_unchecked(k);
+                std::ptr::copy_nonoverlapping(x.as_ptr().add(p * n), w.add(at), n);
+            }
+        }
+        std::ptr::copy_nonoverlapping(
+            self.template.as_ptr(),
+            w.add(self.template_start),
+            self.template.len(),
+        );
         for ins in &self.tape {
-            let v = match ins.code {
-                Code::Load => {
-                    let (k, off) = (ins.a as usize, ins.b as usize);
-                    let n = *self.input_sizes.get_unchecked(k);
-                    *inputs.get_unchecked(k).get_unchecked(p * n + off)
-                }
-                Code::Store => {
-                    let (k, off) = (ins.a as usize, ins.b as usize);
-                    let n = *self.output_sizes.get_unchecked(k);
-                    *outputs.get_unchecked_mut(k).get_unchecked_mut(p * n + off) = r(ins.c);
-                    continue;
-                }
-                Code::Calc(o) => {
-                    let a = r(ins.a);
-                    match o {
-                        Op::Add => a + r(ins.b),
-                        Op::Sub => a - r(ins.b),
-                        Op::Mul => a * r(ins.b),
-                        Op::Div => a / r(ins.b),
-                        Op::Neg => -a,
-                        Op::Sq => a * a,
-                        Op::Sqrt => a.sqrt(),
-                        Op::Exp => a.exp(),
-                        Op::Log => a.ln(),
-                        Op::Sin => a.sin(),
-                        Op::Cos => a.cos(),
-                        Op::Pow => op::pow(a, r(ins.b)),
-                        Op::StrongMul => op::strong_mul(a, r(ins.b)),
-                        Op::IfElse => op::select(a, r(ins.b), r(ins.c)),
-                        o if o.arity() == 1 => o.eval1(a),
-                        o => o.eval2(a, r(ins.b)),
+            let a = *w.add(ins.a as usize);
+            let b = *w.add(ins.b as usize);
+            let v = match ins.op {
+                Op::Add => a + b,
+                Op::Sub => a - b,
+                Op::Mul => a * b,
+                Op::Div => a / b,
+                Op::Neg => -a,
+                Op::Sq => a * a,
+                Op::Sym => a,
+                Op::Sqrt => a.sqrt(),
+                Op::Exp => a.exp(),
+                Op::Log => a.ln(),
+                Op::Sin => a.sin(),
+                Op::Cos => a.cos(),
+                Op::Tan => a.tan(),
+                Op::Asin => a.asin(),
+                Op::Acos => a.acos(),
+                Op::Atan => a.atan(),
+                Op::Sinh => a.sinh(),
+                Op::Cosh => a.cosh(),
+                Op::Tanh => a.tanh(),
+                Op::Abs => a.abs(),
+                Op::Sign => op::sign(a),
+                Op::Not => f64::from(a == 0.0),
+                Op::Pow => op::pow(a, b),
+                Op::Atan2 => a.atan2(b),
+                Op::Min => a.min(b),
+                Op::Max => a.max(b),
+                Op::Lt => f64::from(a < b),
+                Op::Le => f64::from(a <= b),
+                Op::Eq => f64::from(a == b),
+                Op::Ne => f64::from(a != b),
+                Op::And => f64::from(a != 0.0 && b != 0.0),
+                Op::Or => f64::from(a != 0.0 || b != 0.0),
+                Op::StrongMul => op::strong_mul(a, b),
+                Op::IfElse => {
+                    if a != 0.0 {
+                        b
+                    } else {
+                        *w.add(ins.c as usize)
                     }
                 }
+                Op::Const => std::hint::unreachable_unchecked(),
             };
             *w.add(ins.d as usize) = v;
+        }
+        for (k, y) in outputs.iter_mut().enumerate() {
+            let n = *self.output_sizes.get_unchecked(k);
+            let at = *self.output_offsets.get_unchecked(k);
+            std::ptr::copy_nonoverlapping(w.add(at), y.as_mut_ptr().add(p * n), n);
         }
     }
 
@@ -265,216 +298,217 @@ impl Function {
             });
         }
         let ncols = self.input_sizes[input];
+        let first = self.input_offsets[input];
+        let (out_first, nrows) = (self.output_offsets[output], self.output_sizes[output]);
         let mut bits = vec![0u64; self.work_size];
         let mut entries = Vec::new();
         for block in (0..ncols).step_by(64) {
             bits.iter_mut().for_each(|b| *b = 0);
+            for j in block..ncols.min(block + 64) {
+                bits[first + j] = 1u64 << (j - block);
+            }
             for ins in &self.tape {
-                let v = match ins.code {
-                    Code::Load => {
-                        let off = ins.b as usize;
-                        if ins.a as usize == input && off >= block && off < block + 64 {
-                            1u64 << (off - block)
-                        } else {
-                            0
-                        }
-                    }
-                    Code::Store => {
-                        if ins.a as usize == output {
-                            let mut m = bits[ins.c as usize];
-                            while m != 0 {
-                                let t = m.trailing_zeros() as usize;
-                                entries.push((ins.b as usize, block + t));
-                                m &= m - 1;
-                            }
-                        }
-                        continue;
-                    }
-                    Code::Calc(o) if o.has_zero_derivative() => 0,
-                    Code::Calc(Op::IfElse) => bits[ins.b as usize] | bits[ins.c as usize],
-                    Code::Calc(o) => {
-                        let mut m = bits[ins.a as usize];
-                        if o.arity() > 1 {
-                            m |= bits[ins.b as usize];
-                        }
-                        m
-                    }
+                bits[ins.d as usize] = match ins.op {
+                    o if o.has_zero_derivative() => 0,
+                    Op::IfElse => bits[ins.b as usize] | bits[ins.c as usize],
+                    _ => bits[ins.a as usize] | bits[ins.b as usize],
                 };
-                bits[ins.d as usize] = v;
+            }
+            for i in 0..nrows {
+                let mut m = bits[out_first + i];
+                while m != 0 {
+                    entries.push((i, block + m.trailing_zeros() as usize));
+                    m &= m - 1;
+                }
             }
         }
-        Ok(pattern_from_entries(
-            self.output_sizes[output],
-            ncols,
-            entries,
-        ))
+        Ok(pattern_from_entries(nrows, ncols, entries))
     }
 }
 
 fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Function, SymxError> {
     // Per-node scratch indexed by node id. Zero-initialised vectors are allocated lazily
     // by the OS, so a small function in a large graph only touches the pages of its cone.
-    // `seen[id]`: 0 = not visited, else 1 + the node's position in `order`.
-    let n = g.len();
-    let mut seen = vec![0u32; n];
-
-    // Where each input symbol is read from.
-    let mut source: FxHashMap<u32, (u32, u32)> = FxHashMap::default();
-    for (k, x) in inputs.iter().enumerate() {
-        for (off, e) in x.iter().enumerate() {
-            source.insert(e.id, (k as u32, off as u32));
-        }
+    // `seen[id]`: 0 = not visited, else 1 + the node's local index.
+    let mut seen = vec![0u32; g.len()];
+    let mut register: Vec<u32> = Vec::new();
+    fn visit(seen: &mut [u32], id: u32, reg: u32, register: &mut Vec<u32>) {
+        register.push(reg);
+        seen[id as usize] = register.len() as u32;
     }
 
-    // Constants get the first registers (their values are copied in before every run).
-    let mut constants = Vec::new();
+    // Inputs occupy the first registers.
+    let input_sizes: Vec<usize> = inputs.iter().map(|x| x.len()).collect();
+    let output_sizes: Vec<usize> = outputs.iter().map(|y| y.len()).collect();
+    let mut input_offsets = Vec::with_capacity(inputs.len());
+    let mut input_of: FxHashMap<u32, usize> = FxHashMap::default();
+    let mut next = 0usize;
+    for (k, x) in inputs.iter().enumerate() {
+        input_offsets.push(next);
+        for e in x.iter() {
+            input_of.insert(e.id, k);
+            visit(&mut seen, e.id, next as u32, &mut register);
+            next += 1;
+        }
+    }
+    let mut input_used = vec![false; inputs.len()];
 
-    // Depth-first post-order from each output entry; stores follow their node.
-    let mut steps: Vec<Step> = Vec::new();
+    // Depth-first post-order of the computed nodes; constants are collected on the way.
+    let mut constants: Vec<f64> = Vec::new();
+    let mut const_ids: Vec<u32> = Vec::new();
+    let mut steps: Vec<u32> = Vec::new();
     let mut stack: Vec<(u32, u8)> = Vec::new();
-    // Register of each visited node (constants: their constant slot).
-    let mut register: Vec<u32> = Vec::new();
+    let is_seen = |seen: &[u32], id: u32| seen[id as usize] != 0;
     for (k, y) in outputs.iter().enumerate() {
-        for (off, e) in y.iter().enumerate() {
-            if seen[e.id as usize] == 0 {
-                stack.push((e.id, 0));
-            }
-            while let Some(&mut (id, ref mut next)) = stack.last_mut() {
+        for e in y.iter() {
+            stack.push((e.id, 0));
+            while let Some(&mut (id, ref mut child)) = stack.last_mut() {
                 let node = g.node(id);
-                if *next == 0 {
-                    if seen[id as usize] != 0 {
+                if *child == 0 {
+                    if is_seen(&seen, id) {
                         stack.pop();
                         continue;
                     }
                     match node.op {
                         Op::Const => {
-                            register.push(constants.len() as u32);
-                            seen[id as usize] = register.len() as u32;
+                            const_ids.push(id);
                             constants.push(node.value().unwrap_or(f64::NAN));
+                            visit(&mut seen, id, u32::MAX, &mut register);
                             stack.pop();
                             continue;
                         }
-                        Op::Sym if !source.contains_key(&id) => {
+                        Op::Sym => {
                             return Err(SymxError::FreeSymbol {
                                 output: k,
                                 name: g.symbol_name(id).to_string(),
-                            });
+                            })
                         }
                         _ => {}
                     }
                 }
                 let operands = node.operands();
-                if (*next as usize) < operands.len() {
-                    let child = operands[*next as usize];
-                    *next += 1;
-                    if seen[child as usize] == 0 {
-                        stack.push((child, 0));
+                if (*child as usize) < operands.len() {
+                    let c = operands[*child as usize];
+                    *child += 1;
+                    if !is_seen(&seen, c) {
+                        stack.push((c, 0));
                     }
                 } else {
-                    register.push(u32::MAX);
-                    seen[id as usize] = register.len() as u32;
-                    steps.push(Step::Node(id));
+                    visit(&mut seen, id, u32::MAX, &mut register);
+                    steps.push(id);
                     stack.pop();
                 }
             }
-            steps.push(Step::Store {
-                output: k as u32,
-                offset: off as u32,
-                node: e.id,
-            });
         }
     }
-    // Dense local index of each visited node.
     let local = |id: u32| seen[id as usize] as usize - 1;
 
-    // Last step that reads each node (by local index).
-    let mut last_use: Vec<usize> = vec![usize::MAX; register.len()];
-    for (s, step) in steps.iter().enumerate() {
-        match *step {
-            Step::Node(id) => {
-                for &a in g.node(id).operands() {
-                    last_use[local(a)] = s;
+    // Constants, then output slots.
+    let template_start = next;
+    for (c, &id) in const_ids.iter().enumerate() {
+        register[local(id)] = (template_start + c) as u32;
+    }
+    let outputs_start = template_start + constants.len();
+    let mut template = constants;
+    let mut output_offsets = Vec::with_capacity(outputs.len());
+    let mut copies: Vec<Instr> = Vec::new();
+    let mut pinned = vec![false; register.len()];
+    let mut slot = outputs_start;
+    for y in outputs {
+        output_offsets.push(slot);
+        for e in y.iter() {
+            let l = local(e.id);
+            let node = g.node(e.id);
+            if let Some(v) = node.value() {
+                template.push(v);
+            } else if node.op != Op::Sym && !pinned[l] {
+                // The operation computing this entry writes its output slot directly.
+                pinned[l] = true;
+                register[l] = slot as u32;
+                template.push(0.0);
+            } else {
+                // An input, or a node already written to another slot: copy at the end.
+                template.push(0.0);
+                if node.op == Op::Sym {
+                    input_used[input_of[&e.id]] = true;
                 }
+                copies.push(Instr {
+                    op: Op::Sym,
+                    d: slot as u32,
+                    a: e.id, // resolved to a register below
+                    b: 0,
+                    c: 0,
+                });
             }
-            Step::Store { node, .. } => {
-                last_use[local(node)] = s;
+            slot += 1;
+        }
+    }
+
+    // Last step reading each node (by local index).
+    let mut last_use: Vec<usize> = vec![usize::MAX; register.len()];
+    for (s, &id) in steps.iter().enumerate() {
+        for &a in g.node(id).operands() {
+            last_use[local(a)] = s;
+            if g.node(a).op == Op::Sym {
+                input_used[input_of[&a]] = true;
             }
         }
     }
 
-    // Register allocation with reuse after last use.
-    let n_const = constants.len() as u32;
+    // Temporaries: allocated after the output slots, reused after their last use.
+    let temp_start = slot as u32;
     let mut free: Vec<u32> = Vec::new();
-    let mut work_size = n_const;
-    let mut tape = Vec::with_capacity(steps.len());
-    for (s, step) in steps.iter().enumerate() {
-        match *step {
-            Step::Node(id) => {
-                let node = g.node(id);
-                let args = node.args;
-                let arity = node.op.arity();
-                let mut regs = [0u32; 3];
-                for k in 0..arity {
-                    regs[k] = register[local(args[k])];
-                }
-                // Operands whose last use is here free their registers first, so the
-                // result may take one of them (operands are read before the write).
-                for k in 0..arity {
-                    let l = local(args[k]);
-                    if last_use[l] == s && regs[k] >= n_const && !regs[..k].contains(&regs[k]) {
-                        free.push(regs[k]);
-                    }
-                }
-                let d = free.pop().unwrap_or_else(|| {
-                    work_size += 1;
-                    work_size - 1
-                });
-                register[local(id)] = d;
-                let ins = if node.op == Op::Sym {
-                    let (k, off) = source[&id];
-                    Instr {
-                        code: Code::Load,
-                        d,
-                        a: k,
-                        b: off,
-                        c: 0,
-                    }
-                } else {
-                    Instr {
-                        code: Code::Calc(node.op),
-                        d,
-                        a: regs[0],
-                        b: regs[1],
-                        c: regs[2],
-                    }
-                };
-                tape.push(ins);
-            }
-            Step::Store {
-                output,
-                offset,
-                node,
-            } => {
-                let l = local(node);
-                let c = register[l];
-                tape.push(Instr {
-                    code: Code::Store,
-                    d: 0,
-                    a: output,
-                    b: offset,
-                    c,
-                });
-                if last_use[l] == s && c >= n_const {
-                    free.push(c);
-                }
+    let mut work_size = temp_start;
+    let mut tape = Vec::with_capacity(steps.len() + copies.len());
+    for (s, &id) in steps.iter().enumerate() {
+        let node = g.node(id);
+        let arity = node.op.arity();
+        let mut regs = [0u32; 3];
+        for k in 0..arity {
+            regs[k] = register[local(node.args[k])];
+        }
+        // Operands whose last use is here free their registers first, so the result may
+        // take one of them (operands are read before the write).
+        for k in 0..arity {
+            let l = local(node.args[k]);
+            if last_use[l] == s && regs[k] >= temp_start && !regs[..k].contains(&regs[k]) {
+                free.push(regs[k]);
             }
         }
+        let l = local(id);
+        let d = if pinned[l] {
+            register[l]
+        } else {
+            let d = free.pop().unwrap_or_else(|| {
+                work_size += 1;
+                work_size - 1
+            });
+            register[l] = d;
+            d
+        };
+        tape.push(Instr {
+            op: node.op,
+            d,
+            a: regs[0],
+            b: if arity >= 2 { regs[1] } else { regs[0] },
+            c: if arity == 3 { regs[2] } else { regs[0] },
+        });
+    }
+    for mut copy in copies {
+        let r = register[local(copy.a)];
+        // All operand fields name the source, so that readers of `b` see it too.
+        (copy.a, copy.b, copy.c) = (r, r, r);
+        tape.push(copy);
     }
     Ok(Function {
-        input_sizes: inputs.iter().map(|x| x.len()).collect(),
-        output_sizes: outputs.iter().map(|y| y.len()).collect(),
+        input_sizes,
+        output_sizes,
+        input_offsets,
+        input_used,
+        output_offsets,
         tape,
-        constants,
+        template,
+        template_start,
         work_size: work_size as usize,
     })
 }

@@ -225,13 +225,3 @@ pub fn pow(a: f64, b: f64) -> f64 {
         a.powf(b)
     }
 }
-
-/// `if_else` on numbers.
-#[inline(always)]
-pub fn select(c: f64, a: f64, b: f64) -> f64 {
-    if c != 0.0 {
-        a
-    } else {
-        b
-    }
-}
