@@ -1,7 +1,6 @@
-//! symnlp: write nonlinear programs symbolically and solve them.
+#![doc = include_str!("../README.md")]
 //!
-//! This crate re-exports the two building blocks:
-//! - [`symx`]: the expression graph, automatic differentiation, sparsity and compiled evaluators;
-//! - [`nlp`]: the problem builder and the solvers.
+//! This crate re-exports the two building blocks: [`symx`] (expressions, derivatives,
+//! sparsity, compiled functions) and [`nlp`] (problem builder and solvers).
 pub use nlp;
 pub use symx;
