@@ -14,6 +14,7 @@
 //! - [`render`]: hand-written SVG plots of a plan and of solver convergence.
 
 pub mod check;
+pub mod export;
 pub mod gait;
 pub mod model;
 pub mod plan;
