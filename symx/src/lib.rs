@@ -39,3 +39,8 @@ pub use graph::node_count;
 pub use matrix::{Matrix, SparseMatrix};
 pub use op::Op;
 pub use sparsity::Sparsity;
+
+/// The guide `docs/dsl.md`, compiled and run as doc tests so that its examples stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/dsl.md")]
+pub struct DslGuide;
