@@ -97,12 +97,14 @@ impl Function {
         &self.output_sizes
     }
 
-    /// Length of the work vector [`Function::eval`] needs.
+    /// Length of the work vector [`Function::eval`] needs: the inputs, the constants, the
+    /// outputs and the temporaries (reused by liveness).
     pub fn work_size(&self) -> usize {
         self.work_size
     }
 
-    /// Number of tape instructions (loads, operations and stores).
+    /// Number of tape instructions: one per operation, plus one copy per output entry that
+    /// is an input or repeats another entry (inputs, constants and outputs move in bulk).
     pub fn instruction_count(&self) -> usize {
         self.tape.len()
     }
