@@ -190,6 +190,12 @@ pub struct IpmOptions {
     /// LDLᵀ needs a non-zero (2,2) block); iterative refinement removes its effect on the
     /// step. Default 1e-8.
     pub kkt_static_regularization: f64,
+    /// Static regularisation always added to the Hessian block (faer's unpivoted LDLᵀ
+    /// meets an exact zero pivot where the Hessian of the Lagrangian is singular, e.g. a
+    /// variable that enters linearly, although the KKT matrix is not); iterative
+    /// refinement removes its effect on the step, so the step is IPOPT's exact Newton
+    /// step with δ_w = 0. 0 disables it. Default 1e-8.
+    pub kkt_static_hessian_regularization: f64,
     /// Minimum iterative-refinement steps. Default 1.
     pub min_refinement_steps: usize,
     /// Maximum iterative-refinement steps. Default 10.
@@ -286,6 +292,7 @@ impl Default for IpmOptions {
             jacobian_regularization_value: 1e-8,
             jacobian_regularization_exponent: 0.25,
             kkt_static_regularization: 1e-8,
+            kkt_static_hessian_regularization: 1e-8,
             min_refinement_steps: 1,
             max_refinement_steps: 10,
             residual_ratio_max: 1e-10,
@@ -383,6 +390,7 @@ impl IpmOptions {
             kappa_d,
             jacobian_regularization_value,
             jacobian_regularization_exponent,
+            kkt_static_hessian_regularization,
             resto_proximity_weight
         );
         open_unit!(

@@ -126,7 +126,10 @@ pub(crate) struct Core<'p> {
     kdc: Vec<f64>,
     rhs: Vec<f64>,
     rhs_s: Vec<f64>,
+    rhs_copy: Vec<f64>,
     ds: Vec<f64>,
+    /// The static regularisations in the last factorised matrix, with the sign that
+    /// removes them in iterative refinement (set by `factor_kkt`).
     shift: Vec<f64>,
     hzero: Vec<f64>,
     work_nw: Vec<f64>,
@@ -139,6 +142,8 @@ pub(crate) struct Core<'p> {
     delta_w: f64,
     delta_w_last: f64,
     delta_c: f64,
+    jac_degenerate: bool,
+    singular_iters: usize,
     free_mode: bool,
     kkt_refs: Vec<f64>,
     tiny_count: usize,
@@ -254,12 +259,7 @@ impl<'p> Core<'p> {
         kkt.max_refinement_steps = opts.max_refinement_steps;
         kkt.residual_ratio_max = opts.residual_ratio_max;
         // Refinement target: K without the static regularisation of equality rows.
-        let mut shift = vec![0.0; n + m];
-        for i in 0..m {
-            if slack_of_row[i] == usize::MAX {
-                shift[n + i] = opts.kkt_static_regularization;
-            }
-        }
+        let shift = vec![0.0; n + m];
         Ok(Core {
             nlp,
             opts: opts.clone(),
@@ -306,6 +306,7 @@ impl<'p> Core<'p> {
             kdc: vec![0.0; m],
             rhs: vec![0.0; n + m],
             rhs_s: vec![0.0; ni],
+            rhs_copy: vec![0.0; n + m],
             ds: vec![0.0; ni],
             shift,
             hzero: vec![0.0; nnz_h],
@@ -318,6 +319,8 @@ impl<'p> Core<'p> {
             delta_w: 0.0,
             delta_w_last: 0.0,
             delta_c: 0.0,
+            jac_degenerate: false,
+            singular_iters: 0,
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
             kkt_refs: Vec::new(),
             tiny_count: 0,
@@ -579,7 +582,8 @@ impl<'p> Core<'p> {
         if m == 0 {
             return;
         }
-        self.kdx.iter_mut().for_each(|v| *v = 1.0);
+        let xreg = self.opts.kkt_static_hessian_regularization;
+        self.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
         let reg = self.opts.kkt_static_regularization;
         for i in 0..m {
             self.kdc[i] = if self.slack_of_row[i] == usize::MAX {
@@ -602,10 +606,64 @@ impl<'p> Core<'p> {
                 self.zl[n + k] - self.zu[n + k]
             };
         }
-        let ok = self
-            .kkt
-            .factorize(&self.hzero, &self.kdx, &self.jac, &self.kdc)
-            .is_ok()
+        // IPOPT computes these multipliers with an unregularised factorisation and sets
+        // them to zero when the linear solver reports the system singular (a
+        // rank-deficient Jacobian of the equality rows). The static regularisation δ_s
+        // hides that singularity from faer, so detect it from the determinant instead:
+        // det K(δ) = det(−δI − J Jᵀ) on the equality rows, and multiplying δ by 10 multiplies
+        // |det K| by about 10 per (numerically) zero singular value of J.
+        let n_eq = self
+            .slack_of_row
+            .iter()
+            .filter(|&&k| k == usize::MAX)
+            .count();
+        let mut singular = false;
+        if n_eq > 0 && reg > 0.0 {
+            for i in 0..m {
+                if self.slack_of_row[i] == usize::MAX {
+                    self.kdc[i] = 10.0 * reg;
+                }
+            }
+            if self
+                .kkt
+                .factorize(&self.hzero, &self.kdx, &self.jac, &self.kdc)
+                .is_ok()
+            {
+                let ld10 = self.kkt.log_abs_det();
+                for i in 0..m {
+                    if self.slack_of_row[i] == usize::MAX {
+                        self.kdc[i] = reg;
+                    }
+                }
+                if self
+                    .kkt
+                    .factorize(&self.hzero, &self.kdx, &self.jac, &self.kdc)
+                    .is_ok()
+                {
+                    singular = (ld10 - self.kkt.log_abs_det()) / std::f64::consts::LN_10 > 0.5;
+                }
+            }
+            for i in 0..m {
+                if self.slack_of_row[i] == usize::MAX {
+                    self.kdc[i] = reg;
+                }
+            }
+        }
+        for j in 0..n {
+            self.shift[j] = -xreg;
+        }
+        for i in 0..m {
+            self.shift[n + i] = if self.slack_of_row[i] == usize::MAX {
+                reg
+            } else {
+                0.0
+            };
+        }
+        let ok = !singular
+            && self
+                .kkt
+                .factorize(&self.hzero, &self.kdx, &self.jac, &self.kdc)
+                .is_ok()
             && self
                 .kkt
                 .solve_shifted(&mut self.rhs, Some(&self.shift))
@@ -766,54 +824,114 @@ impl<'p> Core<'p> {
 
     // ------------------------------------------------------------------ linear algebra
 
+    /// Assembles the KKT matrix for the current iterate with Hessian perturbation
+    /// `delta_w` and Jacobian perturbation `self.delta_c` (the static regularisation
+    /// `kkt_static_regularization` on equality rows when δ_c = 0) and factorises it.
+    fn factor_kkt(
+        &mut self,
+        shared: &mut Shared,
+        delta_w: f64,
+    ) -> Result<crate::kkt::Inertia, crate::kkt::KktError> {
+        let (n, m) = (self.n, self.m);
+        let eq_reg = if self.delta_c > 0.0 {
+            self.delta_c
+        } else {
+            self.opts.kkt_static_regularization
+        };
+        // The static Hessian regularisation only keeps exact zero pivots away while
+        // δ_w = 0; a real δ_w > 0 does that itself.
+        let x_reg = if delta_w == 0.0 {
+            self.opts.kkt_static_hessian_regularization
+        } else {
+            0.0
+        };
+        self.shift[..n].fill(-x_reg);
+        for i in 0..m {
+            self.shift[n + i] = if self.slack_of_row[i] == usize::MAX && self.delta_c == 0.0 {
+                eq_reg
+            } else {
+                0.0
+            };
+        }
+        for j in 0..n {
+            let mut sig = 0.0;
+            if self.has_l[j] {
+                sig += self.zl[j] / (self.w[j] - self.wl[j]);
+            }
+            if self.has_u[j] {
+                sig += self.zu[j] / (self.wu[j] - self.w[j]);
+            }
+            self.kdx[j] = sig + delta_w + x_reg;
+        }
+        for k in 0..self.ni {
+            let j = n + k;
+            let mut sig = 0.0;
+            if self.has_l[j] {
+                sig += self.zl[j] / (self.w[j] - self.wl[j]);
+            }
+            if self.has_u[j] {
+                sig += self.zu[j] / (self.wu[j] - self.w[j]);
+            }
+            self.ds[k] = (sig + delta_w).max(1e-300);
+        }
+        for i in 0..m {
+            let k = self.slack_of_row[i];
+            // Equality rows carry δ_c, or the static regularisation that faer's
+            // unpivoted LDLᵀ needs (removed again by iterative refinement); inequality
+            // rows already carry 1/(Σ_s + δ_w) > 0 from the eliminated slack, plus δ_c.
+            self.kdc[i] = if k == usize::MAX {
+                eq_reg
+            } else {
+                self.delta_c + 1.0 / self.ds[k]
+            };
+        }
+        let t = Instant::now();
+        let res = self
+            .kkt
+            .factorize(&self.hess, &self.kdx, &self.jac, &self.kdc);
+        shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+        shared.stats.n_factorizations += 1;
+        res
+    }
+
+    /// δ_c = jacobian_regularization_value · μ^jacobian_regularization_exponent.
+    fn delta_cd(&self) -> f64 {
+        self.opts.jacobian_regularization_value
+            * self.mu.powf(self.opts.jacobian_regularization_exponent)
+    }
+
+    /// IPOPT's next trial δ_w: the first one is `first_hessian_perturbation`, or
+    /// κ_w⁻·δ_w_last when an earlier iteration needed one; then ×κ_w⁺ (×κ̄_w⁺ while no
+    /// earlier iteration needed one).
+    fn next_delta_w(&self, delta_w: f64) -> f64 {
+        let o = &self.opts;
+        if delta_w == 0.0 {
+            if self.delta_w_last == 0.0 {
+                o.first_hessian_perturbation
+            } else {
+                o.min_hessian_perturbation
+                    .max(o.perturb_dec_fact * self.delta_w_last)
+            }
+        } else if self.delta_w_last == 0.0 {
+            delta_w * o.perturb_inc_fact_first
+        } else {
+            delta_w * o.perturb_inc_fact
+        }
+    }
+
     /// Factorises the KKT matrix with IPOPT's inertia correction. Returns false if δ_w
     /// exceeded its maximum.
     fn factorize_with_inertia_correction(&mut self, shared: &mut Shared) -> bool {
         let (n, m) = (self.n, self.m);
-        let o = &self.opts;
-        let static_reg = o.kkt_static_regularization;
         let mut delta_w = 0.0;
-        self.delta_c = 0.0;
-        let mut tried_delta_c = false;
+        self.delta_c = if self.jac_degenerate && m > 0 {
+            self.delta_cd()
+        } else {
+            0.0
+        };
+        let mut tried_delta_c = self.delta_c > 0.0;
         loop {
-            for j in 0..n {
-                let mut sig = 0.0;
-                if self.has_l[j] {
-                    sig += self.zl[j] / (self.w[j] - self.wl[j]);
-                }
-                if self.has_u[j] {
-                    sig += self.zu[j] / (self.wu[j] - self.w[j]);
-                }
-                self.kdx[j] = sig + delta_w;
-            }
-            for k in 0..self.ni {
-                let j = n + k;
-                let mut sig = 0.0;
-                if self.has_l[j] {
-                    sig += self.zl[j] / (self.w[j] - self.wl[j]);
-                }
-                if self.has_u[j] {
-                    sig += self.zu[j] / (self.wu[j] - self.w[j]);
-                }
-                self.ds[k] = (sig + delta_w).max(1e-300);
-            }
-            for i in 0..m {
-                let k = self.slack_of_row[i];
-                // The static regularisation is only needed on equality rows: inequality
-                // rows already carry 1/(Σ_s + δ_w) > 0 from the eliminated slack.
-                self.kdc[i] = self.delta_c
-                    + if k == usize::MAX {
-                        static_reg
-                    } else {
-                        1.0 / self.ds[k]
-                    };
-            }
-            let t = Instant::now();
-            let res = self
-                .kkt
-                .factorize(&self.hess, &self.kdx, &self.jac, &self.kdc);
-            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
-            shared.stats.n_factorizations += 1;
+            let res = self.factor_kkt(shared, delta_w);
             let singular = match res {
                 Ok(inertia) => {
                     if inertia.positive == n && inertia.negative == m && inertia.zero == 0 {
@@ -827,26 +945,15 @@ impl<'p> Core<'p> {
                 }
                 Err(_) => true,
             };
+            let o = &self.opts;
             if singular && !tried_delta_c && m > 0 {
                 tried_delta_c = true;
-                self.delta_c = o.jacobian_regularization_value
-                    * self.mu.powf(o.jacobian_regularization_exponent);
+                self.delta_c = self.delta_cd();
                 if self.delta_c > 0.0 {
                     continue;
                 }
             }
-            if delta_w == 0.0 {
-                delta_w = if self.delta_w_last == 0.0 {
-                    o.first_hessian_perturbation
-                } else {
-                    o.min_hessian_perturbation
-                        .max(o.perturb_dec_fact * self.delta_w_last)
-                };
-            } else if self.delta_w_last == 0.0 {
-                delta_w *= o.perturb_inc_fact_first;
-            } else {
-                delta_w *= o.perturb_inc_fact;
-            }
+            delta_w = self.next_delta_w(delta_w);
             if delta_w > o.max_hessian_perturbation {
                 self.delta_w = delta_w;
                 return false;
@@ -896,8 +1003,60 @@ impl<'p> Core<'p> {
         }
         // Refine against the system without the static regularisation.
         let t = Instant::now();
-        let res = self.kkt.solve_shifted(&mut self.rhs, Some(&self.shift));
-        shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+        self.rhs_copy.copy_from_slice(&self.rhs);
+        let mut res = self.kkt.solve_shifted(&mut self.rhs, Some(&self.shift));
+        if self.delta_c == 0.0 && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
+            // The system without the static regularisation is (numerically) singular:
+            // a rank-deficient Jacobian of the equality rows with inconsistent
+            // linearised constraints. Take IPOPT's regularised step: refactorise with
+            // δ_c = 1e-8·μ^¼ and solve that system. After three such iterations in a
+            // row, δ_c is applied from the start (IPOPT's "Jacobian degenerate").
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            self.singular_iters += 1;
+            if self.singular_iters >= 3 {
+                self.jac_degenerate = true;
+            }
+            self.delta_c = self.delta_cd();
+            let dw = self.delta_w;
+            let ok = matches!(self.factor_kkt(shared, dw),
+                Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
+            if !ok {
+                // Should not happen (δ_c does not change the inertia); fall back to
+                // the statically regularised system as it is.
+                self.delta_c = 0.0;
+                if self.factor_kkt(shared, dw).is_err() {
+                    return false;
+                }
+            }
+            let t = Instant::now();
+            self.rhs.copy_from_slice(&self.rhs_copy);
+            res = self.kkt.solve_shifted(&mut self.rhs, Some(&self.shift));
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            let mut dw = self.delta_w;
+            while ok && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
+                // Still singular (singular reduced Hessian): IPOPT increases δ_w.
+                dw = self.next_delta_w(dw);
+                if dw > self.opts.max_hessian_perturbation {
+                    return false;
+                }
+                match self.factor_kkt(shared, dw) {
+                    Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
+                    Ok(_) => continue,
+                    Err(_) => continue,
+                }
+                self.delta_w = dw;
+                self.delta_w_last = dw;
+                let t = Instant::now();
+                self.rhs.copy_from_slice(&self.rhs_copy);
+                res = self.kkt.solve_shifted(&mut self.rhs, Some(&self.shift));
+                shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            }
+        } else {
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            if self.delta_c == 0.0 && !soc {
+                self.singular_iters = 0;
+            }
+        }
         if res.is_err() {
             return false;
         }
