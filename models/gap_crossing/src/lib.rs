@@ -21,5 +21,6 @@ pub mod plan;
 pub mod render;
 pub mod scenario;
 pub mod solve;
+pub mod sweep;
 
 pub mod terrain;

@@ -1,7 +1,8 @@
 //! `gap_crossing`: the quadruped gap-crossing planner's command line.
 //!
-//! Exit codes: 0 success; 1 `check` found violations; 2 any error (bad arguments, bad
-//! files, invalid scenario, not yet implemented). Errors go to stderr.
+//! Exit codes: 0 success; 1 `solve` found no valid plan, `check` found violations, or
+//! some `sweep` point was not solved and checked; 2 any error (bad arguments, bad files,
+//! invalid scenario or grid). Errors go to stderr.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use gap_crossing::check::{self, GoalCheck, Options};
@@ -10,6 +11,7 @@ use gap_crossing::plan::{write_atomic, PlanError, SolutionFile, SolverInfo};
 use gap_crossing::render::{self, IterRecord};
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
+use gap_crossing::sweep::{self, Grid, GridError, PointResult};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -87,9 +89,19 @@ struct RenderArgs {
 
 #[derive(Args, Debug)]
 struct SweepArgs {
-    /// Grid file describing the scenarios to solve.
+    /// Grid file (.toml or .json): an optional `base` scenario and `axes`, lists of values
+    /// for dotted scenario keys, e.g. `gap.min = [2.0, 2.25, 2.5]`.
     #[arg(long, value_name = "FILE")]
     grid: PathBuf,
+    /// Output directory; writes sweep.csv, sweep.json and sweep.svg.
+    #[arg(long, value_name = "DIR", default_value = "out/sweep")]
+    out: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// Also write each point's solution file as DIR/points/NNNN.json (solved or not).
+    #[arg(long)]
+    solutions: bool,
 }
 
 #[derive(Args, Debug)]
@@ -149,8 +161,10 @@ enum CliError {
     },
     #[error(transparent)]
     Planning(#[from] PlanningError),
-    #[error("{0}: not yet implemented")]
-    NotImplemented(&'static str),
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    #[error("cannot start {0} worker threads: {1}")]
+    Threads(usize, String),
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
@@ -289,8 +303,113 @@ fn foot_moves(p: &gap_crossing::plan::Plan) -> String {
 }
 
 fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
-    std::fs::metadata(&a.grid).map_err(io(&a.grid))?;
-    Err(CliError::NotImplemented("sweep"))
+    let grid = Grid::load(&a.grid)?;
+    let threads = a.threads.unwrap_or_else(rayon::current_num_threads).max(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CliError::Threads(threads, e.to_string()))?;
+    let n = grid.len();
+    let points_dir = a.out.join("points");
+    if a.solutions {
+        std::fs::create_dir_all(&points_dir).map_err(io(&points_dir))?;
+    }
+    let axes: Vec<&str> = grid.axes.iter().map(|ax| ax.key.as_str()).collect();
+    eprintln!(
+        "sweep: {n} points ({}) on {threads} threads",
+        if axes.is_empty() {
+            "no axes: the base scenario".to_string()
+        } else {
+            axes.join(" × ")
+        }
+    );
+    // Drawn on stderr; indicatif hides it when stderr is not a terminal.
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} points, {elapsed} elapsed, ~{eta} left  {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let failed = std::sync::atomic::AtomicUsize::new(0);
+    let save_errors = std::sync::Mutex::new(Vec::<String>::new());
+    let started = std::time::Instant::now();
+    let done = |r: &PointResult, file: Option<&SolutionFile>| {
+        if !r.ok() {
+            let f = failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            bar.set_message(format!("{f} failed"));
+        }
+        if let (true, Some(file)) = (a.solutions, file) {
+            let p = points_dir.join(format!("{:04}.json", r.index));
+            if let Err(e) = file.write(&p) {
+                save_errors
+                    .lock()
+                    .expect("not poisoned")
+                    .push(e.to_string());
+            }
+        }
+        bar.inc(1);
+    };
+    let results = pool.install(|| sweep::run(&grid, &Settings::default(), &done));
+    bar.finish_and_clear();
+    let wall = started.elapsed().as_secs_f64();
+    for e in save_errors.into_inner().unwrap_or_default() {
+        eprintln!("warning: {e}");
+    }
+
+    let files = sweep::write_outputs(&a.out, &grid, &results, wall, threads).map_err(io(&a.out))?;
+    let widths: Vec<usize> = grid.axes.iter().map(|ax| ax.key.len().max(6)).collect();
+    let mut head = String::from("point");
+    for (ax, w) in grid.axes.iter().zip(&widths) {
+        head += &format!("  {:>w$}", ax.key);
+    }
+    println!(
+        "{head}  {:<22} {:>6} {:>13} {:>6} {:>8}",
+        "status", "check", "objective", "iter", "time"
+    );
+    for r in &results {
+        let mut line = format!("{:>5}", r.index);
+        for ((_, v), w) in r.overrides.iter().zip(&widths) {
+            line += &format!("  {:>w$}", sweep::label(v));
+        }
+        let check = if r.status == "solved" || r.objective.is_some() {
+            if r.check_ok {
+                "ok".to_string()
+            } else {
+                format!("{} bad", r.violations)
+            }
+        } else {
+            "-".to_string()
+        };
+        let obj = r.objective.map(|o| format!("{o:.6e}")).unwrap_or_default();
+        let it = r.iterations.map(|i| i.to_string()).unwrap_or_default();
+        println!(
+            "{line}  {:<22} {check:>6} {obj:>13} {it:>6} {:>7.2}s",
+            r.status, r.seconds
+        );
+        if let Some(e) = &r.error {
+            println!("       {e}");
+        }
+    }
+    let ok = results.iter().filter(|r| r.ok()).count();
+    println!(
+        "sweep: {ok} of {} points solved and checked, {:.1} s wall on {threads} threads",
+        results.len(),
+        wall
+    );
+    println!(
+        "wrote {}",
+        files
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(if ok == results.len() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 fn check_cmd(a: &CheckArgs) -> Result<ExitCode, CliError> {

@@ -171,13 +171,138 @@ fn solve_writes_a_plan_that_check_accepts() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
 }
 
+/// A small sweep: crawl gait, short horizon; one combination is an invalid scenario
+/// (gap.min ≥ gap.max), which is recorded for its point while the others are solved;
+/// the exit code is 1 because not every point succeeded.
 #[test]
-fn sweep_is_not_implemented_yet() {
+fn sweep_solves_a_grid_and_records_failures() {
     let d = tmp("sweep");
-    let grid = write(&d, "grid.json", &serde_json::json!({}));
-    let out = run(&["sweep", "--grid", &grid]);
+    let grid = d.join("grid.toml");
+    std::fs::write(
+        &grid,
+        "[base]\nn_step = 8\ngait = \"crawl\"\n[axes]\ngap.min = [2.25, 2.4]\n\"gap.depth\" = [0.5, 2]\n",
+    )
+    .unwrap();
+    let out_dir = d.join("out");
+    let out = run(&[
+        "sweep",
+        "--grid",
+        grid.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--solutions",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}{}", text(&out.stderr));
+    assert!(
+        stdout.contains("2 of 4 points solved and checked"),
+        "{stdout}"
+    );
+
+    let csv = std::fs::read_to_string(out_dir.join("sweep.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert!(
+        rows[0].starts_with("index,gap.min,gap.depth,status,check_ok,"),
+        "{csv}"
+    );
+    assert_eq!(rows.len(), 5, "{csv}");
+    assert!(rows[1].starts_with("0,2.25,0.5,solved,true,0,"), "{csv}");
+    assert!(
+        rows[3].starts_with("2,2.4,0.5,invalid_scenario,false,"),
+        "{csv}"
+    );
+    assert!(rows[3].contains("gap.min"), "{csv}");
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("sweep.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["summary"]["points"], 4);
+    assert_eq!(json["summary"]["ok"], 2);
+    let p1 = &json["points"][1];
+    assert_eq!(p1["overrides"]["gap.depth"], 2.0);
+    assert_eq!(p1["status"], "solved");
+    assert_eq!(p1["check_ok"], true);
+    assert!(p1["objective"].as_f64().unwrap() > 0.0);
+    assert!(p1["iterations"].as_u64().unwrap() > 0);
+    assert!(p1["seconds"].as_f64().unwrap() > 0.0);
+
+    let svg = std::fs::read_to_string(out_dir.join("sweep.svg")).unwrap();
+    assert!(
+        svg.starts_with("<svg") && svg.contains("2 of 4 points"),
+        "{svg}"
+    );
+    assert!(svg.contains("gap.min") && svg.contains("invalid scenario"));
+
+    // --solutions: each solved point's plan, which the checker accepts.
+    let p0 = out_dir.join("points").join("0000.json");
+    let out = run(&["check", p0.to_str().unwrap(), "--goal", "skip"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    assert!(!out_dir.join("points").join("0002.json").exists());
+}
+
+#[test]
+fn sweep_succeeds_with_exit_0_and_rejects_bad_grids_with_2() {
+    let d = tmp("sweep_ok");
+    let grid = write(
+        &d,
+        "grid.json",
+        &serde_json::json!({
+            "base": { "n_step": 6, "gait": "crawl" },
+            "axes": { "goal.F": [[5.0, 0.5, 0.5], [5.0, 0.6, 0.5]] }
+        }),
+    );
+    let out_dir = d.join("out");
+    let out = run(&[
+        "sweep",
+        "--grid",
+        &grid,
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    assert!(out_dir.join("sweep.svg").exists());
+
+    for (name, body, needle) in [
+        (
+            "unknown_axis.toml",
+            "[axes]\ngap.widht = [0.1, 0.2]\n",
+            "gap.widht",
+        ),
+        ("unknown_base.toml", "[base]\nn_stpe = 3\n", "n_stpe"),
+        ("unknown_top.toml", "[axis]\ngap.min = [2.0]\n", "axis"),
+        ("not_a_list.toml", "[axes]\ngap.min = 2.0\n", "list"),
+        (
+            "bad_value.toml",
+            "[axes]\ngait = [\"crawl\", \"trot\"]\n",
+            "trot",
+        ),
+        ("grid.yaml", "axes: {}\n", "extension"),
+    ] {
+        let p = d.join(name);
+        std::fs::write(&p, body).unwrap();
+        let out = run(&[
+            "sweep",
+            "--grid",
+            p.to_str().unwrap(),
+            "--out",
+            out_dir.join(name).to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let err = text(&out.stderr);
+        assert!(err.contains(needle) && err.contains(name), "{name}: {err}");
+        assert!(!out_dir.join(name).exists(), "{name}: outputs written");
+    }
+    let out = run(&["sweep", "--grid", d.join("missing.toml").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("not yet implemented"));
+    assert!(text(&out.stderr).contains("missing.toml"));
 }
 
 #[test]
