@@ -116,8 +116,13 @@ pub struct IpmOptions {
     pub slack_bound_push: f64,
     /// Relative push of initial slacks. Default 1e-2.
     pub slack_bound_frac: f64,
-    /// Relative relaxation of all bounds. Default 1e-8.
+    /// Relative relaxation of all bounds: each finite bound moves outwards by
+    /// bound_relax_factor·max(1, |bound|). Default 1e-8.
     pub bound_relax_factor: f64,
+    /// Project the final x onto the original (unrelaxed) variable bounds. The reported
+    /// violations are those of the projected point. Default false (IPOPT 3.14's "no";
+    /// IPOPT ≤ 3.13 defaulted to "yes").
+    pub honor_original_bounds: bool,
     /// Initial bound multipliers. Default 1.
     pub bound_mult_init_val: f64,
     /// Least-squares multipliers larger than this are discarded (set to 0). Default 1e3.
@@ -259,6 +264,7 @@ impl Default for IpmOptions {
             slack_bound_push: 1e-2,
             slack_bound_frac: 1e-2,
             bound_relax_factor: 1e-8,
+            honor_original_bounds: false,
             bound_mult_init_val: 1.0,
             constr_mult_init_max: 1e3,
             warm_start_bound_push: 1e-3,

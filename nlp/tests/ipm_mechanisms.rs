@@ -418,3 +418,35 @@ fn solution_and_options_serialize() {
     assert_eq!(o.mu_strategy, MuStrategy::Adaptive);
     assert!(serde_json::from_str::<IpmOptions>(r#"{"tolerance": 1e-6}"#).is_err());
 }
+
+/// min x on [1, 10] ends on the relaxed bound 1 − 1e-8 (as IPOPT 3.14 with its default
+/// honor_original_bounds = no: 0.9999999925); with honor_original_bounds it is exactly 1.
+#[test]
+fn honor_original_bounds_projects_the_final_point() {
+    let make = || {
+        DenseNlp::new(
+            vec![1.0],
+            vec![10.0],
+            vec![],
+            vec![],
+            vec![5.0],
+            Box::new(|x| x[0]),
+            Box::new(|_, g| g[0] = 1.0),
+            Box::new(|_, _| {}),
+            Box::new(|_, _| {}),
+            Box::new(|_, _, _, h| h[0] = 0.0),
+        )
+    };
+    let sol = Ipm::new(opts()).solve(&mut make()).unwrap();
+    assert_eq!(sol.status, Status::SolveSucceeded);
+    assert!(sol.x[0] < 1.0 && sol.x[0] > 1.0 - 2e-8, "{}", sol.x[0]);
+    let sol = Ipm::new(IpmOptions {
+        honor_original_bounds: true,
+        ..opts()
+    })
+    .solve(&mut make())
+    .unwrap();
+    assert_eq!(sol.status, Status::SolveSucceeded);
+    assert_eq!(sol.x[0], 1.0);
+    assert_eq!(sol.constr_viol, 0.0);
+}

@@ -294,6 +294,14 @@ impl Ipm {
                 }
             }
         };
+        let mut w = w;
+        if opts.honor_original_bounds {
+            for (k, &j) in red.free.iter().enumerate() {
+                if k < w.len() {
+                    w[k] = w[k].clamp(v.x_l[j], v.x_u[j]);
+                }
+            }
+        }
         let mut sol = finish(&mut red, &v, status, &w, &y, &zl, &zu, message);
         if n == 0 && sol.constr_viol > opts.constr_viol_tol {
             sol.status = Status::InfeasibleProblemDetected;
