@@ -11,6 +11,7 @@ pub mod options;
 pub mod problem;
 pub mod scaling;
 pub mod solution;
+pub mod sqp;
 
 pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
@@ -19,6 +20,7 @@ pub use ipm::Ipm;
 pub use problem::{Block, BuildError, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
-pub use numeric::NumericNlp;
+pub use numeric::{AffineCone, NumericNlp};
+pub use sqp::{HessianApproximation, Sqp, SqpOptions};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
 pub use solution::{IterationRecord, Solution, Stats, Status};

@@ -44,4 +44,33 @@ pub trait NumericNlp {
     fn constraint_name(&self, i: usize) -> String {
         format!("g[{i}]")
     }
+    /// Second-order cones with affine entries (default: none). Each also has a row of g
+    /// (its smooth form), which a cone-aware solver replaces by the exact cone.
+    fn affine_cones(&self) -> &[AffineCone] {
+        &[]
+    }
+    /// CSC pattern of the Jacobian of the stacked cone entries (rows: every cone's
+    /// `[t, v]`, in the order of [`NumericNlp::affine_cones`]; columns: the n variables).
+    /// `None` when there are no affine cones.
+    fn cone_jac_sparsity(&self) -> Option<&SymbolicSparseColMat<usize>> {
+        None
+    }
+    /// Values of the stacked cone entries at x.
+    fn eval_cone_entries(&mut self, _x: &[f64], _out: &mut [f64]) {}
+    /// Values of the cone-entry Jacobian in `cone_jac_sparsity` order.
+    fn eval_cone_jac(&mut self, _x: &[f64], _values: &mut [f64]) {}
+}
+
+/// A second-order cone `‖v(x)‖ ≤ t(x)` whose entries are affine in x, exposed by
+/// [`NumericNlp::affine_cones`] to solvers that treat cones natively (the SQP hands it to
+/// clarabel as a second-order cone). Row `row` of g holds the cone's smooth form for
+/// solvers that do not (see `Problem::subject_to_cone`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct AffineCone {
+    /// The row of g holding the smooth form of this cone.
+    pub row: usize,
+    /// Offset of this cone's entries `[t, v₁, …]` in the stacked vector of cone entries.
+    pub offset: usize,
+    /// Dimension `1 + len(v)`.
+    pub dim: usize,
 }

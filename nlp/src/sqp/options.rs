@@ -1,0 +1,236 @@
+//! [`SqpOptions`]: every option of the SQP method with its default, in one place.
+//!
+//! Termination options have the names, meanings and defaults of the interior-point
+//! method's ([`IpmOptions`](crate::IpmOptions)), so a switch of back end keeps the
+//! meaning of "converged".
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::SolveError;
+
+/// How the QP Hessian `B` is obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum HessianApproximation {
+    /// The exact Lagrangian Hessian, shifted by δ·I until it is positive definite (δ is
+    /// found by trial factorisations with [`Kkt`](crate::Kkt) and counting the inertia,
+    /// as IPOPT's inertia correction does). Default.
+    Exact,
+    /// Damped BFGS (Powell 1978) on a dense n×n matrix: for small problems or when
+    /// second derivatives are unreliable.
+    DampedBfgs,
+}
+
+/// All options of the SQP method.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SqpOptions {
+    // ---------- termination (same meaning as IpmOptions) ----------
+    /// Desired relative (scaled) convergence tolerance on the KKT error. Default 1e-8.
+    pub tol: f64,
+    /// Scaling threshold s_max for the NLP error. Default 100.
+    pub s_max: f64,
+    /// Maximum number of SQP iterations. Default 3000.
+    pub max_iter: usize,
+    /// Maximum wall-clock time in seconds. Default 1e20.
+    pub max_wall_time: f64,
+    /// Absolute tolerance on (unscaled) dual infeasibility. Default 1.
+    pub dual_inf_tol: f64,
+    /// Absolute tolerance on (unscaled) constraint violation. Default 1e-4.
+    pub constr_viol_tol: f64,
+    /// Absolute tolerance on (unscaled) complementarity. Default 1e-4.
+    pub compl_inf_tol: f64,
+    /// "Acceptable" relative convergence tolerance. Default 1e-6.
+    pub acceptable_tol: f64,
+    /// Number of consecutive acceptable iterates before stopping. Default 15 (0 disables).
+    pub acceptable_iter: usize,
+    /// Acceptable constraint violation. Default 1e-2.
+    pub acceptable_constr_viol_tol: f64,
+    /// Iterates with a component larger than this in magnitude are diverging. Default 1e20.
+    pub diverging_iterates_tol: f64,
+    // ---------- scaling (as IpmOptions) ----------
+    /// Gradient-based scaling of objective and constraints at the start. Default true.
+    pub gradient_scaling: bool,
+    /// Maximum gradient after scaling. Default 100.
+    pub nlp_scaling_max_gradient: f64,
+    /// Minimum scaling factor. Default 1e-8.
+    pub nlp_scaling_min_value: f64,
+    // ---------- Hessian ----------
+    /// Exact (shifted) Hessian or damped BFGS. Default exact.
+    pub hessian_approximation: HessianApproximation,
+    /// First trial shift δ when the Hessian is not positive definite. Default 1e-4.
+    pub first_hessian_shift: f64,
+    /// Smallest shift tried after a shifted iteration (δ_last/3, at least this). Default 1e-20.
+    pub min_hessian_shift: f64,
+    /// Largest shift before giving up with `ErrorInStepComputation`. Default 1e20.
+    pub max_hessian_shift: f64,
+    // ---------- merit function and line search ----------
+    /// Initial ℓ1 penalty ρ (merit φ = f + ρ·‖violation‖₁, also the cost of the QP's
+    /// elastic variables). Default 10.
+    pub penalty_init: f64,
+    /// Largest penalty ρ. Default 1e8.
+    pub penalty_max: f64,
+    /// Factor by which ρ grows when the linearised constraints need the elastic
+    /// variables (infeasible or nearly infeasible QP). Default 10.
+    pub penalty_increase: f64,
+    /// Armijo constant η in φ(x + αd) ≤ φ(x) − η·α·pred. Default 1e-4.
+    pub armijo: f64,
+    /// Backtracking factor. Default 0.5.
+    pub backtrack: f64,
+    /// Smallest step size before the line search fails. Default 1e-12.
+    pub min_step: f64,
+    /// Try a second-order correction when the full step is rejected. Default true.
+    pub second_order_correction: bool,
+    // ---------- QP (clarabel) ----------
+    /// Clarabel's gap and feasibility tolerances for the QP subproblems. Default 1e-10.
+    pub qp_tol: f64,
+    /// Maximum clarabel iterations per QP. Default 200.
+    pub qp_max_iter: u32,
+    /// An elastic variable above this value means the linearised constraint could not be
+    /// satisfied (elastic mode). Default 1e-8.
+    pub elastic_tol: f64,
+    /// Print level: 0 silent, ≥ 5 iteration table, ≥ 3 summary. Default 0.
+    pub print_level: u8,
+}
+
+impl Default for SqpOptions {
+    fn default() -> Self {
+        SqpOptions {
+            tol: 1e-8,
+            s_max: 100.0,
+            max_iter: 3000,
+            max_wall_time: 1e20,
+            dual_inf_tol: 1.0,
+            constr_viol_tol: 1e-4,
+            compl_inf_tol: 1e-4,
+            acceptable_tol: 1e-6,
+            acceptable_iter: 15,
+            acceptable_constr_viol_tol: 1e-2,
+            diverging_iterates_tol: 1e20,
+            gradient_scaling: true,
+            nlp_scaling_max_gradient: 100.0,
+            nlp_scaling_min_value: 1e-8,
+            hessian_approximation: HessianApproximation::Exact,
+            first_hessian_shift: 1e-4,
+            min_hessian_shift: 1e-20,
+            max_hessian_shift: 1e20,
+            penalty_init: 10.0,
+            penalty_max: 1e8,
+            penalty_increase: 10.0,
+            armijo: 1e-4,
+            backtrack: 0.5,
+            min_step: 1e-12,
+            second_order_correction: true,
+            qp_tol: 1e-10,
+            qp_max_iter: 200,
+            elastic_tol: 1e-8,
+            print_level: 0,
+        }
+    }
+}
+
+fn bad(field: &'static str, reason: impl Into<String>) -> SolveError {
+    SolveError::InvalidOption {
+        field,
+        reason: reason.into(),
+    }
+}
+
+impl SqpOptions {
+    /// Checks every option; the error names the first bad field.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        macro_rules! positive {
+            ($($f:ident),*) => {$(
+                if self.$f.is_nan() || self.$f <= 0.0 || !self.$f.is_finite() {
+                    return Err(bad(stringify!($f), format!("must be finite and > 0, got {}", self.$f)));
+                }
+            )*};
+        }
+        macro_rules! open_unit {
+            ($($f:ident),*) => {$(
+                if self.$f.is_nan() || self.$f <= 0.0 || self.$f >= 1.0 {
+                    return Err(bad(stringify!($f), format!("must be in (0, 1), got {}", self.$f)));
+                }
+            )*};
+        }
+        positive!(
+            tol,
+            s_max,
+            max_wall_time,
+            dual_inf_tol,
+            constr_viol_tol,
+            compl_inf_tol,
+            acceptable_tol,
+            acceptable_constr_viol_tol,
+            diverging_iterates_tol,
+            nlp_scaling_max_gradient,
+            nlp_scaling_min_value,
+            first_hessian_shift,
+            min_hessian_shift,
+            max_hessian_shift,
+            penalty_init,
+            penalty_max,
+            qp_tol,
+            elastic_tol,
+            min_step
+        );
+        open_unit!(armijo, backtrack);
+        if self.penalty_increase <= 1.0 || !self.penalty_increase.is_finite() {
+            return Err(bad(
+                "penalty_increase",
+                format!("must be finite and > 1, got {}", self.penalty_increase),
+            ));
+        }
+        if self.penalty_init > self.penalty_max {
+            return Err(bad(
+                "penalty_init",
+                format!(
+                    "{} exceeds penalty_max {}",
+                    self.penalty_init, self.penalty_max
+                ),
+            ));
+        }
+        if self.min_hessian_shift > self.first_hessian_shift
+            || self.first_hessian_shift > self.max_hessian_shift
+        {
+            return Err(bad(
+                "first_hessian_shift",
+                "need min_hessian_shift <= first_hessian_shift <= max_hessian_shift",
+            ));
+        }
+        if self.max_iter == 0 {
+            return Err(bad("max_iter", "must be at least 1"));
+        }
+        if self.qp_max_iter == 0 {
+            return Err(bad("qp_max_iter", "must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_validate_and_round_trip() {
+        let o = SqpOptions::default();
+        o.validate().unwrap();
+        let s = serde_json::to_string(&o).unwrap();
+        let back: SqpOptions = serde_json::from_str(&s).unwrap();
+        assert_eq!(o, back);
+        let err = serde_json::from_str::<SqpOptions>("{\"tol\": 1e-6, \"toll\": 1}");
+        assert!(err.is_err());
+        let o = SqpOptions {
+            armijo: 1.5,
+            ..SqpOptions::default()
+        };
+        assert!(matches!(
+            o.validate(),
+            Err(SolveError::InvalidOption {
+                field: "armijo",
+                ..
+            })
+        ));
+    }
+}

@@ -1,0 +1,605 @@
+//! The SQP subproblem, an elastic (ℓ1-penalised) QP solved by clarabel:
+//!
+//! ```text
+//! min_{d, e}  ½ dᵀ B d + ∇fᵀ d + ρ·Σ e
+//! s.t.  g_i + J_i d − e⁺_i + e⁻_i = g_l,i          (equality rows, ZeroCone)
+//!       g_i + J_i d − e_k ≤ g_u,i,  g_i + J_i d + e_k ≥ g_l,i   (inequality sides, Nonneg)
+//!       x_l ≤ x + d ≤ x_u                          (bounds; fixed variables: ZeroCone)
+//!       e ≥ 0
+//!       ‖v + J_v d‖ ≤ t + J_t d + e_c              (affine cones, SecondOrderCone)
+//! ```
+//!
+//! This is Fletcher's Sℓ1QP subproblem: always feasible (the elastic variables e absorb
+//! whatever the linearisation cannot satisfy), bounded when B is positive definite, and
+//! its optimal value is the model of the ℓ1 merit function, so `pred = m(0) − m(d) ≥ 0`.
+//! When the linearised constraints are consistent and ρ exceeds the multipliers, e = 0
+//! and d is the ordinary SQP step.
+//!
+//! The pattern of P (upper triangle of B) and A is built once; every iteration only
+//! writes new values through precomputed positions and calls clarabel's `update_*`
+//! (presolve off, zero dropping off, so the symbolic factorisation is kept).
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use faer::sparse::SymbolicSparseColMat;
+
+/// What a QP row stands for (to read multipliers back and to fill `b`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum RowKind {
+    /// Equality row i of g.
+    EqG(usize),
+    /// Upper side of inequality row i of g.
+    UpperG(usize),
+    /// Lower side of inequality row i of g.
+    LowerG(usize),
+    /// Fixed variable j.
+    Fixed(usize),
+    /// Upper bound of variable j.
+    UpperX(usize),
+    /// Lower bound of variable j.
+    LowerX(usize),
+    /// Non-negativity of elastic variable k.
+    Elastic,
+    /// Entry `k` (into the stacked cone vector [t; v] of every cone) of an SOC block.
+    Cone(usize),
+    /// Definition `J_i d − w_i = 0` of the auxiliary variable of row i.
+    Aux(usize),
+}
+
+/// Where a value of A comes from.
+#[derive(Debug, Clone, Copy)]
+enum Src {
+    /// Jacobian storage position, times a sign.
+    Jac(usize, f64),
+    /// Cone Jacobian storage position, times a sign.
+    ConeJac(usize, f64),
+    /// A constant.
+    Const(f64),
+}
+
+/// Numeric data of one QP (scaled problem).
+pub(crate) struct QpData<'a> {
+    pub x: &'a [f64],
+    pub x_l: &'a [f64],
+    pub x_u: &'a [f64],
+    pub g: &'a [f64],
+    pub g_l: &'a [f64],
+    pub g_u: &'a [f64],
+    pub grad: &'a [f64],
+    pub jac: &'a [f64],
+    /// Stacked cone entries [t; v] of every cone at x.
+    pub cone: &'a [f64],
+    pub cone_jac: &'a [f64],
+    /// Lower-triangular Hessian values (pattern given at construction).
+    pub hess: &'a [f64],
+    /// Diagonal shift δ added to B.
+    pub shift: f64,
+    /// Extra diagonal weight per variable (active bounds: ρ_a), added to B.
+    pub bound_weight: &'a [f64],
+    /// Augmented-Lagrangian weight per row of g (ρ_a on active rows, 0 elsewhere): the
+    /// QP objective gets ½·w_i·(J_i d)² through the auxiliary variables `w = J d`.
+    pub row_weight: &'a [f64],
+    /// Optional dense B (damped BFGS), column-major n×n; replaces `hess`/`shift`.
+    pub dense_b: Option<&'a [f64]>,
+    /// ℓ1 penalty ρ.
+    pub rho: f64,
+}
+
+/// Result of a QP solve.
+#[derive(Debug, Clone)]
+pub(crate) struct QpResult {
+    /// Primal step d (length n).
+    pub d: Vec<f64>,
+    /// Elastic variables.
+    pub e: Vec<f64>,
+    /// Constraint multipliers λ in IPOPT's convention (length m).
+    pub lambda: Vec<f64>,
+    /// Lower / upper bound multipliers (length n).
+    pub z_l: Vec<f64>,
+    pub z_u: Vec<f64>,
+    /// Duals of the cone rows (stacked like the cone entries).
+    pub z_cone: Vec<f64>,
+    /// Duals of the rows `J_i d − w_i = 0` (zero without the augmented term).
+    pub z_w: Vec<f64>,
+    pub status: SolverStatus,
+    pub iterations: u32,
+}
+
+/// The QP of one problem structure, with its clarabel solver (set up on the first solve).
+pub(crate) struct Qp {
+    n: usize,
+    m: usize,
+    n_e: usize,
+    rows: Vec<RowKind>,
+    /// Elastic column (absolute, ≥ n) per row that has one (equality rows have two).
+    cones: Vec<SupportedConeT<f64>>,
+    p_colptr: Vec<usize>,
+    p_rowval: Vec<usize>,
+    p_vals: Vec<f64>,
+    /// P position of each Hessian storage entry.
+    h_pos: Vec<usize>,
+    /// P position of each diagonal entry of the d block.
+    diag_pos: Vec<usize>,
+    /// P position of the dense upper triangle (BFGS), column-major (i ≤ j).
+    dense: bool,
+    a_colptr: Vec<usize>,
+    a_rowval: Vec<usize>,
+    a_vals: Vec<f64>,
+    a_src: Vec<Src>,
+    b: Vec<f64>,
+    q: Vec<f64>,
+    tol: f64,
+    max_iter: u32,
+    solver: Option<DefaultSolver<f64>>,
+    /// Cone blocks: (row offset in the stacked cone vector, dimension).
+    cone_blocks: Vec<(usize, usize)>,
+    /// First column of the auxiliary variables w (one per row of g), if present.
+    w_col: Option<usize>,
+    /// P position of the diagonal of each w.
+    w_diag: Vec<usize>,
+}
+
+/// Builds CSC from (row, col, payload) triplets (no duplicates); returns colptr, rowval
+/// and the payloads in CSC order.
+fn to_csc<T: Copy>(
+    ncols: usize,
+    mut t: Vec<(usize, usize, T)>,
+) -> (Vec<usize>, Vec<usize>, Vec<T>) {
+    t.sort_by_key(|&(r, c, _)| (c, r));
+    let mut colptr = vec![0usize; ncols + 1];
+    for &(_, c, _) in &t {
+        colptr[c + 1] += 1;
+    }
+    for c in 0..ncols {
+        colptr[c + 1] += colptr[c];
+    }
+    let rowval = t.iter().map(|&(r, _, _)| r).collect();
+    let payload = t.iter().map(|&(_, _, p)| p).collect();
+    (colptr, rowval, payload)
+}
+
+impl Qp {
+    /// Lays out the QP for a problem with the given patterns and bounds (fixed structure:
+    /// which sides are finite, which variables are fixed). `cone_blocks` are (offset,
+    /// dim) of each cone in the stacked cone vector, `cone_jac` the pattern of its
+    /// Jacobian (rows = stacked cone entries).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        hess: &SymbolicSparseColMat<usize>,
+        jac: &SymbolicSparseColMat<usize>,
+        x_l: &[f64],
+        x_u: &[f64],
+        g_l: &[f64],
+        g_u: &[f64],
+        cone_blocks: &[(usize, usize)],
+        cone_jac: Option<&SymbolicSparseColMat<usize>>,
+        skip_rows: &[bool],
+        aug: bool,
+        dense: bool,
+        tol: f64,
+        max_iter: u32,
+    ) -> Qp {
+        let n = x_l.len();
+        let m = g_l.len();
+        // ---- rows ----
+        let mut rows = Vec::new();
+        // Elastic columns: (row index, column, coefficient) added to A.
+        let mut elastic: Vec<(usize, f64)> = Vec::new();
+        let mut next_e = n;
+        let mut a_trip: Vec<(usize, usize, Src)> = Vec::new();
+        // Rows of g by column: collect J entries per row once.
+        let mut jrows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
+        for c in 0..n {
+            for p in jac.col_range(c) {
+                jrows[jac.row_idx()[p]].push((c, p));
+            }
+        }
+        let push_g_row = |rows: &mut Vec<RowKind>,
+                          kind: RowKind,
+                          i: usize,
+                          sign: f64,
+                          a: &mut Vec<(usize, usize, Src)>| {
+            let r = rows.len();
+            rows.push(kind);
+            for &(c, p) in &jrows[i] {
+                a.push((r, c, Src::Jac(p, sign)));
+            }
+            r
+        };
+        // Zero cone: equality rows (two elastic variables each), fixed variables.
+        for i in 0..m {
+            if skip_rows[i] || g_l[i] != g_u[i] {
+                continue;
+            }
+            let r = push_g_row(&mut rows, RowKind::EqG(i), i, 1.0, &mut a_trip);
+            a_trip.push((r, next_e, Src::Const(-1.0)));
+            a_trip.push((r, next_e + 1, Src::Const(1.0)));
+            elastic.push((next_e, 1.0));
+            elastic.push((next_e + 1, 1.0));
+            next_e += 2;
+        }
+        for j in 0..n {
+            if x_l[j] == x_u[j] {
+                let r = rows.len();
+                rows.push(RowKind::Fixed(j));
+                a_trip.push((r, j, Src::Const(1.0)));
+            }
+        }
+        // Auxiliary variables w_i = J_i d (augmented-Lagrangian convexification).
+        let mut w_rows = Vec::new();
+        if aug {
+            for i in 0..m {
+                if !skip_rows[i] {
+                    let r = push_g_row(&mut rows, RowKind::Aux(i), i, 1.0, &mut a_trip);
+                    w_rows.push((r, i));
+                }
+            }
+        }
+        let n_zero = rows.len();
+        // Nonnegative cone.
+        for i in 0..m {
+            if skip_rows[i] || g_l[i] == g_u[i] {
+                continue;
+            }
+            if g_u[i].is_finite() {
+                let r = push_g_row(&mut rows, RowKind::UpperG(i), i, 1.0, &mut a_trip);
+                a_trip.push((r, next_e, Src::Const(-1.0)));
+                elastic.push((next_e, 1.0));
+                next_e += 1;
+            }
+            if g_l[i].is_finite() {
+                let r = push_g_row(&mut rows, RowKind::LowerG(i), i, -1.0, &mut a_trip);
+                a_trip.push((r, next_e, Src::Const(-1.0)));
+                elastic.push((next_e, 1.0));
+                next_e += 1;
+            }
+        }
+        for j in 0..n {
+            if x_l[j] == x_u[j] {
+                continue;
+            }
+            if x_u[j].is_finite() {
+                let r = rows.len();
+                rows.push(RowKind::UpperX(j));
+                a_trip.push((r, j, Src::Const(1.0)));
+            }
+            if x_l[j].is_finite() {
+                let r = rows.len();
+                rows.push(RowKind::LowerX(j));
+                a_trip.push((r, j, Src::Const(-1.0)));
+            }
+        }
+        // Cone elastic variables (one per cone, on its t entry) are allocated now so that
+        // their non-negativity rows sit in the nonnegative block.
+        let cone_e: Vec<usize> = (0..cone_blocks.len()).map(|k| next_e + k).collect();
+        next_e += cone_blocks.len();
+        for col in n..next_e {
+            let r = rows.len();
+            rows.push(RowKind::Elastic);
+            a_trip.push((r, col, Src::Const(-1.0)));
+        }
+        let n_nonneg = rows.len() - n_zero;
+        // Second-order cones: s = [t; v] + J_c d + [e_c; 0] ∈ SOC, i.e. A = −J_c, b = [t; v].
+        let mut cone_row0 = Vec::new();
+        if let Some(cj) = cone_jac {
+            let mut crows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); cj.nrows()];
+            for c in 0..n {
+                for p in cj.col_range(c) {
+                    crows[cj.row_idx()[p]].push((c, p));
+                }
+            }
+            for (k, &(off, dim)) in cone_blocks.iter().enumerate() {
+                cone_row0.push(rows.len());
+                for q in 0..dim {
+                    let r = rows.len();
+                    rows.push(RowKind::Cone(off + q));
+                    for &(c, p) in &crows[off + q] {
+                        a_trip.push((r, c, Src::ConeJac(p, -1.0)));
+                    }
+                    if q == 0 {
+                        a_trip.push((r, cone_e[k], Src::Const(-1.0)));
+                    }
+                }
+            }
+        }
+        let n_e = next_e - n;
+        let _ = elastic;
+        // w columns come after the elastic ones (w_i for row i at w_col + i).
+        let w_col = aug.then_some(next_e);
+        for &(r, i) in &w_rows {
+            a_trip.push((r, next_e + i, Src::Const(-1.0)));
+        }
+        let n_w = if aug { m } else { 0 };
+        let mut cones = Vec::new();
+        if n_zero > 0 {
+            cones.push(SupportedConeT::ZeroConeT(n_zero));
+        }
+        if n_nonneg > 0 {
+            cones.push(SupportedConeT::NonnegativeConeT(n_nonneg));
+        }
+        for &(_, dim) in cone_blocks {
+            cones.push(SupportedConeT::SecondOrderConeT(dim));
+        }
+        let ncols = n + n_e + n_w;
+        let (a_colptr, a_rowval, a_src) = to_csc(ncols, a_trip);
+        let a_vals = vec![0.0; a_src.len()];
+        // ---- P: upper triangle of B (transpose of the lower Hessian pattern) + diagonal ----
+        let mut p_trip: Vec<(usize, usize, usize)> = Vec::new();
+        if dense {
+            for j in 0..n {
+                for i in 0..=j {
+                    p_trip.push((i, j, usize::MAX));
+                }
+            }
+        } else {
+            let mut has_diag = vec![false; n];
+            for c in 0..n {
+                for p in hess.col_range(c) {
+                    let r = hess.row_idx()[p];
+                    if r == c {
+                        has_diag[c] = true;
+                    }
+                    p_trip.push((c, r, p));
+                }
+            }
+            for (j, &h) in has_diag.iter().enumerate() {
+                if !h {
+                    p_trip.push((j, j, usize::MAX));
+                }
+            }
+        }
+        const W: usize = usize::MAX - 1;
+        for i in 0..n_w {
+            p_trip.push((n + n_e + i, n + n_e + i, W));
+        }
+        let (p_colptr, p_rowval, p_src) = to_csc(ncols, p_trip);
+        let mut w_diag = vec![0usize; n_w];
+        for i in 0..n_w {
+            let c = n + n_e + i;
+            w_diag[i] = p_colptr[c];
+        }
+        let mut h_pos = vec![0usize; hess.row_idx().len()];
+        let mut diag_pos = vec![0usize; n];
+        for c in 0..ncols.min(n) {
+            for k in p_colptr[c]..p_colptr[c + 1] {
+                if p_rowval[k] == c {
+                    diag_pos[c] = k;
+                }
+                if p_src[k] < W {
+                    h_pos[p_src[k]] = k;
+                }
+            }
+        }
+        let p_vals = vec![0.0; p_rowval.len()];
+        let n_rows = rows.len();
+        Qp {
+            n,
+            m,
+            n_e,
+            rows,
+            cones,
+            p_colptr,
+            p_rowval,
+            p_vals,
+            h_pos,
+            diag_pos,
+            dense,
+            a_colptr,
+            a_rowval,
+            a_vals,
+            a_src,
+            b: vec![0.0; n_rows],
+            q: vec![0.0; ncols],
+            tol,
+            max_iter,
+            solver: None,
+            cone_blocks: cone_blocks.to_vec(),
+            w_col,
+            w_diag,
+        }
+    }
+
+    /// Whether the QP has the auxiliary variables of the augmented-Lagrangian term.
+    pub fn has_aug(&self) -> bool {
+        self.w_col.is_some()
+    }
+
+    fn settings(&self) -> DefaultSettings<f64> {
+        DefaultSettings {
+            verbose: false,
+            presolve_enable: false,
+            input_sparse_dropzeros: false,
+            max_threads: 1,
+            max_iter: self.max_iter,
+            tol_gap_abs: self.tol,
+            tol_gap_rel: self.tol,
+            tol_feas: self.tol,
+            tol_ktratio: 1e-8,
+            direct_solve_method: "qdldl".into(),
+            ..DefaultSettings::default()
+        }
+    }
+
+    /// Writes P, q, A, b from `data`.
+    fn fill(&mut self, data: &QpData) {
+        let n = self.n;
+        // P
+        self.p_vals.iter_mut().for_each(|v| *v = 0.0);
+        if let (true, Some(bd)) = (self.dense, data.dense_b) {
+            let mut k = 0;
+            for j in 0..n {
+                for i in 0..=j {
+                    self.p_vals[k] = bd[i + j * n];
+                    k += 1;
+                }
+            }
+        } else {
+            for (p, &h) in data.hess.iter().enumerate() {
+                self.p_vals[self.h_pos[p]] += h;
+            }
+            for j in 0..n {
+                self.p_vals[self.diag_pos[j]] += data.shift + data.bound_weight[j];
+            }
+            for (i, &pos) in self.w_diag.iter().enumerate() {
+                self.p_vals[pos] = data.row_weight[i];
+            }
+        }
+        // q
+        self.q[..n].copy_from_slice(data.grad);
+        let n_e = self.n_e;
+        self.q[n..n + n_e].iter_mut().for_each(|v| *v = data.rho);
+        // A
+        for (v, s) in self.a_vals.iter_mut().zip(&self.a_src) {
+            *v = match *s {
+                Src::Jac(p, sign) => sign * data.jac[p],
+                Src::ConeJac(p, sign) => sign * data.cone_jac[p],
+                Src::Const(c) => c,
+            };
+        }
+        self.fill_b(
+            data.x, data.x_l, data.x_u, data.g, data.g_l, data.g_u, data.cone,
+        );
+    }
+
+    /// Writes b for constraint values `g` (possibly corrected, for a second-order
+    /// correction) at x.
+    #[allow(clippy::too_many_arguments)]
+    fn fill_b(
+        &mut self,
+        x: &[f64],
+        x_l: &[f64],
+        x_u: &[f64],
+        g: &[f64],
+        g_l: &[f64],
+        g_u: &[f64],
+        cone: &[f64],
+    ) {
+        for (b, kind) in self.b.iter_mut().zip(&self.rows) {
+            *b = match *kind {
+                RowKind::EqG(i) => g_l[i] - g[i],
+                RowKind::UpperG(i) => g_u[i] - g[i],
+                RowKind::LowerG(i) => g[i] - g_l[i],
+                RowKind::Fixed(j) | RowKind::UpperX(j) => x_u[j] - x[j],
+                RowKind::LowerX(j) => x[j] - x_l[j],
+                RowKind::Elastic | RowKind::Aux(_) => 0.0,
+                RowKind::Cone(k) => cone[k],
+            };
+        }
+    }
+
+    fn build(&mut self) -> Result<(), String> {
+        let ncols = self.q.len();
+        let p = CscMatrix::new(
+            ncols,
+            ncols,
+            self.p_colptr.clone(),
+            self.p_rowval.clone(),
+            self.p_vals.clone(),
+        );
+        let a = CscMatrix::new(
+            self.b.len(),
+            ncols,
+            self.a_colptr.clone(),
+            self.a_rowval.clone(),
+            self.a_vals.clone(),
+        );
+        let s = DefaultSolver::new(&p, &self.q, &a, &self.b, &self.cones, self.settings())
+            .map_err(|e| e.to_string())?;
+        self.solver = Some(s);
+        Ok(())
+    }
+
+    /// Solves the QP for `data`: reuses the clarabel solver with new values when it
+    /// exists, rebuilding it (fresh equilibration) if that fails to converge.
+    pub fn solve(&mut self, data: &QpData) -> Result<QpResult, String> {
+        self.fill(data);
+        self.run(true)
+    }
+
+    /// Solves again with only the constraint constants changed (second-order
+    /// correction: `g` holds the corrected values ĝ = g(x + d) − J d).
+    #[allow(clippy::too_many_arguments)]
+    pub fn resolve_with_g(
+        &mut self,
+        x: &[f64],
+        x_l: &[f64],
+        x_u: &[f64],
+        g: &[f64],
+        g_l: &[f64],
+        g_u: &[f64],
+        cone: &[f64],
+    ) -> Result<QpResult, String> {
+        self.fill_b(x, x_l, x_u, g, g_l, g_u, cone);
+        self.run(false)
+    }
+
+    fn run(&mut self, all: bool) -> Result<QpResult, String> {
+        let mut fresh = false;
+        match self.solver.as_mut() {
+            None => {
+                self.build()?;
+                fresh = true;
+            }
+            Some(s) => {
+                let r = if all {
+                    s.update_P(&self.p_vals)
+                        .and_then(|_| s.update_q(&self.q))
+                        .and_then(|_| s.update_A(&self.a_vals))
+                        .and_then(|_| s.update_b(&self.b))
+                } else {
+                    s.update_b(&self.b)
+                };
+                if r.is_err() {
+                    self.build()?;
+                    fresh = true;
+                }
+            }
+        }
+        let mut s = self.solver.as_mut().expect("built above");
+        s.solve();
+        let ok = |st: SolverStatus| matches!(st, SolverStatus::Solved | SolverStatus::AlmostSolved);
+        if !ok(s.solution.status) && !fresh {
+            // Equilibration from an earlier QP may be poor for these values: start over.
+            self.build()?;
+            s = self.solver.as_mut().expect("built above");
+            s.solve();
+        }
+        let sol = &s.solution;
+        let n = self.n;
+        let mut res = QpResult {
+            d: sol.x[..n].to_vec(),
+            e: sol.x[n..n + self.n_e].to_vec(),
+            z_w: vec![0.0; self.m],
+            lambda: vec![0.0; self.m],
+            z_l: vec![0.0; n],
+            z_u: vec![0.0; n],
+            z_cone: vec![
+                0.0;
+                self.cone_blocks
+                    .iter()
+                    .map(|&(o, d)| o + d)
+                    .max()
+                    .unwrap_or(0)
+            ],
+            status: sol.status,
+            iterations: sol.iterations,
+        };
+        for (r, kind) in self.rows.iter().enumerate() {
+            let z = sol.z[r];
+            match *kind {
+                RowKind::EqG(i) | RowKind::UpperG(i) => res.lambda[i] += z,
+                RowKind::LowerG(i) => res.lambda[i] -= z,
+                RowKind::Fixed(j) => {
+                    res.z_u[j] = z.max(0.0);
+                    res.z_l[j] = (-z).max(0.0);
+                }
+                RowKind::UpperX(j) => res.z_u[j] = z,
+                RowKind::LowerX(j) => res.z_l[j] = z,
+                RowKind::Elastic => {}
+                RowKind::Cone(k) => res.z_cone[k] = z,
+                RowKind::Aux(i) => res.z_w[i] = z,
+            }
+        }
+        Ok(res)
+    }
+}

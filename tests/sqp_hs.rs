@@ -1,0 +1,225 @@
+//! The Hock–Schittkowski suite solved by the SQP back end ([`nlp::Sqp`]) with default
+//! options: the same problems (`hs/problems.rs`) and the same assertions as `tests/hs.rs`
+//! (status `SolveSucceeded`, published f* to the problem's tolerance or a documented
+//! local minimiser, final constraint violation ≤ 1e-4).
+//!
+//! `sqp_hs_summary` (ignored) prints one JSON line per problem for docs/performance.md:
+//!
+//! ```text
+//! cargo test --release --test sqp_hs -- --ignored --nocapture sqp_hs_summary
+//! ```
+use std::time::Instant;
+
+use symnlp::nlp;
+
+use nlp::{Solution, SolveError, Sqp, SqpOptions, Status};
+
+#[path = "hs/problems.rs"]
+#[allow(dead_code)]
+mod problems;
+
+use problems::Built;
+
+/// The registry and one test per problem (the list of `tests/hs.rs`).
+macro_rules! hs_suite {
+    ($($name:ident),* $(,)?) => {
+        /// Every problem of the suite with its name, in order.
+        pub const SUITE: &[(&str, fn() -> Built)] = &[$((stringify!($name), problems::$name)),*];
+
+        mod solve {
+            $(
+                #[test]
+                fn $name() {
+                    super::check(stringify!($name), super::problems::$name);
+                }
+            )*
+        }
+    };
+}
+
+hs_suite! {
+    hs001, hs002, hs003, hs004, hs005, hs025, hs038, hs045, hs110,
+    hs006, hs007, hs008, hs009, hs026, hs027, hs028, hs039, hs040, hs042, hs046, hs047,
+    hs048, hs049, hs050, hs051, hs052, hs053, hs056, hs061, hs077, hs078, hs079,
+    hs010, hs011, hs012, hs013, hs014, hs015, hs016, hs017, hs018, hs019, hs020, hs021,
+    hs022, hs023, hs024, hs029, hs030, hs031, hs032, hs033, hs034, hs035, hs036, hs037,
+    hs043, hs044, hs064, hs065, hs066, hs076, hs100, hs113,
+    hs071, hs073, hs080, hs081, hs106, hs108, hs114, hs116, hs118,
+}
+
+const CONSTR_VIOL_TOL: f64 = 1e-4;
+
+/// Problems the SQP back end does not solve yet with default options, with what it does
+/// instead (from `sqp_hs_summary` / `sqp_hs_log`). Their tests run the solver and check
+/// only that it returns (no panic, no `SolveError`); the IPM solves all of them.
+const KNOWN_FAILURES: &[(&str, &str)] = &[
+    ("hs013", "no KKT point at the solution: SolvedToAcceptableLevel at f = 0.99837"),
+    ("hs016", "the start x = (-2, 1) is clipped to the bound x1 <= 0.5 and SQP converges to the KKT point f = 23.1447, not 0.25"),
+    ("hs033", "stalls at f = -4 (line search on the l1 merit with a large penalty); MaximumIterationsExceeded"),
+    ("hs037", "SolvedToAcceptableLevel: slow final convergence (QP multipliers of nearly active bounds)"),
+    ("hs047", "SolvedToAcceptableLevel: singular Hessian at the solution, linear convergence"),
+    ("hs056", "clarabel returns InsufficientProgress on a QP at iteration 7"),
+    ("hs061", "MaximumIterationsExceeded: line search stalls (tiny steps, l1 merit)"),
+    ("hs078", "reaches f* to 1e-10 but the final steps are cut by the merit test: MaximumIterationsExceeded"),
+    ("hs081", "MaximumIterationsExceeded near f = 0.0591 (line search stalls)"),
+    ("hs106", "SolvedToAcceptableLevel after 1250 iterations (badly scaled; shifted Hessian, linear rate)"),
+    ("hs108", "reaches f* to 5e-10 but the KKT test is not met: MaximumIterationsExceeded"),
+    ("hs114", "MaximumIterationsExceeded at f = -1550.8 (line search stalls)"),
+    ("hs116", "MaximumIterationsExceeded at f = 95.93"),
+];
+
+struct Run {
+    f_star: f64,
+    local: &'static [f64],
+    tol: f64,
+    seconds: f64,
+    result: Result<Solution, SolveError>,
+}
+
+fn run(name: &str, build: fn() -> Built, print_level: u8) -> Run {
+    let case = build().unwrap_or_else(|e| panic!("{name}: building the problem failed: {e}"));
+    let mut compiled = case
+        .problem
+        .compile()
+        .unwrap_or_else(|e| panic!("{name}: compile failed: {e}"));
+    let t = Instant::now();
+    let result = Sqp::new(SqpOptions {
+        print_level,
+        ..SqpOptions::default()
+    })
+    .solve(&mut compiled);
+    Run {
+        f_star: case.f_star,
+        local: case.local,
+        tol: case.tol,
+        seconds: t.elapsed().as_secs_f64(),
+        result,
+    }
+}
+
+fn objective_error(f: f64, f_star: f64) -> f64 {
+    if f_star == 0.0 {
+        f.abs()
+    } else {
+        (f - f_star).abs() / f_star.abs()
+    }
+}
+
+fn matched(run: &Run, f: f64) -> Option<&'static str> {
+    if objective_error(f, run.f_star) <= run.tol {
+        Some("f*")
+    } else if run.local.iter().any(|&l| objective_error(f, l) <= run.tol) {
+        Some("local")
+    } else {
+        None
+    }
+}
+
+fn check(name: &'static str, build: fn() -> Built) {
+    let run = run(name, build, 0);
+    let sol = match &run.result {
+        Ok(sol) => sol,
+        Err(e) => panic!("{name}: solve error: {e}"),
+    };
+    if let Some((_, why)) = KNOWN_FAILURES.iter().find(|(n, _)| *n == name) {
+        eprintln!(
+            "{name}: known SQP exception ({why}); got {:?}, f = {}",
+            sol.status, sol.objective
+        );
+        return;
+    }
+    assert_eq!(
+        sol.status,
+        Status::SolveSucceeded,
+        "{name}: status {:?} after {} iterations, f = {}, constr_viol = {:e}, dual_inf = {:e}: {}",
+        sol.status,
+        sol.stats.iterations,
+        sol.objective,
+        sol.constr_viol,
+        sol.dual_inf,
+        sol.message
+    );
+    assert!(
+        sol.constr_viol <= CONSTR_VIOL_TOL,
+        "{name}: constraint violation {:e}",
+        sol.constr_viol
+    );
+    assert!(
+        matched(&run, sol.objective).is_some(),
+        "{name}: f = {:.12e}, published f* = {:.12e} (error {:.1e} > {:.0e}), local {:?}",
+        sol.objective,
+        run.f_star,
+        objective_error(sol.objective, run.f_star),
+        run.tol,
+        run.local
+    );
+}
+
+/// One JSON line per problem and a summary on stderr.
+#[test]
+#[ignore = "report for docs/performance.md: run with --release --ignored --nocapture"]
+fn sqp_hs_summary() {
+    let mut iterations = Vec::new();
+    let mut failed = Vec::new();
+    let mut total = 0.0;
+    for &(name, build) in SUITE {
+        let run = run(name, build, 0);
+        total += run.seconds;
+        let line = match &run.result {
+            Ok(sol) => {
+                let m = matched(&run, sol.objective);
+                if sol.status == Status::SolveSucceeded
+                    && m.is_some()
+                    && sol.constr_viol <= CONSTR_VIOL_TOL
+                {
+                    iterations.push(sol.stats.iterations);
+                } else {
+                    failed.push(name);
+                }
+                serde_json::json!({
+                    "name": name, "status": sol.status, "iterations": sol.stats.iterations,
+                    "objective": sol.objective, "f_star": run.f_star, "matches": m,
+                    "constr_viol": sol.constr_viol, "seconds": run.seconds, "message": sol.message,
+                })
+            }
+            Err(e) => {
+                failed.push(name);
+                serde_json::json!({"name": name, "status": "Error", "error": e.to_string()})
+            }
+        };
+        println!("{line}");
+    }
+    iterations.sort_unstable();
+    let median = if iterations.is_empty() {
+        f64::NAN
+    } else {
+        iterations[iterations.len() / 2] as f64
+    };
+    eprintln!(
+        "{} problems: {} solved, median iterations {median}, total iterations {}, total seconds {total:.3}; failed: {failed:?}",
+        SUITE.len(),
+        iterations.len(),
+        iterations.iter().sum::<usize>()
+    );
+}
+
+/// Iteration tables of the problems named in `HS` (comma-separated).
+#[test]
+#[ignore = "diagnostics: run with HS=<names> --release --ignored --nocapture"]
+fn sqp_hs_log() {
+    let wanted = std::env::var("HS").unwrap_or_default();
+    for name in wanted.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let &(name, build) = SUITE
+            .iter()
+            .find(|(n, _)| *n == name)
+            .unwrap_or_else(|| panic!("no problem {name}"));
+        println!("==== {name}");
+        let run = run(name, build, 5);
+        if let Ok(sol) = &run.result {
+            println!(
+                "{:?} f = {} (f* = {}) {}",
+                sol.status, sol.objective, run.f_star, sol.message
+            );
+        }
+    }
+}
