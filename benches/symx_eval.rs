@@ -106,6 +106,31 @@ fn checksums(name: &str, f: &Function, ins: &[&[f64]]) {
     );
 }
 
+/// (median of medians, minimum) of single-call wall times in µs.
+fn per_call(f: &Function, ins: &[&[f64]]) -> (f64, f64) {
+    let mut out = vec![0.0; f.output_sizes()[0]];
+    let mut work = vec![0.0; f.work_size()];
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut medians = Vec::new();
+    let mut min = f64::INFINITY;
+    for _ in 0..7 {
+        let mut times: Vec<f64> = (0..300)
+            .map(|_| {
+                let t = Instant::now();
+                f.eval(black_box(ins), &mut [&mut out], &mut work).unwrap();
+                black_box(&out);
+                t.elapsed().as_secs_f64() * 1e6
+            })
+            .collect();
+        min = times.iter().fold(min, |m, &t| m.min(t));
+        medians.push(median(&mut times));
+    }
+    (median(&mut medians), min)
+}
+
 fn bench(c: &mut Criterion) {
     let d = differentiate(hanging_chain::build(LINKS));
     let fns = compile(&d);
@@ -115,11 +140,23 @@ fn bench(c: &mut Criterion) {
     checksums("jac_g", &fns.jac, &[&x]);
     checksums("hess_L", &fns.hess, &hess_in);
 
+    // The same statistic as the CasADi script's `internal_us`: the wall time of single
+    // calls, median over 300 calls, median of 7 repetitions (robust to preemption on a
+    // shared machine, unlike a mean over batches).
+    for (name, f, ins) in [
+        ("grad_f", &fns.grad, &hess_in[..1]),
+        ("jac_g", &fns.jac, &hess_in[..1]),
+        ("hess_L", &fns.hess, &hess_in[..]),
+    ] {
+        let (median, min) = per_call(f, ins);
+        eprintln!("{name:7} per-call median {median:8.3} us  min {min:8.3} us");
+    }
+
     let mut group = c.benchmark_group("symx_eval/setup");
     group
         .sample_size(10)
-        .measurement_time(Duration::from_secs(4))
-        .warm_up_time(Duration::from_secs(1));
+        .measurement_time(Duration::from_secs(3))
+        .warm_up_time(Duration::from_millis(500));
     let names = ["expr", "grad_f", "jac_g", "hess_L", "functions", "total"];
     for (k, name) in names.iter().enumerate() {
         group.bench_function(BenchmarkId::from_parameter(name), |b| {
