@@ -215,3 +215,168 @@ fn files_by_extension() {
         .contains("n_step"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn unknown_fields_in_nested_tables_name_the_full_path() {
+    let cases: &[(&str, &str, &[&str])] = &[
+        // (file text, unknown path, fields the message must offer)
+        (
+            "[start.com]\nC = [0.0, 0.5, 0.5]",
+            "start.com.C",
+            &["B", "F"],
+        ),
+        (
+            "[start.feet]\nBX = [0.0, 0.0, 0.0]",
+            "start.feet.BX",
+            &["BR", "FL"],
+        ),
+        ("[start]\nfoot = 1", "start.foot", &["com", "feet"]),
+        ("[friction]\nmuu = 0.4", "friction.muu", &["mu", "f_thr"]),
+        ("[weights]\ncomm = 1.0", "weights.comm", &["com", "force"]),
+        ("[masses]\nM = 60.0", "masses.M", &["B", "F"]),
+        (
+            "[same_side_sq]\nmid = 4.0",
+            "same_side_sq.mid",
+            &["min", "max"],
+        ),
+        (
+            "[goal]\nB = [3.0, 0.5, 0.5]\nW = [0.0, 0.0, 0.0]",
+            "goal.W",
+            &["B", "F"],
+        ),
+        ("gap = { min = 2.2, widht = 0.1 }", "gap.widht", &["depth"]),
+    ];
+    for (text, path, known) in cases {
+        let e = toml(text).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("unknown field `{path}`")),
+            "{text:?}: {e}"
+        );
+        for k in *known {
+            assert!(e.contains(k), "{text:?}: {e} does not offer {k}");
+        }
+    }
+    let e = json(r#"{"start": {"com": {"B": [0, 0.5, 0.5], "Q": [0, 0, 0]}}}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `start.com.Q`"), "{e}");
+    let e = json(r#"{"friction": {"mu": 0.5, "kinetic": 0.4}}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("unknown field `friction.kinetic`"), "{e}");
+}
+
+#[test]
+fn n_step_below_two_is_rejected() {
+    for n in [0, 1] {
+        let msg = rejected(&format!("n_step = {n}"));
+        assert!(
+            msg.contains("n_step")
+                && msg.contains("at least 2")
+                && msg.contains(&format!("got {n}")),
+            "{msg}"
+        );
+        let e = json(&format!(r#"{{"n_step": {n}}}"#))
+            .unwrap()
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("n_step") && e.contains("at least 2"), "{e}");
+    }
+    // A negative count is not a count at all.
+    let e = toml("n_step = -3").unwrap_err().to_string();
+    assert!(
+        e.contains("n_step") && e.contains("non-negative integer"),
+        "{e}"
+    );
+    // n_step = 2 (the start and one more stance) is the smallest valid value.
+    toml("n_step = 2").unwrap().validate().unwrap();
+}
+
+#[test]
+fn friction_coefficient_must_be_positive() {
+    for mu in ["0", "0.0", "-0.0", "-0.5", "-1e-9"] {
+        let msg = rejected(&format!("[friction]\nmu = {mu}"));
+        assert!(
+            msg.contains("friction.mu") && msg.contains("must be positive"),
+            "{mu}: {msg}"
+        );
+    }
+    let mut s = Scenario::default();
+    s.apply_overrides(&["friction.mu=0"]).unwrap();
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("friction.mu") && e.contains("got 0"), "{e}");
+    // Small but positive is accepted.
+    toml("[friction]\nmu = 0.01").unwrap().validate().unwrap();
+}
+
+#[test]
+fn gap_min_must_be_below_gap_max() {
+    for (min, max) in [(2.35, 2.35), (2.5, 2.4), (3.0, 1.0)] {
+        let msg = rejected(&format!("[gap]\nmin = {min:?}\nmax = {max:?}"));
+        assert!(
+            msg.contains("gap.min")
+                && msg.contains("less than gap.max")
+                && msg.contains(&format!("({max})"))
+                && msg.contains(&format!("got {min}")),
+            "{min} {max}: {msg}"
+        );
+    }
+    let e = json(r#"{"gap": {"min": 2.4}}"#)
+        .unwrap()
+        .validate()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("gap.min") && e.contains("2.35"), "{e}");
+}
+
+#[test]
+fn start_violating_rigid_legs_is_rejected_naming_foot_and_values() {
+    // (11) with the front CoM moved 0.1 m sideways: ‖r_F − r_FR‖² = 0.61 and
+    // ‖r_F − r_FL‖² = 0.41 instead of 0.5; the back legs are untouched.
+    let e = rejected("[start.com]\nF = [2.0, 0.6, 0.5]");
+    assert!(e.contains("(11) rigid legs"), "{e}");
+    assert!(
+        e.contains("start.feet.FR") && e.contains("start.feet.FL"),
+        "{e}"
+    );
+    assert!(!e.contains("start.feet.BR"), "back legs are fine: {e}");
+    assert!(e.contains("0.5") && e.contains("leg_length_sq"), "{e}");
+    // A foot moved without its CoM: (11) for that foot only.
+    let e = rejected("[start.feet]\nBL = [0.1, 1.0, 0.0]");
+    assert!(e.contains("(11)") && e.contains("foot BL"), "{e}");
+    assert!(!e.contains("foot BR"), "{e}");
+    // Changing leg_length_sq without moving the start breaks all four legs.
+    let e = rejected("leg_length_sq = 0.6");
+    for f in ["BR", "BL", "FR", "FL"] {
+        assert!(e.contains(&format!("start.feet.{f}")), "{f}: {e}");
+    }
+    // Off by 2e-6 m² (beyond the 1e-6 tolerance) is rejected; by 5e-7 it is accepted.
+    let z = |d: f64| (0.25f64 + d).sqrt();
+    rejected(&format!("[start.com]\nB = [0.0, 0.5, {}]", z(2e-6)));
+    toml(&format!("[start.com]\nB = [0.0, 0.5, {}]", z(5e-7)))
+        .unwrap()
+        .validate()
+        .unwrap();
+}
+
+#[test]
+fn every_problem_is_reported_at_once() {
+    let msg = rejected("n_step = 1\n[masses]\nB = 0.0\n[friction]\nmu = -1.0\n[gap]\nmin = 3.0");
+    for needle in ["n_step", "masses.B", "friction.mu", "gap.min"] {
+        assert!(msg.contains(needle), "{needle}: {msg}");
+    }
+    match toml("[friction]\nmu = 0.0\n[masses]\nF = -1.0")
+        .unwrap()
+        .validate()
+    {
+        Err(ScenarioError::Invalid(list)) => {
+            let fields: Vec<&str> = list.iter().map(|i| i.field.as_str()).collect();
+            assert!(
+                fields.contains(&"friction.mu") && fields.contains(&"masses.F"),
+                "{fields:?}"
+            );
+        }
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+}
