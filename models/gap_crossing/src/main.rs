@@ -203,21 +203,18 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let file = &outcome.file;
     let report = check::check(file);
 
-    // Convergence records of all solver runs, numbered on; (10)'s residual is known at
-    // the end of each run.
+    // Convergence records of all solver runs, numbered on. The complementarity residual
+    // per iteration is the interior point's: the barrier parameter μ that the products of
+    // slacks and multipliers are driven to. The residual of (10) is known only at the end
+    // of each run (iterates are not recorded): it is printed in the summary below.
     let mut records = Vec::new();
     for phase in &outcome.phases {
-        let last = phase.records.len().saturating_sub(1);
-        for (k, r) in phase.records.iter().enumerate() {
+        for r in &phase.records {
             records.push(IterRecord {
                 iter: records.len(),
                 objective: r.objective,
                 inf_pr: r.inf_pr,
-                compl: if k == last {
-                    phase.complementarity
-                } else {
-                    f64::NAN
-                },
+                compl: r.mu,
             });
         }
     }
