@@ -193,10 +193,12 @@ fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
 
 fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let s = scenario(&a.scenario)?;
-    let mut settings = Settings::default();
-    settings.backend = match a.solver {
-        None | Some(SolverArg::Ipm) => Backend::Ipm,
-        Some(SolverArg::Sqp) => Backend::Sqp,
+    let mut settings = Settings {
+        backend: match a.solver {
+            None | Some(SolverArg::Ipm) => Backend::Ipm,
+            Some(SolverArg::Sqp) => Backend::Sqp,
+        },
+        ..Settings::default()
     };
     settings.ipm.print_level = 5;
     let outcome = solve::plan(&s, &settings)?;
