@@ -463,3 +463,13 @@ fn compiled_function_evaluates_common_subexpressions_once() {
         2.0 * (0.5f64.sin() * 0.5f64.cos()).exp()
     );
 }
+
+/// Names with a superscript and an index, as the gap-crossing model prints them
+/// (`r_BR^3[0]`), parse back to the same node.
+#[test]
+fn superscripted_indexed_names_round_trip() {
+    let x = symx::Matrix::sym_vec("r_BR^3", 2);
+    let e = (x[0] - x[1]).sq() + x[0].sin();
+    let back = symx::parse(&e.to_string(), &x).unwrap();
+    assert!(back.is(e), "{e} parsed as {back}");
+}

@@ -142,6 +142,9 @@ impl fmt::Display for Expr {
 
 /// Parses the printed form of an expression, resolving names against `symbols`.
 ///
+/// Symbol names are letters, digits, `_`, `.` and `^`, optionally followed by bracketed
+/// indices (`x[3]`, `A[1,2]`, `r_BR^3[0]`); other names do not parse back.
+///
 /// `parse(&e.to_string(), symbols)` returns `e` itself (the same node) when `symbols`
 /// holds every symbol of `e` under distinct names.
 pub fn parse(text: &str, symbols: &[Expr]) -> Result<Expr, SymxError> {
@@ -392,7 +395,7 @@ impl Parser<'_> {
                 let start = self.pos;
                 while self.pos < self.s.len() {
                     let c = self.s[self.pos];
-                    if c.is_ascii_alphanumeric() || matches!(c, b'_' | b'.') {
+                    if c.is_ascii_alphanumeric() || matches!(c, b'_' | b'.' | b'^') {
                         self.pos += 1;
                     } else if c == b'[' {
                         // Indexed names such as `x[3]` or `A[1,2]`.

@@ -320,7 +320,7 @@ pub fn build(
     if has_penalty {
         let penalty = pb.scalar_parameter(PENALTY);
         pb.set_value(&[penalty], &[1.0])?;
-        cost = cost + penalty * complementarity.into_iter().sum::<Expr>();
+        cost += penalty * complementarity.into_iter().sum::<Expr>();
     }
     pb.minimize(cost);
 
