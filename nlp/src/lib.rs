@@ -17,7 +17,7 @@ pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
 pub use error::SolveError;
 pub use ipm::Ipm;
-pub use problem::{Block, BuildError, Problem};
+pub use problem::{Block, BuildError, ComplementarityReport, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
 pub use numeric::{AffineCone, NumericNlp};

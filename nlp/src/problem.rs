@@ -10,16 +10,28 @@ use thiserror::Error;
 pub enum BuildError {
     /// A lower bound above an upper bound.
     #[error("{what}: lower bound {lower} > upper bound {upper}")]
-    InvertedBounds { what: String, lower: f64, upper: f64 },
+    InvertedBounds {
+        what: String,
+        lower: f64,
+        upper: f64,
+    },
     /// NaN (or ∞ where a finite value is required).
     #[error("{what}: {value} is not allowed")]
     NotFinite { what: String, value: f64 },
     /// Two lengths that must agree.
     #[error("{what}: expected {expected} values, got {got}")]
-    Size { what: String, expected: usize, got: usize },
+    Size {
+        what: String,
+        expected: usize,
+        got: usize,
+    },
     /// An expression used where a variable (or parameter) of this problem is required.
     #[error("{what}: entry {index} is not a {kind} of this problem")]
-    NotDeclared { what: String, index: usize, kind: &'static str },
+    NotDeclared {
+        what: String,
+        index: usize,
+        kind: &'static str,
+    },
     /// A parameter whose value was never set.
     #[error("parameter '{name}' has no value (call set_value)")]
     MissingParameterValue { name: String },
@@ -28,7 +40,11 @@ pub enum BuildError {
     FreeSymbol { location: String, name: String },
     /// A constraint between matrices of different shapes.
     #[error("constraint '{name}': shapes {left:?} and {right:?} differ")]
-    ShapeMismatch { name: String, left: (usize, usize), right: (usize, usize) },
+    ShapeMismatch {
+        name: String,
+        left: (usize, usize),
+        right: (usize, usize),
+    },
     /// A constraint that does not involve any variable.
     #[error("constraint '{name}' row {row} does not depend on any variable")]
     ConstantConstraint { name: String, row: usize },
@@ -86,16 +102,24 @@ pub struct Problem {
     objective: Option<Expr>,
     rows: Vec<Row>,
     constraint_blocks: Vec<Block>,
+    complementarity: Vec<(String, Expr, Expr)>,
 }
 
 fn check_bound(what: impl Fn() -> String, lower: f64, upper: f64) -> Result<(), BuildError> {
     for v in [lower, upper] {
         if v.is_nan() {
-            return Err(BuildError::NotFinite { what: what(), value: v });
+            return Err(BuildError::NotFinite {
+                what: what(),
+                value: v,
+            });
         }
     }
     if lower > upper {
-        return Err(BuildError::InvertedBounds { what: what(), lower, upper });
+        return Err(BuildError::InvertedBounds {
+            what: what(),
+            lower,
+            upper,
+        });
     }
     Ok(())
 }
@@ -107,8 +131,15 @@ impl Problem {
     }
 
     fn check_name(&self, name: &str) -> Result<(), BuildError> {
-        if self.variable_blocks.iter().chain(&self.parameter_blocks).any(|b| b.name == name) {
-            return Err(BuildError::DuplicateName { name: name.to_string() });
+        if self
+            .variable_blocks
+            .iter()
+            .chain(&self.parameter_blocks)
+            .any(|b| b.name == name)
+        {
+            return Err(BuildError::DuplicateName {
+                name: name.to_string(),
+            });
         }
         Ok(())
     }
@@ -141,7 +172,11 @@ impl Problem {
     }
 
     fn push_variables(&mut self, name: &str, x: &[Expr]) {
-        self.variable_blocks.push(Block { name: name.to_string(), start: self.variables.len(), len: x.len() });
+        self.variable_blocks.push(Block {
+            name: name.to_string(),
+            start: self.variables.len(),
+            len: x.len(),
+        });
         for &e in x {
             self.variable_index.insert(e.id(), self.variables.len());
             self.variables.push(e);
@@ -167,7 +202,11 @@ impl Problem {
     }
 
     fn push_parameters(&mut self, name: &str, p: &[Expr]) {
-        self.parameter_blocks.push(Block { name: name.to_string(), start: self.parameters.len(), len: p.len() });
+        self.parameter_blocks.push(Block {
+            name: name.to_string(),
+            start: self.parameters.len(),
+            len: p.len(),
+        });
         for &e in p {
             self.parameter_index.insert(e.id(), self.parameters.len());
             self.parameters.push(e);
@@ -186,19 +225,29 @@ impl Problem {
             .map(|(index, e)| {
                 map.get(&e.id())
                     .copied()
-                    .ok_or_else(|| BuildError::NotDeclared { what: what.to_string(), index, kind })
+                    .ok_or_else(|| BuildError::NotDeclared {
+                        what: what.to_string(),
+                        index,
+                        kind,
+                    })
             })
             .collect()
     }
 
     fn variable_name(&self, i: usize) -> String {
-        self.variables[i].name().unwrap_or_else(|| format!("x[{i}]"))
+        self.variables[i]
+            .name()
+            .unwrap_or_else(|| format!("x[{i}]"))
     }
 
     /// Sets `lower ≤ xᵢ ≤ upper` for every entry of `x` (±∞ for none).
     pub fn set_bounds(&mut self, x: &[Expr], lower: f64, upper: f64) -> Result<(), BuildError> {
         for i in self.indices(x, "set_bounds", true)? {
-            check_bound(|| format!("bounds of variable '{}'", self.variable_name(i)), lower, upper)?;
+            check_bound(
+                || format!("bounds of variable '{}'", self.variable_name(i)),
+                lower,
+                upper,
+            )?;
             self.lower[i] = lower;
             self.upper[i] = upper;
         }
@@ -209,11 +258,18 @@ impl Problem {
     pub fn set_initial(&mut self, x: &[Expr], values: &[f64]) -> Result<(), BuildError> {
         let idx = self.indices(x, "set_initial", true)?;
         if values.len() != idx.len() {
-            return Err(BuildError::Size { what: "set_initial".into(), expected: idx.len(), got: values.len() });
+            return Err(BuildError::Size {
+                what: "set_initial".into(),
+                expected: idx.len(),
+                got: values.len(),
+            });
         }
         for (&i, &v) in idx.iter().zip(values) {
             if !v.is_finite() {
-                return Err(BuildError::NotFinite { what: format!("initial value of '{}'", self.variable_name(i)), value: v });
+                return Err(BuildError::NotFinite {
+                    what: format!("initial value of '{}'", self.variable_name(i)),
+                    value: v,
+                });
             }
             self.initial[i] = v;
         }
@@ -224,12 +280,19 @@ impl Problem {
     pub fn set_value(&mut self, p: &[Expr], values: &[f64]) -> Result<(), BuildError> {
         let idx = self.indices(p, "set_value", false)?;
         if values.len() != idx.len() {
-            return Err(BuildError::Size { what: "set_value".into(), expected: idx.len(), got: values.len() });
+            return Err(BuildError::Size {
+                what: "set_value".into(),
+                expected: idx.len(),
+                got: values.len(),
+            });
         }
         for (&i, &v) in idx.iter().zip(values) {
             if !v.is_finite() {
                 let name = self.parameters[i].name().unwrap_or_default();
-                return Err(BuildError::NotFinite { what: format!("value of parameter '{name}'"), value: v });
+                return Err(BuildError::NotFinite {
+                    what: format!("value of parameter '{name}'"),
+                    value: v,
+                });
             }
             self.parameter_values[i] = Some(v);
         }
@@ -254,19 +317,39 @@ impl Problem {
     /// becomes a row of `g`.
     pub fn subject_to_named(&mut self, name: &str, c: Constraint) -> Result<(), BuildError> {
         if let Some((left, right)) = c.mismatch {
-            return Err(BuildError::ShapeMismatch { name: name.to_string(), left, right });
+            return Err(BuildError::ShapeMismatch {
+                name: name.to_string(),
+                left,
+                right,
+            });
         }
         let start = self.rows.len();
         for (k, row) in c.rows.iter().enumerate() {
-            check_bound(|| format!("constraint '{name}' row {k}"), row.lower, row.upper)?;
+            check_bound(
+                || format!("constraint '{name}' row {k}"),
+                row.lower,
+                row.upper,
+            )?;
             if row.expr.value().is_some() {
-                return Err(BuildError::ConstantConstraint { name: name.to_string(), row: k });
+                return Err(BuildError::ConstantConstraint {
+                    name: name.to_string(),
+                    row: k,
+                });
             }
         }
         for row in c.rows {
             if let Some(&i) = self.variable_index.get(&row.expr.id()) {
                 let (lo, hi) = (self.lower[i].max(row.lower), self.upper[i].min(row.upper));
-                check_bound(|| format!("bounds of variable '{}' (from constraint '{name}')", self.variable_name(i)), lo, hi)?;
+                check_bound(
+                    || {
+                        format!(
+                            "bounds of variable '{}' (from constraint '{name}')",
+                            self.variable_name(i)
+                        )
+                    },
+                    lo,
+                    hi,
+                )?;
                 self.lower[i] = lo;
                 self.upper[i] = hi;
             } else {
@@ -274,9 +357,71 @@ impl Problem {
             }
         }
         if self.rows.len() > start {
-            self.constraint_blocks.push(Block { name: name.to_string(), start, len: self.rows.len() - start });
+            self.constraint_blocks.push(Block {
+                name: name.to_string(),
+                start,
+                len: self.rows.len() - start,
+            });
         }
         Ok(())
+    }
+
+    /// Adds the complementarity constraint `0 ≤ a ⊥ b ≥ 0` (a ≥ 0, b ≥ 0, a·b = 0).
+    ///
+    /// It is compiled as an ordinary NLP in the form of Fletcher & Leyffer (2004), "Solving
+    /// mathematical programs with complementarity constraints as nonlinear programs",
+    /// Optim. Methods Softw. 19(1): rows (or bounds) `a ≥ 0`, `b ≥ 0` and the product row
+    /// `a·b ≤ 0` (named `name.a`, `name.b`, `name.ab`). The SQP back end solves this form
+    /// directly, its elastic mode absorbing the QPs made degenerate by the product (no
+    /// constraint qualification holds at a solution). The pair is recorded:
+    /// [`Problem::complementarity_report`] gives the residual and the biactive set.
+    pub fn complementarity(&mut self, name: &str, a: Expr, b: Expr) -> Result<(), BuildError> {
+        use crate::constraint::Relation;
+        self.subject_to_named(&format!("{name}.a"), a.ge(0.0))?;
+        self.subject_to_named(&format!("{name}.b"), b.ge(0.0))?;
+        self.subject_to_named(&format!("{name}.ab"), (a * b).le(0.0))?;
+        self.complementarity.push((name.to_string(), a, b));
+        Ok(())
+    }
+
+    /// The n-ary form: every `qᵢ ≥ 0` and at most one of them non-zero, i.e. the pairwise
+    /// complementarity `qᵢ ⊥ qⱼ` for i < j (pairs named `name[i,j]`).
+    pub fn complementarity_nary(&mut self, name: &str, q: &[Expr]) -> Result<(), BuildError> {
+        for i in 0..q.len() {
+            for j in i + 1..q.len() {
+                self.complementarity(&format!("{name}[{i},{j}]"), q[i], q[j])?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Complementarity residual max over pairs of |min(a, b)| (zero iff a ≥ 0, b ≥ 0 and
+    /// one of them is zero) at `x`, and the biactive pairs (both a and b ≤ `tol`).
+    pub fn complementarity_report(
+        &self,
+        x: &[f64],
+        tol: f64,
+    ) -> Result<ComplementarityReport, BuildError> {
+        let exprs: Vec<Expr> = self
+            .complementarity
+            .iter()
+            .flat_map(|(_, a, b)| [*a, *b])
+            .collect();
+        let v = self.evaluate(&exprs, x)?;
+        let mut residual: f64 = 0.0;
+        let mut biactive = Vec::new();
+        for (k, (name, _, _)) in self.complementarity.iter().enumerate() {
+            let (a, b) = (v[2 * k], v[2 * k + 1]);
+            residual = residual.max(a.min(b).abs());
+            if a.abs() <= tol && b.abs() <= tol {
+                biactive.push(name.clone());
+            }
+        }
+        Ok(ComplementarityReport {
+            residual,
+            biactive,
+            pairs: self.complementarity.len(),
+        })
     }
 
     /// Number of variables.
@@ -323,7 +468,11 @@ impl Problem {
     /// (parameters at their current values), e.g. to read a solution.
     pub fn evaluate(&self, exprs: &[Expr], x: &[f64]) -> Result<Vec<f64>, BuildError> {
         if x.len() != self.variables.len() {
-            return Err(BuildError::Size { what: "evaluate: x".into(), expected: self.variables.len(), got: x.len() });
+            return Err(BuildError::Size {
+                what: "evaluate: x".into(),
+                expected: self.variables.len(),
+                got: x.len(),
+            });
         }
         let p = self.parameter_vector()?;
         let f = self.function(exprs, "evaluate")?;
@@ -345,7 +494,10 @@ impl Problem {
     /// Compiles `exprs` as a function of `(x, p)`; a free symbol is reported with `location`.
     fn function(&self, exprs: &[Expr], location: &str) -> Result<symx::Function, BuildError> {
         symx::Function::new(&[&self.variables, &self.parameters], &[exprs]).map_err(|e| match e {
-            symx::SymxError::FreeSymbol { name, .. } => BuildError::FreeSymbol { location: location.to_string(), name },
+            symx::SymxError::FreeSymbol { name, .. } => BuildError::FreeSymbol {
+                location: location.to_string(),
+                name,
+            },
             e => e.into(),
         })
     }
@@ -360,7 +512,10 @@ impl Problem {
         self.function(&[f], "the objective")?;
         if let Err(e @ BuildError::FreeSymbol { .. }) = self.function(&g, "constraints") {
             for (i, row) in self.rows.iter().enumerate() {
-                self.function(&[row.expr], &format!("constraint '{}'", self.constraint_name(i)))?;
+                self.function(
+                    &[row.expr],
+                    &format!("constraint '{}'", self.constraint_name(i)),
+                )?;
             }
             return Err(e);
         }
@@ -380,6 +535,17 @@ impl Problem {
             constraint_blocks: &self.constraint_blocks,
         }
     }
+}
+
+/// Complementarity at a point: see [`Problem::complementarity_report`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ComplementarityReport {
+    /// max over pairs of |min(a, b)|.
+    pub residual: f64,
+    /// Names of the pairs with both sides within the tolerance of zero.
+    pub biactive: Vec<String>,
+    /// Number of pairs.
+    pub pairs: usize,
 }
 
 /// Borrowed pieces of a problem handed to [`Compiled::new`].

@@ -651,7 +651,11 @@ impl Sqp {
                 match res.status {
                     S::Solved | S::AlmostSolved => {}
                     S::DualInfeasible | S::AlmostDualInfeasible if tries < 8 => {
-                        // Unbounded QP: B too flat along a feasible direction.
+                        // Unbounded QP: B too flat along a feasible direction, or the
+                        // lifted augmented term (convex only on w = J d) did not make
+                        // clarabel's P convex: fall back to a pure shift.
+                        row_weight.iter_mut().for_each(|v| *v = 0.0);
+                        bound_weight.iter_mut().for_each(|v| *v = 0.0);
                         qp_shift = (qp_shift * 100.0).max(o.first_hessian_shift);
                         continue;
                     }
