@@ -200,7 +200,7 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
         },
         ..Settings::default()
     };
-    settings.ipm.print_level = 5;
+    settings.set_print_level(5);
     let outcome = solve::plan(&s, &settings)?;
     let file = &outcome.file;
     let report = check::check(file);

@@ -20,7 +20,10 @@ use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
 use crate::scenario::{Foot, Gait, Scenario};
 use crate::terrain::{GapTerrain, Terrain};
 use nlp::ipm::Ipm;
-use nlp::{BuildError, IpmOptions, IterationRecord, NumericNlp, Solution, SolveError, Status};
+use nlp::{
+    BuildError, IpmOptions, IterationRecord, NumericNlp, Solution, SolveError, Sqp, SqpOptions,
+    Status,
+};
 use std::time::Instant;
 
 /// Complementarity residual below which the free gait's first phase stops raising `π`.
@@ -38,7 +41,7 @@ pub enum Backend {
     /// The interior-point method.
     #[default]
     Ipm,
-    /// The SQP method (not available yet).
+    /// The SQP method (QPs by Clarabel).
     Sqp,
 }
 
@@ -49,6 +52,30 @@ pub struct Settings {
     pub backend: Backend,
     /// Interior-point options (tolerances, print level, limits).
     pub ipm: IpmOptions,
+    /// SQP options (used with [`Backend::Sqp`]).
+    pub sqp: SqpOptions,
+}
+
+impl Settings {
+    /// Sets the iteration-log verbosity of both back ends.
+    pub fn set_print_level(&mut self, level: u8) {
+        self.ipm.print_level = level;
+        self.sqp.print_level = level;
+    }
+
+    fn print_level(&self) -> u8 {
+        match self.backend {
+            Backend::Ipm => self.ipm.print_level,
+            Backend::Sqp => self.sqp.print_level,
+        }
+    }
+
+    fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
+        match self.backend {
+            Backend::Ipm => Ipm::new(self.ipm.clone()).solve(nlp),
+            Backend::Sqp => Sqp::new(self.sqp.clone()).solve(nlp),
+        }
+    }
 }
 
 /// One solver run within a plan's solve (the free gait has several).
@@ -84,8 +111,6 @@ pub enum PlanningError {
     Solve(#[from] SolveError),
     #[error("reading the plan: {0}")]
     Plan(#[from] PlanError),
-    #[error("the {0:?} back end is not available yet (use --solver ipm)")]
-    Unavailable(Backend),
 }
 
 /// Residual of (10) for a flat plan: the largest `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²` over transitions.
@@ -188,12 +213,11 @@ fn run(
     phases: &mut Vec<Phase>,
     name: &str,
 ) -> Result<Run, PlanningError> {
-    if settings.ipm.print_level > 0 {
+    if settings.print_level() > 0 {
         println!("\n== {name}");
     }
     let model = model::build(s, terrain, formulation, guess)?;
     let mut compiled = model.problem.compile()?;
-    let ipm = Ipm::new(settings.ipm.clone());
     let penalties: &[f64] = if model.has_penalty {
         &PENALTIES
     } else {
@@ -208,7 +232,7 @@ fn run(
         if let Some(prev) = &last {
             compiled.set_initial_point(&prev.solution.x)?;
         }
-        let solution = ipm.solve(&mut compiled)?;
+        let solution = settings.solve(&mut compiled)?;
         let flat = model.problem.evaluate(&model.layout, &solution.x)?;
         let complementarity = complementarity_residual(s, &flat);
         phases.push(Phase {
@@ -252,9 +276,6 @@ pub fn plan_on(
     terrain: &dyn Terrain,
     settings: &Settings,
 ) -> Result<Outcome, PlanningError> {
-    if settings.backend != Backend::Ipm {
-        return Err(PlanningError::Unavailable(settings.backend));
-    }
     let started = Instant::now();
     let mut phases = Vec::new();
     let guess = gait::crawl(s);
@@ -312,7 +333,11 @@ pub fn plan_on(
     };
     let plan = Plan::from_flat(s, &last.flat)?;
     let solver = SolverInfo {
-        name: "ipm".into(),
+        name: match settings.backend {
+            Backend::Ipm => "ipm",
+            Backend::Sqp => "sqp",
+        }
+        .into(),
         status: status_name(last.solution.status).into(),
         iterations: phases
             .iter()
