@@ -6,6 +6,7 @@ pub mod error;
 pub mod ipm;
 pub mod kkt;
 pub mod log;
+pub mod mpcc;
 pub mod numeric;
 pub mod options;
 pub mod problem;
@@ -21,6 +22,7 @@ pub use problem::{Block, BuildError, ComplementarityReport, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
 pub use numeric::{AffineCone, NumericNlp};
+pub use mpcc::{solve_mpcc, MpccBackend, MpccError, MpccOptions, MpccPhase, MpccSolution};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
 pub use solution::{IterationRecord, Solution, Stats, Status};

@@ -424,6 +424,51 @@ impl Problem {
         })
     }
 
+    /// The complementarity pairs (name, a, b) in the order they were added.
+    pub fn complementarity_pairs(&self) -> &[(String, Expr, Expr)] {
+        &self.complementarity
+    }
+
+    /// A copy for the MPCC driver ([`crate::mpcc`]): the same variables, bounds, initial
+    /// point, parameters, rows and pairs, with objective `objective`; without the product
+    /// rows `name.ab` of the pairs unless `keep_products`.
+    pub(crate) fn mpcc_copy(&self, objective: Expr, keep_products: bool) -> Problem {
+        let products: std::collections::HashSet<String> = self
+            .complementarity
+            .iter()
+            .map(|(name, _, _)| format!("{name}.ab"))
+            .collect();
+        let mut rows = Vec::with_capacity(self.rows.len());
+        let mut constraint_blocks = Vec::with_capacity(self.constraint_blocks.len());
+        for b in &self.constraint_blocks {
+            if !keep_products && products.contains(&b.name) {
+                continue;
+            }
+            constraint_blocks.push(Block {
+                name: b.name.clone(),
+                start: rows.len(),
+                len: b.len,
+            });
+            rows.extend_from_slice(&self.rows[b.range()]);
+        }
+        Problem {
+            variables: self.variables.clone(),
+            variable_blocks: self.variable_blocks.clone(),
+            lower: self.lower.clone(),
+            upper: self.upper.clone(),
+            initial: self.initial.clone(),
+            variable_index: self.variable_index.clone(),
+            parameters: self.parameters.clone(),
+            parameter_blocks: self.parameter_blocks.clone(),
+            parameter_values: self.parameter_values.clone(),
+            parameter_index: self.parameter_index.clone(),
+            objective: Some(objective),
+            rows,
+            constraint_blocks,
+            complementarity: self.complementarity.clone(),
+        }
+    }
+
     /// Number of variables.
     pub fn n_variables(&self) -> usize {
         self.variables.len()

@@ -619,6 +619,7 @@ impl Sqp {
             // ---- QP (elastic loop) ----
             let mut qp_shift = delta;
             let mut tries = 0;
+            let mut elastic_prev: Option<(QpResult, f64, f64)> = None;
             let res: Option<QpResult> = loop {
                 let data = QpData {
                     x: &x,
@@ -651,9 +652,10 @@ impl Sqp {
                 match res.status {
                     S::Solved | S::AlmostSolved => {}
                     S::DualInfeasible | S::AlmostDualInfeasible if tries < 8 => {
-                        // Unbounded QP: B too flat along a feasible direction, or the
-                        // lifted augmented term (convex only on w = J d) did not make
-                        // clarabel's P convex: fall back to a pure shift.
+                        // Unbounded QP: B too flat along a feasible direction (δ·I and
+                        // ρ_a·J_AᵀJ_A certified by `Convexify` are positive definite,
+                        // but a near-singular B may still read as unbounded to
+                        // clarabel): fall back to a pure shift.
                         row_weight.iter_mut().for_each(|v| *v = 0.0);
                         bound_weight.iter_mut().for_each(|v| *v = 0.0);
                         qp_shift = (qp_shift * 100.0).max(o.first_hessian_shift);
@@ -669,9 +671,24 @@ impl Sqp {
                     }
                 }
                 let e_max = res.e.iter().fold(0.0f64, |a, v| a.max(*v));
-                if e_max > o.elastic_tol && rho < o.penalty_max && tries < 12 {
-                    rho = (rho * o.penalty_increase).min(o.penalty_max);
-                    continue;
+                let e_sum: f64 = res.e.iter().map(|v| v.max(0.0)).sum();
+                if e_max > o.elastic_tol {
+                    // Elastic mode. A larger ρ helps only while it lowers the linearised
+                    // infeasibility; when the linearisation is inconsistent (typical of
+                    // complementarity products away from the solution) Σe stalls, and
+                    // the step of the smaller ρ is kept (Fletcher & Leyffer 2004, §3).
+                    if let Some((_, prev_sum, _)) = &elastic_prev {
+                        if e_sum > 0.9 * prev_sum {
+                            let (prev, _, prev_rho) = elastic_prev.take().expect("checked");
+                            rho = prev_rho;
+                            break Some(prev);
+                        }
+                    }
+                    if rho < o.penalty_max && tries < 12 {
+                        elastic_prev = Some((res, e_sum, rho));
+                        rho = (rho * o.penalty_increase).min(o.penalty_max);
+                        continue;
+                    }
                 }
                 break Some(res);
             };

@@ -42,8 +42,6 @@ pub(crate) enum RowKind {
     Elastic,
     /// Entry `k` (into the stacked cone vector [t; v] of every cone) of an SOC block.
     Cone(usize),
-    /// Definition `J_i d − w_i = 0` of the auxiliary variable of row i.
-    Aux(usize),
 }
 
 /// Where a value of A comes from.
@@ -99,7 +97,7 @@ pub(crate) struct QpResult {
     pub z_u: Vec<f64>,
     /// Duals of the cone rows (stacked like the cone entries).
     pub z_cone: Vec<f64>,
-    /// Duals of the rows `J_i d − w_i = 0` (zero without the augmented term).
+    /// ρ_a·J_i d per row (the augmented term's share of the row multiplier; zero without it).
     pub z_w: Vec<f64>,
     pub status: SolverStatus,
     pub iterations: u32,
@@ -133,10 +131,15 @@ pub(crate) struct Qp {
     solver: Option<DefaultSolver<f64>>,
     /// Cone blocks: (row offset in the stacked cone vector, dimension).
     cone_blocks: Vec<(usize, usize)>,
-    /// First column of the auxiliary variables w (one per row of g), if present.
-    w_col: Option<usize>,
-    /// P position of the diagonal of each w.
-    w_diag: Vec<usize>,
+    /// Whether P holds the augmented term ρ_a·J_AᵀJ_A.
+    aug: bool,
+    /// Jacobian entries (column, storage position) of each row of g.
+    jrows: Vec<Vec<(usize, usize)>>,
+    /// Products of the augmented term: (row, position of J_ia, of J_ib, P position).
+    jtj: Vec<(usize, usize, usize, usize)>,
+    /// Jacobian values and row weights of the last `fill` (to recover λ from the QP).
+    jac_copy: Vec<f64>,
+    weight_copy: Vec<f64>,
 }
 
 /// Builds CSC from (row, col, payload) triplets (no duplicates); returns colptr, rowval
@@ -225,16 +228,6 @@ impl Qp {
                 a_trip.push((r, j, Src::Const(1.0)));
             }
         }
-        // Auxiliary variables w_i = J_i d (augmented-Lagrangian convexification).
-        let mut w_rows = Vec::new();
-        if aug {
-            for i in 0..m {
-                if !skip_rows[i] {
-                    let r = push_g_row(&mut rows, RowKind::Aux(i), i, 1.0, &mut a_trip);
-                    w_rows.push((r, i));
-                }
-            }
-        }
         let n_zero = rows.len();
         // Nonnegative cone.
         for i in 0..m {
@@ -304,12 +297,6 @@ impl Qp {
         }
         let n_e = next_e - n;
         let _ = elastic;
-        // w columns come after the elastic ones (w_i for row i at w_col + i).
-        let w_col = aug.then_some(next_e);
-        for &(r, i) in &w_rows {
-            a_trip.push((r, next_e + i, Src::Const(-1.0)));
-        }
-        let n_w = if aug { m } else { 0 };
         let mut cones = Vec::new();
         if n_zero > 0 {
             cones.push(SupportedConeT::ZeroConeT(n_zero));
@@ -320,53 +307,75 @@ impl Qp {
         for &(_, dim) in cone_blocks {
             cones.push(SupportedConeT::SecondOrderConeT(dim));
         }
-        let ncols = n + n_e + n_w;
+        let ncols = n + n_e;
         let (a_colptr, a_rowval, a_src) = to_csc(ncols, a_trip);
         let a_vals = vec![0.0; a_src.len()];
-        // ---- P: upper triangle of B (transpose of the lower Hessian pattern) + diagonal ----
-        let mut p_trip: Vec<(usize, usize, usize)> = Vec::new();
+        // ---- P: upper triangle of B (transpose of the lower Hessian pattern) + diagonal,
+        // plus (augmented-Lagrangian convexification) the pattern of JᵀJ, so that
+        // P = H + δI + ρ_a·(J_AᵀJ_A + I_b) is exactly the matrix `Convexify` certified
+        // positive definite. The pattern of JᵀJ over all rows contains that of any active
+        // subset, so it is fixed. ----
+        let mut pat: Vec<(usize, usize)> = Vec::new(); // (col, row), row ≤ col
         if dense {
             for j in 0..n {
                 for i in 0..=j {
-                    p_trip.push((i, j, usize::MAX));
+                    pat.push((j, i));
                 }
             }
         } else {
-            let mut has_diag = vec![false; n];
             for c in 0..n {
                 for p in hess.col_range(c) {
                     let r = hess.row_idx()[p];
-                    if r == c {
-                        has_diag[c] = true;
+                    pat.push((r.max(c), r.min(c)));
+                }
+                pat.push((c, c));
+            }
+        }
+        if aug {
+            for row in &jrows {
+                for (a, &(ca, _)) in row.iter().enumerate() {
+                    for &(cb, _) in &row[a..] {
+                        pat.push((ca.max(cb), ca.min(cb)));
                     }
-                    p_trip.push((c, r, p));
-                }
-            }
-            for (j, &h) in has_diag.iter().enumerate() {
-                if !h {
-                    p_trip.push((j, j, usize::MAX));
                 }
             }
         }
-        const W: usize = usize::MAX - 1;
-        for i in 0..n_w {
-            p_trip.push((n + n_e + i, n + n_e + i, W));
+        pat.sort_unstable();
+        pat.dedup();
+        let mut p_colptr = vec![0usize; ncols + 1];
+        for &(c, _) in &pat {
+            p_colptr[c + 1] += 1;
         }
-        let (p_colptr, p_rowval, p_src) = to_csc(ncols, p_trip);
-        let mut w_diag = vec![0usize; n_w];
-        for i in 0..n_w {
-            let c = n + n_e + i;
-            w_diag[i] = p_colptr[c];
+        for c in 0..ncols {
+            p_colptr[c + 1] += p_colptr[c];
         }
+        let p_rowval: Vec<usize> = pat.iter().map(|&(_, r)| r).collect();
+        let pos = |r: usize, c: usize| -> usize {
+            let (r, c) = (r.min(c), r.max(c));
+            let lo = p_colptr[c];
+            lo + p_rowval[lo..p_colptr[c + 1]]
+                .binary_search(&r)
+                .expect("entry in the pattern of P")
+        };
         let mut h_pos = vec![0usize; hess.row_idx().len()];
         let mut diag_pos = vec![0usize; n];
-        for c in 0..ncols.min(n) {
-            for k in p_colptr[c]..p_colptr[c + 1] {
-                if p_rowval[k] == c {
-                    diag_pos[c] = k;
+        if !dense {
+            for c in 0..n {
+                for p in hess.col_range(c) {
+                    h_pos[p] = pos(hess.row_idx()[p], c);
                 }
-                if p_src[k] < W {
-                    h_pos[p_src[k]] = k;
+            }
+        }
+        for (j, dp) in diag_pos.iter_mut().enumerate() {
+            *dp = pos(j, j);
+        }
+        let mut jtj = Vec::new();
+        if aug {
+            for (i, row) in jrows.iter().enumerate() {
+                for (a, &(ca, pa)) in row.iter().enumerate() {
+                    for &(cb, pb) in &row[a..] {
+                        jtj.push((i, pa, pb, pos(ca, cb)));
+                    }
                 }
             }
         }
@@ -394,14 +403,17 @@ impl Qp {
             max_iter,
             solver: None,
             cone_blocks: cone_blocks.to_vec(),
-            w_col,
-            w_diag,
+            aug,
+            jrows,
+            jtj,
+            jac_copy: Vec::new(),
+            weight_copy: vec![0.0; m],
         }
     }
 
     /// Whether the QP has the auxiliary variables of the augmented-Lagrangian term.
     pub fn has_aug(&self) -> bool {
-        self.w_col.is_some()
+        self.aug
     }
 
     fn settings(&self) -> DefaultSettings<f64> {
@@ -440,8 +452,18 @@ impl Qp {
             for j in 0..n {
                 self.p_vals[self.diag_pos[j]] += data.shift + data.bound_weight[j];
             }
-            for (i, &pos) in self.w_diag.iter().enumerate() {
-                self.p_vals[pos] = data.row_weight[i];
+            if self.aug {
+                for &(i, pa, pb, pos) in &self.jtj {
+                    let w = data.row_weight[i];
+                    if w != 0.0 {
+                        // Off-diagonal pairs appear once in the upper triangle; a pair
+                        // (a, a) is the diagonal entry w·J_ia².
+                        self.p_vals[pos] += w * data.jac[pa] * data.jac[pb];
+                    }
+                }
+                self.jac_copy.clear();
+                self.jac_copy.extend_from_slice(data.jac);
+                self.weight_copy.copy_from_slice(data.row_weight);
             }
         }
         // q
@@ -481,7 +503,7 @@ impl Qp {
                 RowKind::LowerG(i) => g[i] - g_l[i],
                 RowKind::Fixed(j) | RowKind::UpperX(j) => x_u[j] - x[j],
                 RowKind::LowerX(j) => x[j] - x_l[j],
-                RowKind::Elastic | RowKind::Aux(_) => 0.0,
+                RowKind::Elastic => 0.0,
                 RowKind::Cone(k) => cone[k],
             };
         }
@@ -597,7 +619,17 @@ impl Qp {
                 RowKind::LowerX(j) => res.z_l[j] = z,
                 RowKind::Elastic => {}
                 RowKind::Cone(k) => res.z_cone[k] = z,
-                RowKind::Aux(i) => res.z_w[i] = z,
+            }
+        }
+        if self.aug {
+            // Row multiplier of the augmented QP: the term ½ρ_a(J_i d)² adds ρ_a·J_i d to
+            // the dual of row i (→ λ_i as d → 0).
+            for (i, row) in self.jrows.iter().enumerate() {
+                let w = self.weight_copy[i];
+                if w != 0.0 {
+                    let jd: f64 = row.iter().map(|&(c, p)| self.jac_copy[p] * res.d[c]).sum();
+                    res.z_w[i] = w * jd;
+                }
             }
         }
         Ok(res)
