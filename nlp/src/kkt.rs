@@ -68,12 +68,15 @@ pub enum KktError {
 /// Which faer numeric factorisation the symbolic analysis selects.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum KktFactorization {
-    /// Supernodal (the default; fast on anything but tiny systems).
-    #[default]
+    /// Supernodal (dense blocks; fastest when the factor has large dense parts).
     Supernodal,
     /// Simplicial (column by column).
     Simplicial,
-    /// Let faer decide from the flop ratio.
+    /// Let faer decide from the flop ratio (the default). Measured on the gap-crossing
+    /// crawl gait (n + m = 2678, 33 k factor entries) it picks simplicial, 2.5× faster
+    /// than forced supernodal; on a 35 000-row KKT it picks supernodal, 30× faster than
+    /// forced simplicial.
+    #[default]
     Auto,
 }
 
@@ -117,15 +120,16 @@ impl std::fmt::Debug for Kkt {
 
 impl Kkt {
     /// Builds the KKT pattern from the lower-triangular Hessian pattern (n×n) and the
-    /// Jacobian pattern (m×n) and performs the symbolic analysis (AMD ordering,
-    /// supernodal).
+    /// Jacobian pattern (m×n) and performs the symbolic analysis (AMD ordering;
+    /// simplicial or supernodal as faer's flop-ratio heuristic chooses, see
+    /// [`KktFactorization::Auto`]).
     pub fn new(
         n: usize,
         m: usize,
         hess_lower: &SymbolicSparseColMat<usize>,
         jac: &SymbolicSparseColMat<usize>,
     ) -> Result<Kkt, KktError> {
-        Self::with_factorization(n, m, hess_lower, jac, KktFactorization::Supernodal)
+        Self::with_factorization(n, m, hess_lower, jac, KktFactorization::Auto)
     }
 
     /// As [`Kkt::new`] with a chosen factorisation kind.

@@ -189,6 +189,13 @@ pub struct IpmOptions {
     pub perturb_dec_fact: f64,
     /// δ_c base value δ̄_c (δ_c = δ̄_c·μ^κ_c). Default 1e-8.
     pub jacobian_regularization_value: f64,
+    /// After this many iterations in a row that needed δ_w > 0, the next inertia
+    /// correction starts at κ_w⁻·δ_w_last instead of first trying δ_w = 0 (one
+    /// factorisation less per iteration on nonconvex problems); 0 always tries δ_w = 0
+    /// first, as IPOPT does. Default 20: on the gap-crossing crawl gait (106 of 115
+    /// iterations need δ_w) it saves 31 % of the factorisations with the same iterates;
+    /// on the HS suite it changes only hs025 (36 → 40) and hs027 (56 → 54).
+    pub perturbation_skip_zero_after: usize,
     /// κ_c. Default 0.25.
     pub jacobian_regularization_exponent: f64,
     /// Static regularisation always applied to the constraint block (faer's unpivoted
@@ -297,6 +304,7 @@ impl Default for IpmOptions {
             perturb_dec_fact: 1.0 / 3.0,
             jacobian_regularization_value: 1e-8,
             jacobian_regularization_exponent: 0.25,
+            perturbation_skip_zero_after: 20,
             kkt_static_regularization: 1e-8,
             kkt_static_hessian_regularization: 1e-8,
             min_refinement_steps: 1,

@@ -144,6 +144,7 @@ pub(crate) struct Core<'p> {
     delta_c: f64,
     jac_degenerate: bool,
     singular_iters: usize,
+    perturbed_iters: usize,
     free_mode: bool,
     kkt_refs: Vec<f64>,
     tiny_count: usize,
@@ -321,6 +322,7 @@ impl<'p> Core<'p> {
             delta_c: 0.0,
             jac_degenerate: false,
             singular_iters: 0,
+            perturbed_iters: 0,
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
             kkt_refs: Vec::new(),
             tiny_count: 0,
@@ -930,6 +932,15 @@ impl<'p> Core<'p> {
             0.0
         };
         let mut tried_delta_c = self.delta_c > 0.0;
+        // After `perturbation_skip_zero_after` iterations in a row that needed δ_w > 0,
+        // start from IPOPT's second trial κ_w⁻·δ_w_last and skip the δ_w = 0 trial
+        // (saves one factorisation per iteration on nonconvex problems). δ_w then keeps
+        // shrinking by κ_w⁻ per iteration while the inertia allows it.
+        let skip = self.opts.perturbation_skip_zero_after;
+        let skipped = skip > 0 && self.perturbed_iters >= skip && self.delta_w_last > 0.0;
+        if skipped {
+            delta_w = self.next_delta_w(0.0);
+        }
         loop {
             let res = self.factor_kkt(shared, delta_w);
             let singular = match res {
@@ -938,6 +949,9 @@ impl<'p> Core<'p> {
                         self.delta_w = delta_w;
                         if delta_w > 0.0 {
                             self.delta_w_last = delta_w;
+                            self.perturbed_iters += 1;
+                        } else {
+                            self.perturbed_iters = 0;
                         }
                         return true;
                     }
