@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""CasADi + IPOPT on the MPCC test problems of tests/mpcc/problems.rs, in the plain
+products-as-constraints NLP form (a >= 0, b >= 0, a*b <= 0 -- Fletcher & Leyffer's form,
+the one symnlp's SQP back end solves directly). IPOPT gets no special treatment of the
+complementarity (no relaxation, no penalty): this records where a general interior-point
+NLP solver fails on MPCCs (no strictly feasible interior for the product rows, MFCQ fails
+at every feasible point).
+
+Same formulations, starting points and published optima as the Rust tests (sources cited
+there: MacMPEC table values; hand derivations). Success = IPOPT status Solve_Succeeded,
+objective within 1e-6 (relative, absolute when f* = 0) and complementarity residual
+max |min(a, b)| <= 1e-8.
+
+Usage: python3 benches/reference/mpcc_casadi.py benches/reference/results/mpcc_ipopt.json
+(IPOPT prints its banner on stdout, so the JSON goes to the named file.)
+"""
+import json
+import time
+
+import casadi as ca
+
+
+def two_branches():
+    x = ca.SX.sym("x", 2)
+    return x, [1.0, 0.5], (x[0] - 1) ** 2 + (x[1] - 1) ** 2, [], [(x[0], x[1])], {}, 1.0
+
+
+def linear_objective():
+    x = ca.SX.sym("x", 2)
+    return x, [0.7, 0.6], x[0] + x[1], [(x[0] + x[1], 1.0, ca.inf)], [(x[0], x[1])], {}, 1.0
+
+
+def bard1():
+    v = ca.SX.sym("v", 5)
+    x, y, l1, l2, l3 = v[0], v[1], v[2], v[3], v[4]
+    g = [(2 * (y - 1) - 1.5 * x + l1 - 0.5 * l2 + l3, 0.0, 0.0)]
+    pairs = [(l1, 3 * x - y - 3), (l2, -x + 0.5 * y + 4), (l3, -x - y + 7)]
+    return v, [0.0] * 5, (x - 5) ** 2 + (2 * y + 1) ** 2, g, pairs, {i: 0.0 for i in range(5)}, 17.0
+
+
+def ralph1():
+    v = ca.SX.sym("v", 2)
+    return v, [1.0, 1.0], 2 * v[0] - v[1], [], [(v[1], v[1] - v[0])], {0: 0.0}, 0.0
+
+
+def ralph2():
+    v = ca.SX.sym("v", 2)
+    f = v[0] ** 2 + v[1] ** 2 - 4 * v[0] * v[1]
+    return v, [1.0, 1.0], f, [], [(v[0], v[1])], {}, 0.0
+
+
+def scholtes3():
+    v = ca.SX.sym("v", 2)
+    f = 0.5 * ((v[0] - 1) ** 2 + (v[1] - 1) ** 2)
+    return v, [0.0, 0.0], f, [], [(v[0], v[1])], {}, 0.5
+
+
+def jr1():
+    v = ca.SX.sym("v", 2)
+    return v, [0.0, 0.0], (v[1] - 1) ** 2 + v[0] ** 2, [], [(v[1], v[1] - v[0])], {}, 0.5
+
+
+def lcp_chain():
+    x = ca.SX.sym("x", 10)
+    y = ca.SX.sym("y", 10)
+    f = 0
+    for i in range(10):
+        f += (x[i] - 2) ** 2 + (y[i] - (1 + i / 10)) ** 2
+    return ca.vertcat(x, y), [1.0] * 20, f, [], [(x[i], y[i]) for i in range(10)], {}, 21.85
+
+
+CASES = [two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr1, lcp_chain]
+
+
+def solve(case):
+    x, x0, f, rows, pairs, lower, f_star = case()
+    n = x.shape[0]
+    lbx = [lower.get(i, -ca.inf) for i in range(n)]
+    g, lbg, ubg = [], [], []
+    for e, lo, hi in rows:
+        g.append(e); lbg.append(lo); ubg.append(hi)
+    for a, b in pairs:
+        for e in (a, b):
+            g.append(e); lbg.append(0.0); ubg.append(ca.inf)
+        g.append(a * b); lbg.append(-ca.inf); ubg.append(0.0)
+    nlp = {"x": x, "f": f, "g": ca.vertcat(*g)}
+    s = ca.nlpsol("s", "ipopt", nlp, {"print_time": False, "record_time": True,
+                                      "ipopt": {"print_level": 0, "tol": 1e-8, "max_iter": 3000}})
+    t = time.perf_counter()
+    r = s(x0=x0, lbx=lbx, ubx=[ca.inf] * n, lbg=lbg, ubg=ubg)
+    wall = time.perf_counter() - t
+    st = s.stats()
+    ab = ca.Function("ab", [x], [ca.vertcat(*[ca.fmin(a, b) for a, b in pairs])])
+    res = float(ca.mmax(ca.fabs(ab(r["x"])))) if pairs else 0.0
+    fv = float(r["f"])
+    err = abs(fv - f_star) / max(1.0, abs(f_star))
+    ok = st["return_status"] == "Solve_Succeeded" and err <= 1e-6 and res <= 1e-8
+    return {"name": case.__name__, "status": st["return_status"], "iterations": st["iter_count"],
+            "objective": fv, "f_star": f_star, "residual": res, "solved": ok,
+            "seconds": st.get("t_wall_total", wall)}
+
+
+if __name__ == "__main__":
+    import sys
+    out = [solve(c) for c in CASES]
+    with open(sys.argv[1], "w") as fh:
+        fh.write(json.dumps({"solver": "ipopt " + ca.__version__, "formulation": "products as constraints",
+                      "problems": out}, indent=1) + "\n")
