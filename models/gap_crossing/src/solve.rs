@@ -134,6 +134,10 @@ fn step_sq(x: &[f64], k: usize, i: Foot) -> f64 {
     (0..3).map(|d| (x[b + d] - x[a + d]).powi(2)).sum()
 }
 
+/// (10) residual under which the complementarity phase's point warm-starts the exact
+/// phase as it is.
+pub const NEARLY_COMPLEMENTARY: f64 = 1e-4;
+
 /// Squared move (m²) below which a transition counts as "no foot moves" when reading a
 /// schedule off a plan: 1e-6 m², a millimetre.
 pub const NEGLIGIBLE_MOVE_SQ: f64 = 1e-6;
@@ -311,7 +315,14 @@ pub fn plan_on(
             let crawl_schedule = gait::crawl_schedule(s.n_step);
             let schedule = schedule_of(s, &choice.flat, &crawl_schedule);
             if choice.solution.status.is_success() && schedule != crawl_schedule {
-                let warm = scheduled_guess(s, terrain, &choice.flat, &schedule);
+                // A nearly complementary point (non-moving feet displaced by ≲ 1e-2 m) is
+                // already a good start; otherwise rebuild a consistent one.
+                let nearly = complementarity_residual(s, &choice.flat) <= NEARLY_COMPLEMENTARY;
+                let warm = if nearly {
+                    choice.flat.clone()
+                } else {
+                    scheduled_guess(s, terrain, &choice.flat, &schedule)
+                };
                 let exact = run(
                     s,
                     terrain,
