@@ -85,9 +85,27 @@ fn mpcc_summary() {
                     "f_star": case.f_star, "residual": s.report.residual,
                     "biactive": s.report.biactive, "iterations": s.iterations,
                     "seconds": s.seconds, "solved": solved(&case, &s),
-                    "phases": s.phases.len(),
+                    "phases": s.phases.iter().map(|p| format!("{}:{:?}:{}", p.kind, p.status, p.iterations)).collect::<Vec<_>>(),
                 })
             );
         }
+    }
+}
+
+/// Iteration tables of one case (`MPCC=<name> BACKEND=sqp|ipm`).
+#[test]
+#[ignore = "diagnostics: run with MPCC=<name> --release --ignored --nocapture"]
+fn mpcc_log() {
+    let wanted = std::env::var("MPCC").unwrap_or_default();
+    let backend = match std::env::var("BACKEND").as_deref() {
+        Ok("ipm") => MpccBackend::Ipm,
+        _ => MpccBackend::Sqp,
+    };
+    for case in ALL.iter().map(|c| c()).filter(|c| c.name == wanted) {
+        let mut o = MpccOptions::default();
+        o.sqp.print_level = 5;
+        o.ipm.print_level = 5;
+        let s = solve_mpcc(&(case.build)(), backend, &o).unwrap();
+        println!("{:?}\n{:?}", s.phases, s.report);
     }
 }

@@ -87,24 +87,6 @@ const KNOWN_FAILURES: &[(&str, Status, &str)] = &[
         Status::SolvedToAcceptableLevel,
         "singular Hessian, linear rate",
     ),
-    // clarabel returns InsufficientProgress on a QP at iteration 7.
-    (
-        "hs056",
-        Status::ErrorInStepComputation,
-        "clarabel InsufficientProgress",
-    ),
-    // Line search stalls (tiny steps on the l1 merit) at f = -121.35.
-    (
-        "hs061",
-        Status::MaximumIterationsExceeded,
-        "line search stalls",
-    ),
-    // Reaches f* to 1e-13 but the final steps are cut by the merit test (Maratos).
-    (
-        "hs078",
-        Status::SolvedToAcceptableLevel,
-        "final steps cut by the merit test",
-    ),
     // Line search stalls near f = 0.0591.
     (
         "hs081",
@@ -131,6 +113,28 @@ const KNOWN_FAILURES: &[(&str, Status, &str)] = &[
     ),
     // Stops at f = 95.93 (infeasible by 7.7e-3).
     ("hs116", Status::MaximumIterationsExceeded, "no convergence"),
+];
+
+/// Problems observed with two outcomes between runs of the same binary: the listed
+/// failure, or a full success. The cause is not isolated yet (suspected: rounding of the
+/// parallel faer factorisation behind the inertia test of the Hessian convexification,
+/// which picks δ and ρ_a). Their tests accept exactly these two outcomes, nothing else.
+const UNSTABLE: &[(&str, Status, &str)] = &[
+    (
+        "hs056",
+        Status::ErrorInStepComputation,
+        "clarabel InsufficientProgress at iteration 7",
+    ),
+    (
+        "hs061",
+        Status::MaximumIterationsExceeded,
+        "line search stalls at f = -121.35",
+    ),
+    (
+        "hs078",
+        Status::SolvedToAcceptableLevel,
+        "final steps cut by the merit test",
+    ),
 ];
 
 struct Run {
@@ -186,6 +190,18 @@ fn check(name: &'static str, build: fn() -> Built) {
         Ok(sol) => sol,
         Err(e) => panic!("{name}: solve error: {e}"),
     };
+    let success = sol.status == Status::SolveSucceeded
+        && sol.constr_viol <= CONSTR_VIOL_TOL
+        && matched(&run, sol.objective).is_some();
+    if let Some((_, failure, why)) = UNSTABLE.iter().find(|(n, _, _)| *n == name) {
+        assert!(
+            success || sol.status == *failure,
+            "{name}: unstable case ({why}) has a third outcome: {:?}, f = {}; update UNSTABLE",
+            sol.status,
+            sol.objective
+        );
+        return;
+    }
     if let Some((_, expected, why)) = KNOWN_FAILURES.iter().find(|(n, _, _)| *n == name) {
         // Honest known failure: the current (failing) behaviour, exactly.
         assert_eq!(
@@ -193,9 +209,6 @@ fn check(name: &'static str, build: fn() -> Built) {
             "{name}: known SQP failure ({why}) changed status: now {:?}, f = {}; update KNOWN_FAILURES",
             sol.status, sol.objective
         );
-        let success = sol.status == Status::SolveSucceeded
-            && sol.constr_viol <= CONSTR_VIOL_TOL
-            && matched(&run, sol.objective).is_some();
         assert!(
             !success,
             "{name}: listed as a known SQP failure ({why}) but now solved: remove it from KNOWN_FAILURES"
