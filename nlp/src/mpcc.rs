@@ -185,7 +185,7 @@ pub fn solve_mpcc(
             loop {
                 let mut obj = f;
                 for (_, a, b) in &pairs {
-                    obj = obj + pi * (*a * *b);
+                    obj += pi * (*a * *b);
                 }
                 let pb = problem.mpcc_copy(obj, false);
                 let sol = run(backend, o, &pb, x.as_deref())?;

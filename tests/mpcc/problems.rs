@@ -180,7 +180,7 @@ pub fn lcp_chain() -> Case {
         let mut f = symx::Expr::from(0.0);
         for i in 0..10 {
             let b = 1.0 + i as f64 / 10.0;
-            f = f + (xs[i] - 2.0).sq() + (ys[i] - b).sq();
+            f += (xs[i] - 2.0).sq() + (ys[i] - b).sq();
             pb.complementarity(&format!("c{i}"), xs[i], ys[i]).unwrap();
         }
         pb.minimize(f);
