@@ -69,11 +69,60 @@ def lcp_chain():
     return ca.vertcat(x, y), [1.0] * 20, f, [], [(x[i], y[i]) for i in range(10)], {}, 21.85
 
 
-CASES = [two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr1, lcp_chain]
+def dempe():
+    v = ca.SX.sym("v", 3)
+    x, z, w = v[0], v[1], v[2]
+    return (v, [0.183193, 0.428106, 3.00379], (x - 3.5) ** 2 + (z + 4) ** 2,
+            [(z - 3 + 2 * z * w, 0.0, 0.0)], [(x - z ** 2, w)], {}, 28.25)
+
+
+def desilva():
+    v = ca.SX.sym("v", 6)
+    x, y, l = v[0:2], v[2:4], v[4:6]
+    f = x[0] ** 2 - 2 * x[0] + x[1] ** 2 - 2 * x[1] + y[0] ** 2 + y[1] ** 2
+    rows = [(2 * y[i] - 2 * x[i] + 2 * (y[i] - 1) * l[i], 0.0, 0.0) for i in range(2)]
+    pairs = [(0.25 - (y[i] - 1) ** 2, l[i]) for i in range(2)]
+    return v, [0.0] * 6, f, rows, pairs, {0: 0.0, 1: 0.0, 4: 0.0, 5: 0.0}, -1.0, {0: 2.0, 1: 2.0}
+
+
+def gauvin():
+    v = ca.SX.sym("v", 3)
+    x, y, u = v[0], v[1], v[2]
+    pairs = [(4 * (x + 2 * y - 30) + u, y), (20 - x - y, u)]
+    return v, [7.5, 0.0, 1.0], x ** 2 + (y - 10) ** 2, [], pairs, {0: 0.0, 1: 0.0, 2: 0.0}, 20.0, {0: 15.0}
+
+
+def qpec2():
+    x = ca.SX.sym("x", 10)
+    y = ca.SX.sym("y", 20)
+    f = sum((x[i] - 1) ** 2 for i in range(10)) + sum((y[j] - 2) ** 2 for j in range(20))
+    pairs = [(y[i] - x[i], y[i]) for i in range(10)] + [(y[j], y[j]) for j in range(10, 20)]
+    return (ca.vertcat(x, y), [1.0] * 30, f, [], pairs, {10 + j: 0.0 for j in range(20)}, 45.0)
+
+
+def scale1():
+    v = ca.SX.sym("v", 2)
+    return v, [0.0, 0.0], (100 * v[0] - 1) ** 2 + (v[1] - 1) ** 2, [], [(v[0], v[1])], {}, 1.0
+
+
+def fl_ex1():
+    v = ca.SX.sym("v", 2)
+    return v, [0.0, 0.0], (v[0] - 1) ** 2 + v[1] ** 2, [], [(v[1] - v[0], v[1])], {}, 0.5
+
+
+def fl_ex2():
+    v = ca.SX.sym("v", 2)
+    return (v, [0.0, 0.0], v[0] + v[1], [(v[1] ** 2, 1.0, ca.inf)], [(v[0], v[1])],
+            {0: 0.0, 1: 0.0}, 1.0)
+
+
+CASES = [two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr1, dempe, desilva,
+         gauvin, qpec2, scale1, fl_ex1, fl_ex2, lcp_chain]
 
 
 def solve(case):
-    x, x0, f, rows, pairs, lower, f_star = case()
+    x, x0, f, rows, pairs, lower, f_star, *rest = case()
+    upper = rest[0] if rest else {}
     n = x.shape[0]
     lbx = [lower.get(i, -ca.inf) for i in range(n)]
     g, lbg, ubg = [], [], []
@@ -87,7 +136,7 @@ def solve(case):
     s = ca.nlpsol("s", "ipopt", nlp, {"print_time": False, "record_time": True,
                                       "ipopt": {"print_level": 0, "tol": 1e-8, "max_iter": 3000}})
     t = time.perf_counter()
-    r = s(x0=x0, lbx=lbx, ubx=[ca.inf] * n, lbg=lbg, ubg=ubg)
+    r = s(x0=x0, lbx=lbx, ubx=[upper.get(i, ca.inf) for i in range(n)], lbg=lbg, ubg=ubg)
     wall = time.perf_counter() - t
     st = s.stats()
     ab = ca.Function("ab", [x], [ca.vertcat(*[ca.fmin(a, b) for a, b in pairs])])
@@ -104,5 +153,5 @@ if __name__ == "__main__":
     import sys
     out = [solve(c) for c in CASES]
     with open(sys.argv[1], "w") as fh:
-        fh.write(json.dumps({"solver": "ipopt " + ca.__version__, "formulation": "products as constraints",
+        fh.write(json.dumps({"solver": "casadi " + ca.__version__ + " nlpsol ipopt", "formulation": "products as constraints",
                       "problems": out}, indent=1) + "\n")

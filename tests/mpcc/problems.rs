@@ -194,3 +194,190 @@ pub fn lcp_chain() -> Case {
         known_failures: &[],
     }
 }
+
+// The following MacMPEC formulations and f* were checked against the JuMP transcription
+// of MacMPEC in MathOptInterface's complementarity test instances (from Leyffer's .mod
+// files; f* from the MacMPEC table) and re-derived by hand where noted.
+
+/// MacMPEC dempe (Dempe 1992; Luo, Pang & Ralph 1997, p. 354): min (x−3.5)² + (z+4)²
+/// s.t. z − 3 + 2zw = 0, 0 ≤ x − z² ⊥ w ≥ 0, from (0.183193, 0.428106, 3.00379).
+/// MacMPEC f* = 28.25. By hand: on the branch x = z², z = 3/(1+2w) ∈ (0, 3] and
+/// f(z) = (z²−3.5)² + (z+4)² has f' = 4(z−1)²(z+2) ≥ 0, so 28.25 is an infimum (z → 0,
+/// w → ∞), not attained.
+pub fn dempe() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["x", "z", "w"]);
+        let (x, z, w) = (v[0], v[1], v[2]);
+        pb.set_initial(&v, &[0.183193, 0.428106, 3.00379]).unwrap();
+        pb.minimize((x - 3.5).sq() + (z + 4.0).sq());
+        pb.subject_to((z - 3.0 + 2.0 * z * w).eq(0.0)).unwrap();
+        pb.complementarity("c", x - z.sq(), w).unwrap();
+        pb
+    }
+    Case {
+        name: "dempe",
+        source: "MacMPEC dempe, f* = 28.25 (infimum)",
+        build,
+        f_star: 28.25,
+        known_failures: &[
+            (
+                MpccBackend::Sqp,
+                "infimum not attained (w -> inf): MaximumIterationsExceeded at f = 28.348",
+            ),
+            (
+                MpccBackend::Ipm,
+                "infimum not attained (w -> inf): final phase SolvedToAcceptableLevel at f = 28.25036",
+            ),
+        ],
+    }
+}
+
+/// MacMPEC desilva (Facchinei, Jiang & Qi, problem 5): min x₁² − 2x₁ + x₂² − 2x₂ + y₁² + y₂²
+/// s.t. 0 ≤ x ≤ 2, 2yᵢ − 2xᵢ + 2(yᵢ−1)lᵢ = 0, 0 ≤ 0.25 − (yᵢ−1)² ⊥ lᵢ ≥ 0. f* = −1
+/// (x = y = 0.5).
+pub fn desilva() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["x1", "x2", "y1", "y2", "l1", "l2"]);
+        pb.set_bounds(&v[..2], 0.0, 2.0).unwrap();
+        pb.set_bounds(&v[4..], 0.0, f64::INFINITY).unwrap();
+        pb.minimize(v[0].sq() - 2.0 * v[0] + v[1].sq() - 2.0 * v[1] + v[2].sq() + v[3].sq());
+        for i in 0..2 {
+            let (x, y, l) = (v[i], v[2 + i], v[4 + i]);
+            pb.subject_to((2.0 * y - 2.0 * x + 2.0 * (y - 1.0) * l).eq(0.0))
+                .unwrap();
+            pb.complementarity(&format!("c{i}"), 0.25 - (y - 1.0).sq(), l)
+                .unwrap();
+        }
+        pb
+    }
+    Case {
+        name: "desilva",
+        source: "MacMPEC desilva, f* = -1",
+        build,
+        f_star: -1.0,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC gauvin (Gauvin & Savard 1992, via MPECLIB): min x² + (y−10)², 0 ≤ x ≤ 15,
+/// y, u ≥ 0, 0 ≤ 4(x + 2y − 30) + u ⊥ y ≥ 0, 0 ≤ 20 − x − y ⊥ u ≥ 0, from x = 7.5,
+/// u = 1. MacMPEC f* = 20.
+pub fn gauvin() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["x", "y", "u"]);
+        let (x, y, u) = (v[0], v[1], v[2]);
+        pb.set_bounds(&v[..1], 0.0, 15.0).unwrap();
+        pb.set_bounds(&v[1..], 0.0, f64::INFINITY).unwrap();
+        pb.set_initial(&v, &[7.5, 0.0, 1.0]).unwrap();
+        pb.minimize(x.sq() + (y - 10.0).sq());
+        pb.complementarity("c1", 4.0 * (x + 2.0 * y - 30.0) + u, y)
+            .unwrap();
+        pb.complementarity("c2", 20.0 - x - y, u).unwrap();
+        pb
+    }
+    Case {
+        name: "gauvin",
+        source: "MacMPEC gauvin, f* = 20",
+        build,
+        f_star: 20.0,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC qpec2 (Jiang & Ralph 1997), n = 10, m = 20: min Σ(xᵢ−1)² + Σ(yⱼ−2)², y ≥ 0,
+/// yᵢ − xᵢ ≥ 0 ⊥ yᵢ (i ≤ n), yⱼ ⊥ yⱼ (j > n, i.e. yⱼ = 0), from x = y = 1. f* = 45
+/// (by hand: 10 × 0.5 on the branch yᵢ = xᵢ = 1.5, plus 10 × 4).
+pub fn qpec2() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let x: Vec<_> = pb.variable("x", 10).iter().copied().collect();
+        let y: Vec<_> = pb.variable("y", 20).iter().copied().collect();
+        pb.set_bounds(&y, 0.0, f64::INFINITY).unwrap();
+        pb.set_initial(&x, &[1.0; 10]).unwrap();
+        pb.set_initial(&y, &[1.0; 20]).unwrap();
+        let mut f = symx::Expr::from(0.0);
+        for xi in &x {
+            f += (*xi - 1.0).sq();
+        }
+        for yj in &y {
+            f += (*yj - 2.0).sq();
+        }
+        pb.minimize(f);
+        for i in 0..10 {
+            pb.complementarity(&format!("c{i}"), y[i] - x[i], y[i])
+                .unwrap();
+        }
+        for (j, yj) in y.iter().enumerate().skip(10) {
+            pb.complementarity(&format!("d{j}"), *yj, *yj).unwrap();
+        }
+        pb
+    }
+    Case {
+        name: "qpec2",
+        source: "MacMPEC qpec2, f* = 45",
+        build,
+        f_star: 45.0,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC scale1: min (100x₁ − 1)² + (x₂ − 1)², 0 ≤ x₁ ⊥ x₂ ≥ 0 (badly scaled). f* = 1
+/// at (0.01, 0) or (0, 1).
+pub fn scale1() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["x1", "x2"]);
+        pb.minimize((100.0 * v[0] - 1.0).sq() + (v[1] - 1.0).sq());
+        pb.complementarity("c", v[0], v[1]).unwrap();
+        pb
+    }
+    Case {
+        name: "scale1",
+        source: "MacMPEC scale1, f* = 1",
+        build,
+        f_star: 1.0,
+        known_failures: &[],
+    }
+}
+
+/// Fletcher & Leyffer (2002/2006), "Local convergence of SQP methods for MPECs", ex. (2.2):
+/// min (z₁−1)² + z₂², z₂ ≥ 0, 0 ≤ z₂ − z₁ ⊥ z₂ ≥ 0. f* = 0.5 at (0.5, 0.5).
+pub fn fl_ex1() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["z1", "z2"]);
+        pb.minimize((v[0] - 1.0).sq() + v[1].sq());
+        pb.complementarity("c", v[1] - v[0], v[1]).unwrap();
+        pb
+    }
+    Case {
+        name: "fl_ex1",
+        source: "Fletcher et al., local SQP for MPECs, ex. 2.2, f* = 0.5",
+        build,
+        f_star: 0.5,
+        known_failures: &[],
+    }
+}
+
+/// Fletcher et al., ex. (2.2) second problem: min z₁ + z₂, z ≥ 0, z₂² ≥ 1, 0 ≤ z₁ ⊥ z₂ ≥ 0.
+/// f* = 1 at (0, 1).
+pub fn fl_ex2() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["z1", "z2"]);
+        pb.set_bounds(&v, 0.0, f64::INFINITY).unwrap();
+        pb.minimize(v[0] + v[1]);
+        pb.subject_to(v[1].sq().ge(1.0)).unwrap();
+        pb.complementarity("c", v[0], v[1]).unwrap();
+        pb
+    }
+    Case { name: "fl_ex2", source: "Fletcher et al., local SQP for MPECs, ex. 2.2, f* = 1", build, f_star: 1.0,
+        known_failures: &[(
+            MpccBackend::Sqp,
+            "from z = 0 the linearisation of z2^2 >= 1 has a zero gradient: the SQP stays at the infeasible origin (MaximumIterationsExceeded)",
+        )],
+    }
+}
