@@ -1,0 +1,128 @@
+//! Interior-point solves of the scalable problems (hanging chain, Van der Pol optimal
+//! control), formulated exactly as benches/reference/{hanging_chain,ocp}.py, at about
+//! 10², 10³, 10⁴ and 10⁵ variables.
+//!
+//! ```text
+//! cargo bench --bench solve                 # criterion (10², 10³, 10⁴; 10⁵ timed once)
+//! cargo bench --bench solve -- --json       # one JSON line per problem and size
+//! ```
+//! The JSON mode prints what docs/performance.md compares with
+//! `python3 benches/reference/solve_casadi.py`: iterations, status, objective, median
+//! solve wall time (5 solves up to 10³ variables, 3 at 10⁴, 1 at 10⁵), compile time,
+//! and the time split of the median solve.
+#[path = "common/solve_problems.rs"]
+mod solve_problems;
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::Criterion;
+use nlp::{Compiled, Ipm, IpmOptions, Problem, Solution};
+use solve_problems::{hanging_chain, van_der_pol, CHAIN_SIZES, OCP_SIZES};
+
+type Builder = fn(usize) -> Problem;
+type Sizes = [(u32, usize); 4];
+
+const PROBLEMS: [(&str, Builder, Sizes); 2] = [
+    ("hanging_chain", hanging_chain, CHAIN_SIZES),
+    ("ocp", van_der_pol, OCP_SIZES),
+];
+
+fn solver() -> Ipm {
+    // IPOPT's defaults (tol 1e-8), as the reference script, which caps IPOPT at 120 s
+    // (`--cap 120`) as well.
+    Ipm::new(IpmOptions {
+        max_wall_time: 120.0,
+        ..IpmOptions::default()
+    })
+}
+
+fn solve(compiled: &mut Compiled) -> Solution {
+    solver().solve(compiled).expect("valid problem")
+}
+
+fn json_mode() {
+    for (name, build, sizes) in PROBLEMS {
+        for (log_n, size) in sizes {
+            let pb = build(size);
+            let t = Instant::now();
+            let mut compiled = pb.compile().expect("compiles");
+            let compile_s = t.elapsed().as_secs_f64();
+            let reps = match log_n {
+                0..=3 => 5,
+                4 => 3,
+                _ => 1,
+            };
+            let mut runs: Vec<(f64, Solution)> = (0..reps)
+                .map(|_| {
+                    let t = Instant::now();
+                    let sol = solve(&mut compiled);
+                    (t.elapsed().as_secs_f64(), sol)
+                })
+                .collect();
+            runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let all: Vec<f64> = runs.iter().map(|r| r.0).collect();
+            let (secs, sol) = &runs[runs.len() / 2];
+            let s = &sol.stats;
+            println!(
+                "{}",
+                serde_json::json!({
+                    "problem": name,
+                    "N": size,
+                    "n": pb.n_variables(),
+                    "m": pb.n_constraints(),
+                    "status": format!("{:?}", sol.status),
+                    "iterations": s.iterations,
+                    "objective": sol.objective,
+                    "constr_viol": sol.constr_viol,
+                    "solve_s": secs,
+                    "solve_s_all": all,
+                    "compile_s": compile_s,
+                    "eval_s": s.eval_seconds,
+                    "factor_s": s.factor_seconds,
+                    "other_s": s.other_seconds,
+                    "n_factorizations": s.n_factorizations,
+                })
+            );
+        }
+    }
+}
+
+fn criterion_mode() {
+    let mut c = Criterion::default()
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3))
+        .configure_from_args();
+    for (name, build, sizes) in PROBLEMS {
+        let mut group = c.benchmark_group(format!("solve_{name}"));
+        for (log_n, size) in sizes {
+            let mut compiled = build(size).compile().expect("compiles");
+            if log_n <= 4 {
+                group.bench_function(format!("1e{log_n}"), |b| {
+                    b.iter(|| black_box(solve(&mut compiled)))
+                });
+            } else {
+                // 10⁵ variables: one timed solve instead of a sample.
+                let t = Instant::now();
+                let sol = solve(&mut compiled);
+                println!(
+                    "solve_{name}/1e{log_n}: one solve {:.3} s ({:?}, {} iterations)",
+                    t.elapsed().as_secs_f64(),
+                    sol.status,
+                    sol.stats.iterations
+                );
+            }
+        }
+        group.finish();
+    }
+    c.final_summary();
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--json") {
+        json_mode();
+    } else {
+        criterion_mode();
+    }
+}
