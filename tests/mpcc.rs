@@ -64,7 +64,12 @@ macro_rules! mpcc_tests {
 }
 
 mpcc_tests! {
-    two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr1, dempe, desilva, gauvin, qpec2, scale1, fl_ex1, fl_ex2,
+    two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr2,
+    kth1,
+    kth2,
+    kth3,
+    scholtes5,
+    nash1, dempe, desilva, gauvin, qpec2, scale1, fl_ex1, fl_ex2,
     lcp_chain,
 }
 

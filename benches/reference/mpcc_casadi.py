@@ -55,7 +55,7 @@ def scholtes3():
     return v, [0.0, 0.0], f, [], [(v[0], v[1])], {}, 0.5
 
 
-def jr1():
+def jr2():
     v = ca.SX.sym("v", 2)
     return v, [0.0, 0.0], (v[1] - 1) ** 2 + v[0] ** 2, [], [(v[1], v[1] - v[0])], {}, 0.5
 
@@ -67,6 +67,36 @@ def lcp_chain():
     for i in range(10):
         f += (x[i] - 2) ** 2 + (y[i] - (1 + i / 10)) ** 2
     return ca.vertcat(x, y), [1.0] * 20, f, [], [(x[i], y[i]) for i in range(10)], {}, 21.85
+
+
+def kth1():
+    v = ca.SX.sym("v", 2)
+    return v, [0.0, 1.0], v[0] + v[1], [], [(v[0], v[1])], {}, 0.0
+
+
+def kth2():
+    v = ca.SX.sym("v", 2)
+    return v, [1.0, 0.0], v[0] + (v[1] - 1) ** 2, [], [(v[0], v[1])], {}, 0.0
+
+
+def kth3():
+    v = ca.SX.sym("v", 2)
+    return v, [1.0, 1.0], 0.5 * (v[0] - 1) ** 2 + (v[1] - 1) ** 2, [], [(v[0], v[1])], {}, 0.5
+
+
+def scholtes5():
+    z = ca.SX.sym("z", 3)
+    f = (z[0] - 1) ** 2 + (z[1] - 2) ** 2 + (z[2] + 1) ** 2
+    return z, [1.0] * 3, f, [], [(z[0], z[2]), (z[1], z[2])], {}, 1.0
+
+
+def nash1():
+    v = ca.SX.sym("v", 6)
+    x1, x2, y1, y2, l1, l2 = [v[i] for i in range(6)]
+    rows = [(-34 + 2 * y1 + (8 / 3) * y2 + l1, 0.0, 0.0), (-24.25 + 1.25 * y1 + 2 * y2 + l2, 0.0, 0.0)]
+    pairs = [(15 - x2 - y1, l1), (15 - x1 - y2, l2)]
+    f = 0.5 * ((x1 - y1) ** 2 + (x2 - y2) ** 2)
+    return v, [0.0] * 6, f, rows, pairs, {0: 0.0, 1: 0.0, 4: 0.0, 5: 0.0}, 0.0, {0: 10.0, 1: 10.0}
 
 
 def dempe():
@@ -116,7 +146,8 @@ def fl_ex2():
             {0: 0.0, 1: 0.0}, 1.0)
 
 
-CASES = [two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr1, dempe, desilva,
+CASES = [two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr2, kth1, kth2, kth3,
+         scholtes5, nash1, dempe, desilva,
          gauvin, qpec2, scale1, fl_ex1, fl_ex2, lcp_chain]
 
 

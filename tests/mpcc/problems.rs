@@ -146,9 +146,10 @@ pub fn scholtes3() -> Case {
     }
 }
 
-/// MacMPEC jr1 (Jiang & Ralph): min (z₂−1)² + z₁²  s.t. 0 ≤ z₂ ⊥ z₂ − z₁ ≥ 0. f* = 0.5 at
-/// z = (0.5, 0.5) (branch z₂ = z₁; the branch z₂ = 0 costs ≥ 1).
-pub fn jr1() -> Case {
+/// MacMPEC jr2 (QPEC from ideas by Jiang & Ralph): min (z₂−1)² + z₁²  s.t. z₂ ≥ 0,
+/// 0 ≤ z₂ ⊥ z₂ − z₁ ≥ 0. f* = 0.5 at z = (0.5, 0.5) (by hand: branch z₂ = z₁; the branch
+/// z₂ = 0 costs ≥ 1).
+pub fn jr2() -> Case {
     fn build() -> Problem {
         let mut pb = Problem::new();
         let v = scalars(&mut pb, &["z1", "z2"]);
@@ -157,10 +158,117 @@ pub fn jr1() -> Case {
         pb
     }
     Case {
-        name: "jr1",
-        source: "MacMPEC jr1, f* = 0.5",
+        name: "jr2",
+        source: "MacMPEC jr2, f* = 0.5",
         build,
         f_star: 0.5,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC kth1: min z₁ + z₂, z ≥ 0, 0 ≤ z₁ ⊥ z₂ ≥ 0, from (0, 1). f* = 0.
+pub fn kth1() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["z1", "z2"]);
+        pb.set_initial(&v, &[0.0, 1.0]).unwrap();
+        pb.minimize(v[0] + v[1]);
+        pb.complementarity("c", v[0], v[1]).unwrap();
+        pb
+    }
+    Case {
+        name: "kth1",
+        source: "MacMPEC kth1, f* = 0",
+        build,
+        f_star: 0.0,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC kth2: min z₁ + (z₂−1)², 0 ≤ z₁ ⊥ z₂ ≥ 0, from (1, 0). f* = 0 at (0, 1).
+pub fn kth2() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["z1", "z2"]);
+        pb.set_initial(&v, &[1.0, 0.0]).unwrap();
+        pb.minimize(v[0] + (v[1] - 1.0).sq());
+        pb.complementarity("c", v[0], v[1]).unwrap();
+        pb
+    }
+    Case {
+        name: "kth2",
+        source: "MacMPEC kth2, f* = 0",
+        build,
+        f_star: 0.0,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC kth3: min ½(z₁−1)² + (z₂−1)², 0 ≤ z₁ ⊥ z₂ ≥ 0, from (1, 1). f* = 0.5 at (0, 1).
+pub fn kth3() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["z1", "z2"]);
+        pb.set_initial(&v, &[1.0, 1.0]).unwrap();
+        pb.minimize(0.5 * (v[0] - 1.0).sq() + (v[1] - 1.0).sq());
+        pb.complementarity("c", v[0], v[1]).unwrap();
+        pb
+    }
+    Case {
+        name: "kth3",
+        source: "MacMPEC kth3, f* = 0.5",
+        build,
+        f_star: 0.5,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC scholtes5 (Scholtes, SIAM J. Optim. 11(4), 2001): min (z₁−1)² + (z₂−2)² +
+/// (z₃+1)², z ≥ 0, 0 ≤ z₁ ⊥ z₃ ≥ 0, 0 ≤ z₂ ⊥ z₃ ≥ 0, from z = 1. f* = 1 at (1, 2, 0).
+pub fn scholtes5() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["z1", "z2", "z3"]);
+        pb.set_initial(&v, &[1.0, 1.0, 1.0]).unwrap();
+        pb.minimize((v[0] - 1.0).sq() + (v[1] - 2.0).sq() + (v[2] + 1.0).sq());
+        pb.complementarity("c1", v[0], v[2]).unwrap();
+        pb.complementarity("c2", v[1], v[2]).unwrap();
+        pb
+    }
+    Case {
+        name: "scholtes5",
+        source: "MacMPEC scholtes5, f* = 1",
+        build,
+        f_star: 1.0,
+        known_failures: &[],
+    }
+}
+
+/// MacMPEC nash1 (Facchinei, Jiang & Qi, problem 9): min ½‖x − y‖², 0 ≤ x ≤ 10,
+/// −34 + 2y₁ + (8/3)y₂ + l₁ = 0, −24.25 + 1.25y₁ + 2y₂ + l₂ = 0,
+/// 0 ≤ 15 − x₂ − y₁ ⊥ l₁ ≥ 0, 0 ≤ 15 − x₁ − y₂ ⊥ l₂ ≥ 0, from 0. f* = 0 (by hand:
+/// x = y = (5, 9), l = 0).
+pub fn nash1() -> Case {
+    fn build() -> Problem {
+        let mut pb = Problem::new();
+        let v = scalars(&mut pb, &["x1", "x2", "y1", "y2", "l1", "l2"]);
+        let (x1, x2, y1, y2, l1, l2) = (v[0], v[1], v[2], v[3], v[4], v[5]);
+        pb.set_bounds(&v[..2], 0.0, 10.0).unwrap();
+        pb.set_bounds(&v[4..], 0.0, f64::INFINITY).unwrap();
+        pb.minimize(0.5 * ((x1 - y1).sq() + (x2 - y2).sq()));
+        pb.subject_to((-34.0 + 2.0 * y1 + (8.0 / 3.0) * y2 + l1).eq(0.0))
+            .unwrap();
+        pb.subject_to((-24.25 + 1.25 * y1 + 2.0 * y2 + l2).eq(0.0))
+            .unwrap();
+        pb.complementarity("g1", 15.0 - x2 - y1, l1).unwrap();
+        pb.complementarity("g2", 15.0 - x1 - y2, l2).unwrap();
+        pb
+    }
+    Case {
+        name: "nash1",
+        source: "MacMPEC nash1, f* = 0",
+        build,
+        f_star: 0.0,
         known_failures: &[],
     }
 }
