@@ -52,7 +52,7 @@ def ralph2():
 def scholtes3():
     v = ca.SX.sym("v", 2)
     f = 0.5 * ((v[0] - 1) ** 2 + (v[1] - 1) ** 2)
-    return v, [0.0, 0.0], f, [], [(v[0], v[1])], {}, 0.5
+    return v, [1e-4, 1e-4], f, [], [(v[0], v[1])], {}, 0.5
 
 
 def jr2():

@@ -127,12 +127,12 @@ pub fn ralph2() -> Case {
 }
 
 /// MacMPEC scholtes3 (Scholtes): min ½((x−1)² + (y−1)²)  s.t. 0 ≤ x ⊥ y ≥ 0. f* = 0.5
-/// at (1, 0) or (0, 1).
+/// at (1, 0) or (0, 1); the .mod's start (1e-4, 1e-4), close to the biactive origin.
 pub fn scholtes3() -> Case {
     fn build() -> Problem {
         let mut pb = Problem::new();
         let v = scalars(&mut pb, &["x", "y"]);
-        pb.set_initial(&v, &[0.0, 0.0]).unwrap();
+        pb.set_initial(&v, &[1e-4, 1e-4]).unwrap();
         pb.minimize(0.5 * ((v[0] - 1.0).sq() + (v[1] - 1.0).sq()));
         pb.complementarity("c", v[0], v[1]).unwrap();
         pb
