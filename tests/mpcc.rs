@@ -6,7 +6,8 @@
 //! Problems of MacMPEC (S. Leyffer's collection of MPCCs in AMPL, Argonne; the f* are the
 //! values of its table, also reported by Fletcher & Leyffer 2004, Optim. Methods Softw.
 //! 19(1):15–40, Table 1) and small problems derived by hand. Every case asserts, per back
-//! end, either success — objective within 1e-6 relative (absolute when f* = 0) of f*
+//! end, either success — objective within 1e-6 relative (absolute when f* = 0) of f*, or
+//! to the published digits (outrata31: 1e-4) —
 //! and complementarity residual ≤ 1e-8 — or its listed known failure (the failure is
 //! asserted, so a change of behaviour fails the test).
 use symnlp::nlp;
@@ -24,7 +25,7 @@ fn objective_error(f: f64, f_star: f64) -> f64 {
 
 pub fn solved(case: &Case, s: &MpccSolution) -> bool {
     s.solution.status.is_success()
-        && objective_error(s.solution.objective, case.f_star) <= 1e-6
+        && objective_error(s.solution.objective, case.f_star) <= case.f_tol
         && s.report.residual <= 1e-8
 }
 
@@ -71,6 +72,7 @@ mpcc_tests! {
     scholtes5,
     nash1, dempe, desilva, gauvin, qpec2, scale1, fl_ex1, fl_ex2,
     lcp_chain,
+    outrata31,
 }
 
 /// One JSON line per case and back end (for docs/performance.md):

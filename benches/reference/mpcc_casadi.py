@@ -99,6 +99,18 @@ def nash1():
     return v, [0.0] * 6, f, rows, pairs, {0: 0.0, 1: 0.0, 4: 0.0, 5: 0.0}, 0.0, {0: 10.0, 1: 10.0}
 
 
+def outrata31():
+    v = ca.SX.sym("v", 5)
+    x1, x2, x3, x4, y = [v[i] for i in range(5)]
+    f1 = (1 + 0.2 * y) * x1 - (3 + 1.333 * y) - 0.333 * x3 + 2 * x1 * x4
+    f2 = (1 + 0.1 * y) * x2 - y + x3 + 2 * x2 * x4
+    f3 = 0.333 * x1 - x2 + 1 - 0.1 * y
+    f4 = 9 + 0.1 * y - x1 ** 2 - x2 ** 2
+    pairs = [(f1, x1), (f2, x2), (f3, x3), (f4, x4)]
+    f = 0.5 * ((x1 - 3) ** 2 + (x2 - 4) ** 2)
+    return v, [0.0] * 5, f, [], pairs, {i: 0.0 for i in range(5)}, 3.2077, {4: 10.0}
+
+
 def dempe():
     v = ca.SX.sym("v", 3)
     x, z, w = v[0], v[1], v[2]
@@ -148,7 +160,7 @@ def fl_ex2():
 
 CASES = [two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr2, kth1, kth2, kth3,
          scholtes5, nash1, dempe, desilva,
-         gauvin, qpec2, scale1, fl_ex1, fl_ex2, lcp_chain]
+         gauvin, qpec2, scale1, fl_ex1, fl_ex2, lcp_chain, outrata31]
 
 
 def solve(case):
@@ -174,7 +186,8 @@ def solve(case):
     res = float(ca.mmax(ca.fabs(ab(r["x"])))) if pairs else 0.0
     fv = float(r["f"])
     err = abs(fv - f_star) / max(1.0, abs(f_star))
-    ok = st["return_status"] == "Solve_Succeeded" and err <= 1e-6 and res <= 1e-8
+    f_tol = 1e-4 if case.__name__ == "outrata31" else 1e-6  # f* published to 5 digits
+    ok = st["return_status"] == "Solve_Succeeded" and err <= f_tol and res <= 1e-8
     return {"name": case.__name__, "status": st["return_status"], "iterations": st["iter_count"],
             "objective": fv, "f_star": f_star, "residual": res, "solved": ok,
             "seconds": st.get("t_wall_total", wall)}
