@@ -33,7 +33,12 @@ pub struct Compiled {
 }
 
 impl Compiled {
-    pub(crate) fn new(problem: &Problem, f: Expr, g: &[Expr], params: Vec<f64>) -> Result<Compiled, BuildError> {
+    pub(crate) fn new(
+        problem: &Problem,
+        f: Expr,
+        g: &[Expr],
+        params: Vec<f64>,
+    ) -> Result<Compiled, BuildError> {
         let parts = problem.parts();
         let x = parts.variables;
         let p = parts.parameters;
@@ -69,7 +74,11 @@ impl Compiled {
             jac_sparsity: jac.sparsity().clone(),
             hess_sparsity: hess.sparsity().clone(),
             work: vec![0.0; work_size],
-            variable_names: x.iter().enumerate().map(|(i, e)| e.name().unwrap_or_else(|| format!("x[{i}]"))).collect(),
+            variable_names: x
+                .iter()
+                .enumerate()
+                .map(|(i, e)| e.name().unwrap_or_else(|| format!("x[{i}]")))
+                .collect(),
             variable_blocks: parts.variable_blocks.to_vec(),
             parameter_blocks: parts.parameter_blocks.to_vec(),
             constraint_blocks: parts.constraint_blocks.to_vec(),
@@ -82,12 +91,23 @@ impl Compiled {
             .parameter_blocks
             .iter()
             .find(|b| b.name == name)
-            .ok_or_else(|| BuildError::NotDeclared { what: format!("set_parameter('{name}')"), index: 0, kind: "parameter" })?;
+            .ok_or_else(|| BuildError::NotDeclared {
+                what: format!("set_parameter('{name}')"),
+                index: 0,
+                kind: "parameter",
+            })?;
         if values.len() != block.len {
-            return Err(BuildError::Size { what: format!("parameter '{name}'"), expected: block.len, got: values.len() });
+            return Err(BuildError::Size {
+                what: format!("parameter '{name}'"),
+                expected: block.len,
+                got: values.len(),
+            });
         }
         if let Some(&v) = values.iter().find(|v| !v.is_finite()) {
-            return Err(BuildError::NotFinite { what: format!("value of parameter '{name}'"), value: v });
+            return Err(BuildError::NotFinite {
+                what: format!("value of parameter '{name}'"),
+                value: v,
+            });
         }
         self.params[block.range()].copy_from_slice(values);
         Ok(())
@@ -96,10 +116,17 @@ impl Compiled {
     /// Replaces the initial guess (e.g. for a new solve after changing parameters).
     pub fn set_initial_point(&mut self, x0: &[f64]) -> Result<(), BuildError> {
         if x0.len() != self.n {
-            return Err(BuildError::Size { what: "initial point".into(), expected: self.n, got: x0.len() });
+            return Err(BuildError::Size {
+                what: "initial point".into(),
+                expected: self.n,
+                got: x0.len(),
+            });
         }
         if let Some(i) = x0.iter().position(|v| !v.is_finite()) {
-            return Err(BuildError::NotFinite { what: format!("initial value of '{}'", self.variable_names[i]), value: x0[i] });
+            return Err(BuildError::NotFinite {
+                what: format!("initial value of '{}'", self.variable_names[i]),
+                value: x0[i],
+            });
         }
         self.x0.copy_from_slice(x0);
         Ok(())
@@ -167,10 +194,18 @@ impl NumericNlp for Compiled {
         Compiled::eval(&self.jac_fn, &[x, &self.params], values, &mut self.work);
     }
     fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]) {
-        Compiled::eval(&self.hess_fn, &[x, &self.params, &[obj_factor], lambda], values, &mut self.work);
+        Compiled::eval(
+            &self.hess_fn,
+            &[x, &self.params, &[obj_factor], lambda],
+            values,
+            &mut self.work,
+        );
     }
     fn variable_name(&self, i: usize) -> String {
-        self.variable_names.get(i).cloned().unwrap_or_else(|| format!("x[{i}]"))
+        self.variable_names
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| format!("x[{i}]"))
     }
     fn constraint_name(&self, i: usize) -> String {
         row_name(&self.constraint_blocks, i, "g")

@@ -22,7 +22,10 @@ pub(crate) struct Row {
 
 impl Constraint {
     fn single(row: Row) -> Constraint {
-        Constraint { rows: vec![row], mismatch: None }
+        Constraint {
+            rows: vec![row],
+            mismatch: None,
+        }
     }
 
     /// Number of scalar rows.
@@ -71,15 +74,51 @@ enum Kind {
 fn relation(lhs: Expr, rhs: Expr, kind: Kind) -> Row {
     let inf = f64::INFINITY;
     match (lhs.value(), rhs.value(), kind) {
-        (_, Some(c), Kind::Eq) => Row { expr: lhs, lower: c, upper: c },
-        (Some(c), None, Kind::Eq) => Row { expr: rhs, lower: c, upper: c },
-        (_, Some(c), Kind::Le) => Row { expr: lhs, lower: -inf, upper: c },
-        (Some(c), None, Kind::Le) => Row { expr: rhs, lower: c, upper: inf },
-        (_, Some(c), Kind::Ge) => Row { expr: lhs, lower: c, upper: inf },
-        (Some(c), None, Kind::Ge) => Row { expr: rhs, lower: -inf, upper: c },
-        (None, None, Kind::Eq) => Row { expr: lhs - rhs, lower: 0.0, upper: 0.0 },
-        (None, None, Kind::Le) => Row { expr: lhs - rhs, lower: -inf, upper: 0.0 },
-        (None, None, Kind::Ge) => Row { expr: lhs - rhs, lower: 0.0, upper: inf },
+        (_, Some(c), Kind::Eq) => Row {
+            expr: lhs,
+            lower: c,
+            upper: c,
+        },
+        (Some(c), None, Kind::Eq) => Row {
+            expr: rhs,
+            lower: c,
+            upper: c,
+        },
+        (_, Some(c), Kind::Le) => Row {
+            expr: lhs,
+            lower: -inf,
+            upper: c,
+        },
+        (Some(c), None, Kind::Le) => Row {
+            expr: rhs,
+            lower: c,
+            upper: inf,
+        },
+        (_, Some(c), Kind::Ge) => Row {
+            expr: lhs,
+            lower: c,
+            upper: inf,
+        },
+        (Some(c), None, Kind::Ge) => Row {
+            expr: rhs,
+            lower: -inf,
+            upper: c,
+        },
+        (None, None, Kind::Eq) => Row {
+            expr: lhs - rhs,
+            lower: 0.0,
+            upper: 0.0,
+        },
+        (None, None, Kind::Le) => Row {
+            expr: lhs - rhs,
+            lower: -inf,
+            upper: 0.0,
+        },
+        (None, None, Kind::Ge) => Row {
+            expr: lhs - rhs,
+            lower: 0.0,
+            upper: inf,
+        },
     }
 }
 
@@ -136,7 +175,11 @@ broadcast_relation!(f64, Expr);
 /// [`crate::Problem::subject_to`].
 fn entrywise(a: &Matrix, b: &Matrix, kind: fn() -> Kind) -> Constraint {
     Constraint {
-        rows: a.iter().zip(b.iter()).map(|(&x, &y)| relation(x, y, kind())).collect(),
+        rows: a
+            .iter()
+            .zip(b.iter())
+            .map(|(&x, &y)| relation(x, y, kind()))
+            .collect(),
         mismatch: (a.shape() != b.shape()).then(|| (a.shape(), b.shape())),
     }
 }
@@ -156,7 +199,11 @@ impl Relation<&Matrix> for &Matrix {
 /// The two-sided constraint `lower ≤ g ≤ upper` for every entry of `g`.
 pub fn bounded(lower: f64, g: impl Into<Matrix>, upper: f64) -> Constraint {
     Constraint {
-        rows: g.into().iter().map(|&expr| Row { expr, lower, upper }).collect(),
+        rows: g
+            .into()
+            .iter()
+            .map(|&expr| Row { expr, lower, upper })
+            .collect(),
         mismatch: None,
     }
 }

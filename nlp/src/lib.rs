@@ -21,8 +21,8 @@ pub use ipm::Ipm;
 pub use problem::{Block, BuildError, ComplementarityReport, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
-pub use numeric::{AffineCone, NumericNlp};
 pub use mpcc::{solve_mpcc, MpccBackend, MpccError, MpccOptions, MpccPhase, MpccSolution};
-pub use sqp::{HessianApproximation, Sqp, SqpOptions};
+pub use numeric::{AffineCone, NumericNlp};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
 pub use solution::{IterationRecord, Solution, Stats, Status};
+pub use sqp::{HessianApproximation, Sqp, SqpOptions};

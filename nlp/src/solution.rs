@@ -141,3 +141,23 @@ pub struct Solution {
     /// Statistics.
     pub stats: Stats,
 }
+
+impl Solution {
+    /// Checks that this solution can warm-start a problem with `n` variables and `m`
+    /// constraints (lengths of x, λ, z_L, z_U).
+    pub fn check_warm_start(&self, n: usize, m: usize) -> Result<(), crate::SolveError> {
+        for (what, len, expected) in [
+            ("previous.x", self.x.len(), n),
+            ("previous.lambda", self.lambda.len(), m),
+            ("previous.z_l", self.z_l.len(), n),
+            ("previous.z_u", self.z_u.len(), n),
+        ] {
+            if len != expected {
+                return Err(crate::SolveError::WrongSize(format!(
+                    "{what} has length {len}, expected {expected}"
+                )));
+            }
+        }
+        Ok(())
+    }
+}

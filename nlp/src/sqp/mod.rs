@@ -257,19 +257,7 @@ impl Sqp {
         nlp: &mut dyn NumericNlp,
         previous: &Solution,
     ) -> Result<Solution, SolveError> {
-        let (n, m) = (nlp.n(), nlp.m());
-        for (what, len, expected) in [
-            ("previous.x", previous.x.len(), n),
-            ("previous.lambda", previous.lambda.len(), m),
-            ("previous.z_l", previous.z_l.len(), n),
-            ("previous.z_u", previous.z_u.len(), n),
-        ] {
-            if len != expected {
-                return Err(SolveError::WrongSize(format!(
-                    "{what} has length {len}, expected {expected}"
-                )));
-            }
-        }
+        previous.check_warm_start(nlp.n(), nlp.m())?;
         self.run(nlp, Some(previous))
     }
 
