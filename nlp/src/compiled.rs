@@ -1,5 +1,5 @@
 //! [`Compiled`]: a problem differentiated and compiled once; the numeric NLP solvers consume.
-use crate::numeric::NumericNlp;
+use crate::numeric::{AffineCone, NumericNlp};
 use crate::problem::{row_name, Block, BuildError, Problem};
 use symx::{Expr, Function, Matrix, Sparsity};
 
@@ -30,6 +30,10 @@ pub struct Compiled {
     variable_blocks: Vec<Block>,
     parameter_blocks: Vec<Block>,
     constraint_blocks: Vec<Block>,
+    /// Affine second-order cones, with evaluators of their stacked entries `[t; v]` and
+    /// of the entries' Jacobian (`None` without affine cones).
+    affine_cones: Vec<AffineCone>,
+    cone_fns: Option<(Function, Function, Sparsity)>,
 }
 
 impl Compiled {
@@ -52,8 +56,30 @@ impl Compiled {
         let g_fn = Function::new(&[x, p], &[g])?;
         let jac_fn = Function::new(&[x, p], &[jac.values()])?;
         let hess_fn = Function::new(&[x, p, &[sigma], &lambda], &[hess.values()])?;
+        let mut affine_cones = Vec::new();
+        let mut entries = Vec::new();
+        for c in parts.cones.iter().filter(|c| c.affine) {
+            affine_cones.push(AffineCone {
+                row: c.row,
+                offset: entries.len(),
+                dim: 1 + c.v.len(),
+            });
+            entries.push(c.t);
+            entries.extend_from_slice(&c.v);
+        }
+        let cone_fns = if entries.is_empty() {
+            None
+        } else {
+            let cj = symx::jacobian(&entries, x)?;
+            Some((
+                Function::new(&[x, p], &[&entries])?,
+                Function::new(&[x, p], &[cj.values()])?,
+                cj.sparsity().clone(),
+            ))
+        };
         let work_size = [&f_fn, &grad_fn, &g_fn, &jac_fn, &hess_fn]
-            .iter()
+            .into_iter()
+            .chain(cone_fns.iter().flat_map(|(a, b, _)| [a, b]))
             .map(|f| f.work_size())
             .max()
             .unwrap_or(0);
@@ -82,6 +108,8 @@ impl Compiled {
             variable_blocks: parts.variable_blocks.to_vec(),
             parameter_blocks: parts.parameter_blocks.to_vec(),
             constraint_blocks: parts.constraint_blocks.to_vec(),
+            affine_cones,
+            cone_fns,
         })
     }
 
@@ -209,5 +237,21 @@ impl NumericNlp for Compiled {
     }
     fn constraint_name(&self, i: usize) -> String {
         row_name(&self.constraint_blocks, i, "g")
+    }
+    fn affine_cones(&self) -> &[AffineCone] {
+        &self.affine_cones
+    }
+    fn cone_jac_sparsity(&self) -> Option<&Sparsity> {
+        self.cone_fns.as_ref().map(|(_, _, s)| s)
+    }
+    fn eval_cone_entries(&mut self, x: &[f64], out: &mut [f64]) {
+        if let Some((f, _, _)) = &self.cone_fns {
+            Compiled::eval(f, &[x, &self.params], out, &mut self.work);
+        }
+    }
+    fn eval_cone_jac(&mut self, x: &[f64], values: &mut [f64]) {
+        if let Some((_, f, _)) = &self.cone_fns {
+            Compiled::eval(f, &[x, &self.params], values, &mut self.work);
+        }
     }
 }
