@@ -84,6 +84,30 @@ fn distance_to_a_line() {
     }
 }
 
+/// min t  s.t.  ‖x − a‖ ≤ t,  x₁ + x₂ + x₃ = 0, a = (1, 2, 3): a cone of dimension 4.
+///
+/// As above, t* is the distance from a to the plane c·x = 0, c = (1, 1, 1):
+/// t* = |c·a|/‖c‖ = 6/√3 = 2√3, at x* = a − (c·a/‖c‖²) c = (1, 2, 3) − 2·(1, 1, 1)
+/// = (−1, 0, 1).
+#[test]
+fn distance_to_a_plane() {
+    let mut pb = Problem::new();
+    let x = pb.variable("x", 3);
+    let t = pb.scalar_variable("t");
+    let a = [1.0, 2.0, 3.0];
+    pb.minimize(t);
+    let v: Vec<Expr> = (0..3).map(|i| x[i] - a[i]).collect();
+    pb.subject_to_cone("dist", &v, t).unwrap();
+    pb.subject_to_named("plane", (x[0] + x[1] + x[2]).eq(0.0))
+        .unwrap();
+    for s in solve_both(&pb, 1) {
+        assert_close("objective", s.objective, 2.0 * 3f64.sqrt(), 1e-6);
+        for (i, want) in [-1.0, 0.0, 1.0].into_iter().enumerate() {
+            assert_close("x", s.x[i], want, 1e-6);
+        }
+    }
+}
+
 /// A cone that is not affine: min −y  s.t.  ‖(x, y)‖ ≤ 2 − x² (a convex set: ‖(x, y)‖ + x²
 /// is convex). Both back ends see the smooth row. On the boundary y² = (2 − x²)² − x²
 /// = 4 − 5x² + x⁴, decreasing in x² on [0, 2] (derivative −5 + 2x² < 0), so the largest y
