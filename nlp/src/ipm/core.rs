@@ -590,9 +590,16 @@ impl<'p> Core<'p> {
         let xreg = self.opts.kkt_static_hessian_regularization;
         self.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
         self.update_eq_reg();
+        // The static regularisation of the equality rows, 1e-6 × the step's: the
+        // Schur complement here is J Jᵀ, whose smallest eigenvalue on a long chain of
+        // small-entry rows is far below the step's regularisation (chain with 5000
+        // links: σ_min(J)² ≈ 2.5e-13 against 1e-11); at full size the singularity test
+        // below reported J rank-deficient and y = 0, and refinement could not remove
+        // it from the smooth (low-frequency) part of y either.
+        let ls_reg = 1e-6;
         for i in 0..m {
             self.kdc[i] = if self.slack_of_row[i] == usize::MAX {
-                self.eq_reg[i]
+                ls_reg * self.eq_reg[i]
             } else {
                 1.0
             };
@@ -626,7 +633,7 @@ impl<'p> Core<'p> {
         if n_eq > 0 && self.opts.kkt_static_regularization > 0.0 {
             for i in 0..m {
                 if self.slack_of_row[i] == usize::MAX {
-                    self.kdc[i] = 10.0 * self.eq_reg[i];
+                    self.kdc[i] = 10.0 * ls_reg * self.eq_reg[i];
                 }
             }
             if self
@@ -637,7 +644,7 @@ impl<'p> Core<'p> {
                 let ld10 = self.kkt.log_abs_det();
                 for i in 0..m {
                     if self.slack_of_row[i] == usize::MAX {
-                        self.kdc[i] = self.eq_reg[i];
+                        self.kdc[i] = ls_reg * self.eq_reg[i];
                     }
                 }
                 if self
@@ -650,7 +657,7 @@ impl<'p> Core<'p> {
             }
             for i in 0..m {
                 if self.slack_of_row[i] == usize::MAX {
-                    self.kdc[i] = self.eq_reg[i];
+                    self.kdc[i] = ls_reg * self.eq_reg[i];
                 }
             }
         }
@@ -659,7 +666,7 @@ impl<'p> Core<'p> {
         }
         for i in 0..m {
             self.shift[n + i] = if self.slack_of_row[i] == usize::MAX {
-                self.eq_reg[i]
+                ls_reg * self.eq_reg[i]
             } else {
                 0.0
             };
