@@ -1,39 +1,12 @@
 //! The hanging chain of benches/solve.rs at one size (default 50 000 links), with the
 //! iteration log. Ignored: `CHAIN_N=50000 cargo test --release -p nlp --test chain_large -- --ignored --nocapture`.
 
-use nlp::{Ipm, IpmOptions, Problem, Relation};
-use symx::{Expr, Matrix};
+// The benchmark's own builder, so the test and benches/solve.rs cannot drift apart.
+#[path = "../../benches/common/solve_problems.rs"]
+mod solve_problems;
 
-fn hanging_chain(links: usize) -> Problem {
-    let n = 2 * (links + 1);
-    let mut pb = Problem::new();
-    let w = pb.variable("w", n);
-    let x = |i: usize| w[2 * i];
-    let y = |i: usize| w[2 * i + 1];
-    let seg2 = (2.0 / links as f64).powi(2);
-    let g: Vec<Expr> = (0..links)
-        .map(|i| (x(i + 1) - x(i)).sq() + (y(i + 1) - y(i)).sq() - seg2)
-        .collect();
-    let mut f = y(0);
-    for i in 1..=links {
-        f += y(i);
-    }
-    f /= links as f64;
-    pb.minimize(f);
-    pb.subject_to_named("link", (&Matrix::from_vec(g)).eq(0.0))
-        .expect("chain constraints");
-    for (k, v) in [(0, 0.0), (1, 0.0), (2 * links, 1.0), (2 * links + 1, 0.0)] {
-        pb.set_bounds(&[w[k]], v, v).expect("chain bounds");
-    }
-    let mut x0 = vec![0.0; n];
-    for i in 0..=links {
-        let t = i as f64 / links as f64;
-        x0[2 * i] = t;
-        x0[2 * i + 1] = -0.5 * (std::f64::consts::PI * t).sin();
-    }
-    pb.set_initial(&w, &x0).expect("chain start");
-    pb
-}
+use nlp::{Ipm, IpmOptions};
+use solve_problems::hanging_chain;
 
 #[test]
 #[ignore]

@@ -45,7 +45,8 @@ pub struct Model {
     pub layout: Vec<Expr>,
     /// Lifted step lengths `s_i^k` per transition, in [`Foot::ALL`] order (free gait only).
     pub step_lengths: Vec<[Expr; 4]>,
-    /// Name of the penalty parameter (free gait only): see [`PENALTY`].
+    /// Whether the cost holds the complementarity penalty, a parameter named [`PENALTY`]
+    /// (free gait only).
     pub has_penalty: bool,
 }
 

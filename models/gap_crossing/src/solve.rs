@@ -378,10 +378,3 @@ pub fn status_name(status: Status) -> &'static str {
         _ => "failed",
     }
 }
-
-/// The number of variables and constraints of a built model (for summaries).
-pub fn size(s: &Scenario, formulation: &Formulation) -> Result<(usize, usize), PlanningError> {
-    let m = model::build(s, &GapTerrain { gap: s.gap }, formulation, &gait::crawl(s))?;
-    let c = m.problem.compile()?;
-    Ok((c.n(), c.m()))
-}
