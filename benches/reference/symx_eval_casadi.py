@@ -50,13 +50,13 @@ import platform
 import statistics
 import sys
 import time
-import timeit
 
 import casadi as ca
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hanging_chain  # noqa: E402
+from eval_timing import internal_times, nz_stats, time_call  # noqa: E402
 
 
 def build_all(N):
@@ -87,27 +87,6 @@ def build_all(N):
     t["total"] = t5 - t0
     exprs = {"grad_f": ([x], grad_f), "jac_g": ([x], jac_g), "hess_L": ([x, sigma, lam], hess_l)}
     return p, (F_grad, F_jac, F_hess), (x, sigma, lam), t, exprs
-
-
-def time_call(fn, reps, target=0.2):
-    """Median seconds per call of fn() over `reps` repetitions (auto-sized loop)."""
-    timer = timeit.Timer(fn)
-    number, _ = timer.autorange()
-    # scale so one repetition lasts ~target seconds
-    one = timer.timeit(number) / number
-    number = max(1, int(target / max(one, 1e-9)))
-    samples = [timer.timeit(number) / number for _ in range(reps)]
-    return statistics.median(samples), samples
-
-
-def nz_stats(dm):
-    v = np.asarray(dm.nonzeros(), dtype=float)
-    return {
-        "nnz": int(dm.nnz()),
-        "sum": float(v.sum()),
-        "sum_abs": float(np.abs(v).sum()),
-        "norm2": float(np.linalg.norm(v)),
-    }
 
 
 def main():
@@ -169,16 +148,9 @@ def main():
         ins = [ca.DM(a) for a in npin]
         res = F(*ins)
         # CasADi-internal timing
-        rec = []
-        Frec = REC[name]
-        for _ in range(args.eval_reps):
-            ts = []
-            for _ in range(args.internal_calls):
-                Frec(*ins)
-                ts.append(Frec.stats()["t_wall_total"])
-            rec.append(ts)
-        internal_med = statistics.median(statistics.median(ts) for ts in rec)
-        internal_min = min(min(ts) for ts in rec)
+        internal_med, internal_min, rep_medians = internal_times(
+            REC[name], ins, args.eval_reps, args.internal_calls
+        )
 
         call_s, call_samples = time_call(lambda: F(*ins), args.eval_reps)
         T = triv[name]
@@ -204,7 +176,7 @@ def main():
             "call_numpy_us": np_s * 1e6,
             "call_us_samples": [s * 1e6 for s in call_samples],
             "map_us_samples": [s / K * 1e6 for s in map_samples],
-            "internal_us_rep_medians": [statistics.median(ts) * 1e6 for ts in rec],
+            "internal_us_rep_medians": [t * 1e6 for t in rep_medians],
         }
 
     print(json.dumps(out, indent=1))

@@ -44,12 +44,12 @@ import subprocess
 import sys
 import threading
 import time
-import timeit
 
 import casadi as ca
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from eval_timing import internal_times, nz_stats, time_call  # noqa: E402
 from gap_crossing_casadi import Parser  # noqa: E402
 
 
@@ -86,25 +86,6 @@ def build_all(d):
     t["total_without_parse"] = t5 - t1
     exprs = {"grad_f": ([x], grad_f), "jac_g": ([x], jac_g), "hess_L": ([x, sigma, lam], hess_l)}
     return (x, f, g), (F_grad, F_jac, F_hess), (x, sigma, lam), t, exprs
-
-
-def time_call(fn, reps, target=0.2):
-    """Median seconds per call of fn() over `reps` repetitions (auto-sized loop)."""
-    timer = timeit.Timer(fn)
-    number, _ = timer.autorange()
-    one = timer.timeit(number) / number
-    number = max(1, int(target / max(one, 1e-9)))
-    return statistics.median(timer.timeit(number) / number for _ in range(reps))
-
-
-def nz_stats(dm):
-    v = np.asarray(dm.nonzeros(), dtype=float)
-    return {
-        "nnz": int(dm.nnz()),
-        "sum": float(v.sum()),
-        "sum_abs": float(np.abs(v).sum()),
-        "norm2": float(np.linalg.norm(v)),
-    }
 
 
 def run(d, args):
@@ -153,19 +134,12 @@ def run(d, args):
     for name, F in func.items():
         ins = [ca.DM(a) for a in np_inputs[name]]
         res = F(*ins)
-        Frec = rec_f[name]
-        rec = []
-        for _ in range(args.eval_reps):
-            ts = []
-            for _ in range(args.internal_calls):
-                Frec(*ins)
-                ts.append(Frec.stats()["t_wall_total"])
-            rec.append(ts)
-        internal_med = statistics.median(statistics.median(ts) for ts in rec)
-        internal_min = min(min(ts) for ts in rec)
-        call_s = time_call(lambda: F(*ins), args.eval_reps)
+        internal_med, internal_min, rep_medians = internal_times(
+            rec_f[name], ins, args.eval_reps, args.internal_calls
+        )
+        call_s, _ = time_call(lambda: F(*ins), args.eval_reps)
         T = triv[name]
-        ovh_s = time_call(lambda: T(*ins), args.eval_reps)
+        ovh_s, _ = time_call(lambda: T(*ins), args.eval_reps)
         out["functions"][name] = {
             **nz_stats(res),
             "shape": list(res.shape),
@@ -174,7 +148,7 @@ def run(d, args):
             "internal_us_min": internal_min * 1e6,
             "call_us": call_s * 1e6,
             "overhead_us": ovh_s * 1e6,
-            "internal_us_rep_medians": [statistics.median(ts) * 1e6 for ts in rec],
+            "internal_us_rep_medians": [t * 1e6 for t in rep_medians],
         }
         r = out["functions"][name]
         print(f"{name:7} nnz {r['nnz']:6}  instructions {r['n_instructions']:6}  sum {r['sum']:.16e}  "
