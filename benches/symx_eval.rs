@@ -32,8 +32,16 @@ mod hanging_chain;
 
 const LINKS: usize = 1000;
 
+/// An NLP in symbolic form: objective, constraints, variables.
+struct Symbolic {
+    f: Expr,
+    g: Vec<Expr>,
+    x: Vec<Expr>,
+}
+
+/// ∇f, ∂g/∂x and the lower triangle of ∇²(σf + λᵀg) with σ, λ symbolic.
 struct Derivatives {
-    chain: hanging_chain::HangingChain,
+    x: Vec<Expr>,
     grad: Vec<Expr>,
     jac: SparseMatrix,
     sigma: Expr,
@@ -41,14 +49,26 @@ struct Derivatives {
     hess: SparseMatrix,
 }
 
-fn differentiate(chain: hanging_chain::HangingChain) -> Derivatives {
-    let grad = gradient(chain.f, &chain.w).unwrap();
-    let jac = jacobian(&chain.g, &chain.w).unwrap();
+fn gradient_of(p: &Symbolic) -> Vec<Expr> {
+    gradient(p.f, &p.x).unwrap()
+}
+
+fn jacobian_of(p: &Symbolic) -> SparseMatrix {
+    jacobian(&p.g, &p.x).unwrap()
+}
+
+fn hessian_of(p: &Symbolic) -> (Expr, Matrix, SparseMatrix) {
     let sigma = Expr::sym("sigma");
-    let lambda = Matrix::sym_vec("lambda", chain.g.len());
-    let hess = lagrangian_hessian(chain.f, &chain.g, &chain.w, sigma, &lambda).unwrap();
+    let lambda = Matrix::sym_vec("lambda", p.g.len());
+    let hess = lagrangian_hessian(p.f, &p.g, &p.x, sigma, &lambda).unwrap();
+    (sigma, lambda, hess)
+}
+
+fn differentiate(p: Symbolic) -> Derivatives {
+    let (grad, jac) = (gradient_of(&p), jacobian_of(&p));
+    let (sigma, lambda, hess) = hessian_of(&p);
     Derivatives {
-        chain,
+        x: p.x,
         grad,
         jac,
         sigma,
@@ -64,30 +84,29 @@ struct Compiled {
 }
 
 fn compile(d: &Derivatives) -> Compiled {
-    let w = &d.chain.w;
+    let x = &d.x;
     Compiled {
-        grad: Function::new(&[w], &[&d.grad]).unwrap(),
-        jac: Function::new(&[w], &[d.jac.values()]).unwrap(),
-        hess: Function::new(&[w, &[d.sigma], &d.lambda], &[d.hess.values()]).unwrap(),
+        grad: Function::new(&[x], &[&d.grad]).unwrap(),
+        jac: Function::new(&[x], &[d.jac.values()]).unwrap(),
+        hess: Function::new(&[x, &[d.sigma], &d.lambda], &[d.hess.values()]).unwrap(),
     }
 }
 
-/// Set-up phases, timed in a fresh thread: (expr, grad_f, jac_g, hess_L, functions).
-fn setup_phases() -> [Duration; 5] {
+/// Set-up phases timed in a fresh thread (a fresh expression graph, as a new program
+/// would have): (build, grad_f, jac_g, hess_L, functions).
+fn setup_phases(build: impl FnOnce() -> Symbolic + Send + 'static) -> [Duration; 5] {
     std::thread::spawn(|| {
         let t0 = Instant::now();
-        let chain = hanging_chain::build(LINKS);
+        let p = build();
         let t1 = Instant::now();
-        let grad = gradient(chain.f, &chain.w).unwrap();
+        let grad = gradient_of(&p);
         let t2 = Instant::now();
-        let jac = jacobian(&chain.g, &chain.w).unwrap();
+        let jac = jacobian_of(&p);
         let t3 = Instant::now();
-        let sigma = Expr::sym("sigma");
-        let lambda = Matrix::sym_vec("lambda", chain.g.len());
-        let hess = lagrangian_hessian(chain.f, &chain.g, &chain.w, sigma, &lambda).unwrap();
+        let (sigma, lambda, hess) = hessian_of(&p);
         let t4 = Instant::now();
         let d = Derivatives {
-            chain,
+            x: p.x,
             grad,
             jac,
             sigma,
@@ -102,14 +121,14 @@ fn setup_phases() -> [Duration; 5] {
     .unwrap()
 }
 
-/// The gap-crossing problem with the derivatives of the chain group.
-struct GapDerivatives {
-    x: Vec<Expr>,
-    grad: Vec<Expr>,
-    jac: SparseMatrix,
-    sigma: Expr,
-    lambda: Matrix,
-    hess: SparseMatrix,
+fn chain(links: usize) -> (Symbolic, Vec<f64>) {
+    let c = hanging_chain::build(links);
+    let p = Symbolic {
+        f: c.f,
+        g: c.g,
+        x: c.w.to_vec(),
+    };
+    (p, c.x0)
 }
 
 /// The default scenario (n_step 60, default gap), crawl schedule and crawl guess.
@@ -129,71 +148,16 @@ fn gap_model(s: &Scenario) -> Model {
     .unwrap()
 }
 
-fn gap_differentiate(m: &Model) -> GapDerivatives {
-    let x = m.problem.variables().to_vec();
-    let f = m.problem.objective();
-    let g = m.problem.constraint_expressions();
-    let grad = gradient(f, &x).unwrap();
-    let jac = jacobian(&g, &x).unwrap();
-    let sigma = Expr::sym("sigma");
-    let lambda = Matrix::sym_vec("lambda", g.len());
-    let hess = lagrangian_hessian(f, &g, &x, sigma, &lambda).unwrap();
-    GapDerivatives {
-        x,
-        grad,
-        jac,
-        sigma,
-        lambda,
-        hess,
+fn gap_symbolic(m: &Model) -> Symbolic {
+    Symbolic {
+        f: m.problem.objective(),
+        g: m.problem.constraint_expressions(),
+        x: m.problem.variables().to_vec(),
     }
 }
 
-fn gap_compile(d: &GapDerivatives) -> Compiled {
-    let x = &d.x;
-    Compiled {
-        grad: Function::new(&[x], &[&d.grad]).unwrap(),
-        jac: Function::new(&[x], &[d.jac.values()]).unwrap(),
-        hess: Function::new(&[x, &[d.sigma], &d.lambda], &[d.hess.values()]).unwrap(),
-    }
-}
-
-/// Gap-crossing set-up phases, timed in a fresh thread: (build, grad_f, jac_g, hess_L,
-/// functions).
-fn gap_setup_phases(s: &Scenario) -> [Duration; 5] {
-    let s = s.clone();
-    std::thread::spawn(move || {
-        let t0 = Instant::now();
-        let m = gap_model(&s);
-        let x = m.problem.variables().to_vec();
-        let f = m.problem.objective();
-        let g = m.problem.constraint_expressions();
-        let t1 = Instant::now();
-        let grad = gradient(f, &x).unwrap();
-        let t2 = Instant::now();
-        let jac = jacobian(&g, &x).unwrap();
-        let t3 = Instant::now();
-        let sigma = Expr::sym("sigma");
-        let lambda = Matrix::sym_vec("lambda", g.len());
-        let hess = lagrangian_hessian(f, &g, &x, sigma, &lambda).unwrap();
-        let t4 = Instant::now();
-        let d = GapDerivatives {
-            x,
-            grad,
-            jac,
-            sigma,
-            lambda,
-            hess,
-        };
-        black_box(gap_compile(&d));
-        let t5 = Instant::now();
-        [t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4]
-    })
-    .join()
-    .unwrap()
-}
-
-fn inputs(links: usize, x0: &[f64]) -> (Vec<f64>, [f64; 1], Vec<f64>) {
-    let lambda = (0..links).map(|i| (i + 1) as f64 / links as f64).collect();
+fn inputs(rows: usize, x0: &[f64]) -> (Vec<f64>, [f64; 1], Vec<f64>) {
+    let lambda = (0..rows).map(|i| (i + 1) as f64 / rows as f64).collect();
     (x0.to_vec(), [1.0], lambda)
 }
 
@@ -234,39 +198,52 @@ fn per_call(f: &Function, ins: &[&[f64]]) -> (f64, f64) {
     (median(&mut medians), min)
 }
 
-fn bench(c: &mut Criterion) {
-    let d = differentiate(hanging_chain::build(LINKS));
-    let fns = compile(&d);
-    let (x, sigma, lambda) = inputs(LINKS, &d.chain.x0);
-    let hess_in: [&[f64]; 3] = [&x, &sigma, &lambda];
-    checksums("grad_f", &fns.grad, &[&x]);
-    checksums("jac_g", &fns.jac, &[&x]);
-    checksums("hess_L", &fns.hess, &hess_in);
-
-    // The same statistic as the CasADi script's `internal_us`: the wall time of single
-    // calls, median over 300 calls, median of 7 repetitions (robust to preemption on a
-    // shared machine, unlike a mean over batches).
-    for (name, f, ins) in [
+/// Prints checksums and per-call medians, then runs the criterion groups
+/// `{group}/setup` (phases of `setup`, named by `build_name` for the first) and
+/// `{group}/eval` for one problem.
+fn measure(
+    c: &mut Criterion,
+    group: &str,
+    fns: &Compiled,
+    hess_in: [&[f64]; 3],
+    build_name: &str,
+    setup_time: Duration,
+    setup: impl Fn() -> [Duration; 5],
+) {
+    let functions = [
         ("grad_f", &fns.grad, &hess_in[..1]),
         ("jac_g", &fns.jac, &hess_in[..1]),
         ("hess_L", &fns.hess, &hess_in[..]),
-    ] {
+    ];
+    for (name, f, ins) in functions {
+        checksums(name, f, ins);
+    }
+    // The same statistic as the CasADi scripts' `internal_us`: the wall time of single
+    // calls, median over 300 calls, median of 7 repetitions (robust to preemption on a
+    // shared machine, unlike a mean over batches).
+    for (name, f, ins) in functions {
         let (median, min) = per_call(f, ins);
         eprintln!("{name:7} per-call median {median:8.3} us  min {min:8.3} us");
     }
 
-    let mut group = c.benchmark_group("symx_eval/setup");
-    group
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(3))
+    let mut g = c.benchmark_group(format!("{group}/setup"));
+    g.sample_size(10)
+        .measurement_time(setup_time)
         .warm_up_time(Duration::from_millis(500));
-    let names = ["expr", "grad_f", "jac_g", "hess_L", "functions", "total"];
+    let names = [
+        build_name,
+        "grad_f",
+        "jac_g",
+        "hess_L",
+        "functions",
+        "total",
+    ];
     for (k, name) in names.iter().enumerate() {
-        group.bench_function(BenchmarkId::from_parameter(name), |b| {
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter_custom(|iters| {
                 (0..iters)
                     .map(|_| {
-                        let p = setup_phases();
+                        let p = setup();
                         if k < 5 {
                             p[k]
                         } else {
@@ -277,102 +254,68 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
-    group.finish();
+    g.finish();
 
-    let mut group = c.benchmark_group("symx_eval/eval");
-    group
-        .sample_size(20)
+    let mut g = c.benchmark_group(format!("{group}/eval"));
+    g.sample_size(20)
         .measurement_time(Duration::from_secs(3))
         .warm_up_time(Duration::from_secs(1));
-    for (name, f, ins) in [
-        ("grad_f", &fns.grad, &hess_in[..1]),
-        ("jac_g", &fns.jac, &hess_in[..1]),
-        ("hess_L", &fns.hess, &hess_in[..]),
-    ] {
+    for (name, f, ins) in functions {
         let mut out = vec![0.0; f.output_sizes()[0]];
         let mut work = vec![0.0; f.work_size()];
-        group.bench_function(BenchmarkId::from_parameter(name), |b| {
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter(|| {
                 f.eval(black_box(ins), &mut [&mut out], &mut work).unwrap();
                 black_box(&out);
             })
         });
     }
-    group.finish();
+    g.finish();
+}
+
+fn bench(c: &mut Criterion) {
+    let (p, x0) = chain(LINKS);
+    let fns = compile(&differentiate(p));
+    let (x, sigma, lambda) = inputs(LINKS, &x0);
+    measure(
+        c,
+        "symx_eval",
+        &fns,
+        [&x, &sigma, &lambda],
+        "expr",
+        Duration::from_secs(3),
+        || setup_phases(|| chain(LINKS).0),
+    );
 }
 
 fn bench_gap(c: &mut Criterion) {
     let s = gap_scenario();
     let m = gap_model(&s);
-    let d = gap_differentiate(&m);
-    let fns = gap_compile(&d);
+    let sym = gap_symbolic(&m);
+    let (nx, ng) = (sym.x.len(), sym.g.len());
+    let fns = compile(&differentiate(sym));
     let compiled = m.problem.compile().unwrap();
     let (n, rows) = (compiled.n(), compiled.m());
-    assert_eq!((n, rows), (d.x.len(), d.lambda.len()));
+    assert_eq!((n, rows), (nx, ng));
     let mut x0 = vec![0.0; n];
     compiled.initial_point(&mut x0);
     let (x, sigma, lambda) = inputs(rows, &x0);
-    let hess_in: [&[f64]; 3] = [&x, &sigma, &lambda];
     eprintln!(
         "gap crossing (crawl, default scenario, n_step {}): n {n}, m {rows}",
         s.n_step
     );
-    checksums("grad_f", &fns.grad, &[&x]);
-    checksums("jac_g", &fns.jac, &[&x]);
-    checksums("hess_L", &fns.hess, &hess_in);
-    for (name, f, ins) in [
-        ("grad_f", &fns.grad, &hess_in[..1]),
-        ("jac_g", &fns.jac, &hess_in[..1]),
-        ("hess_L", &fns.hess, &hess_in[..]),
-    ] {
-        let (median, min) = per_call(f, ins);
-        eprintln!("{name:7} per-call median {median:8.3} us  min {min:8.3} us");
-    }
-
-    let mut group = c.benchmark_group("symx_eval_gap/setup");
-    group
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(5))
-        .warm_up_time(Duration::from_millis(500));
-    let names = ["build", "grad_f", "jac_g", "hess_L", "functions", "total"];
-    for (k, name) in names.iter().enumerate() {
-        group.bench_function(BenchmarkId::from_parameter(name), |b| {
-            b.iter_custom(|iters| {
-                (0..iters)
-                    .map(|_| {
-                        let p = gap_setup_phases(&s);
-                        if k < 5 {
-                            p[k]
-                        } else {
-                            p.iter().sum()
-                        }
-                    })
-                    .sum()
-            })
-        });
-    }
-    group.finish();
-
-    let mut group = c.benchmark_group("symx_eval_gap/eval");
-    group
-        .sample_size(20)
-        .measurement_time(Duration::from_secs(3))
-        .warm_up_time(Duration::from_secs(1));
-    for (name, f, ins) in [
-        ("grad_f", &fns.grad, &hess_in[..1]),
-        ("jac_g", &fns.jac, &hess_in[..1]),
-        ("hess_L", &fns.hess, &hess_in[..]),
-    ] {
-        let mut out = vec![0.0; f.output_sizes()[0]];
-        let mut work = vec![0.0; f.work_size()];
-        group.bench_function(BenchmarkId::from_parameter(name), |b| {
-            b.iter(|| {
-                f.eval(black_box(ins), &mut [&mut out], &mut work).unwrap();
-                black_box(&out);
-            })
-        });
-    }
-    group.finish();
+    measure(
+        c,
+        "symx_eval_gap",
+        &fns,
+        [&x, &sigma, &lambda],
+        "build",
+        Duration::from_secs(5),
+        || {
+            let s = s.clone();
+            setup_phases(move || gap_symbolic(&gap_model(&s)))
+        },
+    );
 }
 
 criterion_group!(benches, bench, bench_gap);
