@@ -65,6 +65,7 @@ def main():
         (ref, "ocp", "#2471a3", "6,4", "IPOPT, Van der Pol OCP"),
     ]
     notes = []
+    any_capped = False
     ly = 44
     for rows, prob, col, dash, label in series:
         pts = []
@@ -77,6 +78,7 @@ def main():
                 continue
             ok = r.get("status", r.get("return_status")) in ("SolveSucceeded", "Solve_Succeeded")
             pts.append((x_of(r["n"]), y_of(r["solve_s"]), ok))
+            any_capped = any_capped or not ok
         if pts:
             d = " ".join(("M" if i == 0 else "L") + f"{x:.1f},{y:.1f}" for i, (x, y, _) in enumerate(pts))
             out.append(f'<path d="{d}" fill="none" stroke="{col}" stroke-width="2" stroke-dasharray="{dash}"/>')
@@ -92,11 +94,14 @@ def main():
             f'stroke-dasharray="{dash}"/><text x="508" y="{ly + 4}" font-size="10">{label}</text>'
         )
         ly += 18
-    out.append(
-        f'<circle cx="492" cy="{ly + 6}" r="4" fill="white" stroke="black" stroke-width="2"/>'
-        f'<text x="508" y="{ly + 10}" font-size="10">not solved (cap)</text>'
-    )
-    ly += 28
+    if any_capped:
+        out.append(
+            f'<circle cx="492" cy="{ly + 6}" r="4" fill="white" stroke="black" stroke-width="2"/>'
+            f'<text x="508" y="{ly + 10}" font-size="10">not solved (cap)</text>'
+        )
+        ly += 28
+    else:
+        ly += 10
     for note in notes:
         a, b = note.split(": ")
         out.append(f'<text x="480" y="{ly}" font-size="10">{a.replace("^5", "⁵").replace("^4", "⁴")}:</text>'
