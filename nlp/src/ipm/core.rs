@@ -133,6 +133,10 @@ pub(crate) struct Core<'p> {
     shift: Vec<f64>,
     /// Static regularisation of each equality row (see `update_eq_reg`).
     eq_reg: Vec<f64>,
+    /// The regularisation of the current factorisation (see `step_eq_reg`).
+    eq_reg_step: Vec<f64>,
+    /// Position of the diagonal entry of each Hessian column (usize::MAX: none).
+    hess_diag: Vec<usize>,
     hzero: Vec<f64>,
     work_nw: Vec<f64>,
     // algorithm state
@@ -263,6 +267,17 @@ impl<'p> Core<'p> {
         kkt.residual_ratio_max = opts.residual_ratio_max;
         // Refinement target: K without the static regularisation of equality rows.
         let shift = vec![0.0; n + m];
+        let mut hess_diag = vec![usize::MAX; n];
+        {
+            let hp = nlp.hess_l_sparsity();
+            for (j, d) in hess_diag.iter_mut().enumerate() {
+                for p in hp.col_range(j) {
+                    if hp.row_idx()[p] == j {
+                        *d = p;
+                    }
+                }
+            }
+        }
         Ok(Core {
             nlp,
             opts: opts.clone(),
@@ -313,6 +328,8 @@ impl<'p> Core<'p> {
             ds: vec![0.0; ni],
             shift,
             eq_reg: vec![0.0; m],
+            eq_reg_step: vec![0.0; m],
+            hess_diag,
             hzero: vec![0.0; nnz_h],
             work_nw: vec![0.0; nw],
             mu: setup.mu_init,
@@ -590,13 +607,16 @@ impl<'p> Core<'p> {
         let xreg = self.opts.kkt_static_hessian_regularization;
         self.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
         self.update_eq_reg();
-        // The static regularisation of the equality rows, 1e-6 × the step's: the
-        // Schur complement here is J Jᵀ, whose smallest eigenvalue on a long chain of
-        // small-entry rows is far below the step's regularisation (chain with 5000
-        // links: σ_min(J)² ≈ 2.5e-13 against 1e-11); at full size the singularity test
-        // below reported J rank-deficient and y = 0, and refinement could not remove
-        // it from the smooth (low-frequency) part of y either.
-        let ls_reg = 1e-6;
+        // The static regularisation of the equality rows, 1e-2 × the step's: the
+        // Schur complement here is J Jᵀ, whose smallest eigenvalue on a long chain is
+        // far below its diagonal (≈ (π/N)² × it), so a regularisation relative to the
+        // diagonal perturbs the smooth part of y and can trip the singularity test
+        // below (y = 0). Measured: 1× fails the hanging chain with 50 000 links (rows
+        // scaled up to gradient 0.8 by nlp_scaling_min_gradient; not solved in 40 s),
+        // 1e-2× solves it in 8 iterations; 1e-6× (chosen before the row scaling, for the
+        // unscaled 5000-link chain) changed hs027 from 54 to 77 iterations through
+        // round-off alone (the path of hs027 is long and sensitive).
+        let ls_reg = 1e-2;
         for i in 0..m {
             self.kdc[i] = if self.slack_of_row[i] == usize::MAX {
                 ls_reg * self.eq_reg[i]
@@ -863,6 +883,50 @@ impl<'p> Core<'p> {
         self.eq_reg = rmax;
     }
 
+    /// The static regularisation of the equality rows for this factorisation. With
+    /// δ_w = 0 it is `eq_reg` lowered, row by row, to kkt_static_regularization ×
+    /// Σ_j J_ij² / |D_jj| where that is smaller (D the diagonal of W + Σ + the static
+    /// Hessian regularisation, so the sum estimates the row's Schur complement
+    /// J D⁻¹ Jᵀ), but not below 1e-3 × `eq_reg`. The hanging chain needs it: with 50 000
+    /// links (rows scaled up to gradient 0.8) the Schur diagonal is ≈ 1e-4 against
+    /// `eq_reg` = 6.4e-9, and its smooth modes are (π/N)² ≈ 4e-9 times smaller still,
+    /// so refinement could not remove `eq_reg` and the solve did not converge (40 s);
+    /// with the lowering it takes 8 iterations. The 1e-3 bound: without it (or with
+    /// 1e-6) the Wächter–Biegler example of nlp/tests/ipm_mechanisms.rs ends its
+    /// restoration at a point of local infeasibility (1e-4 … 1e-2 pass). With δ_w > 0
+    /// (inertia correction) `eq_reg` is kept: lowering it there too took the 5000-link
+    /// chain 14 iterations (IPOPT's count) instead of 11.
+    fn step_eq_reg(&mut self, delta_w: f64) {
+        let mut out = std::mem::take(&mut self.eq_reg_step);
+        if delta_w == 0.0 {
+            let reg = self.opts.kkt_static_regularization;
+            out.fill(0.0);
+            let jp = self.nlp.jac_g_sparsity();
+            let ri = jp.row_idx();
+            for j in 0..self.n {
+                let hd = self.hess_diag[j];
+                let h = if hd == usize::MAX { 0.0 } else { self.hess[hd] };
+                let d = (h + self.kdx[j]).abs();
+                if d > 0.0 {
+                    for p in jp.col_range(j) {
+                        out[ri[p]] += self.jac[p] * self.jac[p] / d;
+                    }
+                }
+            }
+            for (o, &e) in out.iter_mut().zip(&self.eq_reg) {
+                let r = reg * *o;
+                *o = if r > 0.0 && r.is_finite() {
+                    r.min(e).max(1e-3 * e)
+                } else {
+                    e
+                };
+            }
+        } else {
+            out.copy_from_slice(&self.eq_reg);
+        }
+        self.eq_reg_step = out;
+    }
+
     /// Assembles the KKT matrix for the current iterate with Hessian perturbation
     /// `delta_w` and Jacobian perturbation `self.delta_c` (the static regularisation
     /// `kkt_static_regularization` on equality rows when δ_c = 0) and factorises it.
@@ -879,14 +943,6 @@ impl<'p> Core<'p> {
         } else {
             0.0
         };
-        self.shift[..n].fill(-x_reg);
-        for i in 0..m {
-            self.shift[n + i] = if self.slack_of_row[i] == usize::MAX && self.delta_c == 0.0 {
-                self.eq_reg[i]
-            } else {
-                0.0
-            };
-        }
         for j in 0..n {
             let mut sig = 0.0;
             if self.has_l[j] {
@@ -896,6 +952,15 @@ impl<'p> Core<'p> {
                 sig += self.zu[j] / (self.wu[j] - self.w[j]);
             }
             self.kdx[j] = sig + delta_w + x_reg;
+        }
+        self.step_eq_reg(delta_w);
+        self.shift[..n].fill(-x_reg);
+        for i in 0..m {
+            self.shift[n + i] = if self.slack_of_row[i] == usize::MAX && self.delta_c == 0.0 {
+                self.eq_reg_step[i]
+            } else {
+                0.0
+            };
         }
         for k in 0..self.ni {
             let j = n + k;
@@ -917,7 +982,7 @@ impl<'p> Core<'p> {
                 if self.delta_c > 0.0 {
                     self.delta_c
                 } else {
-                    self.eq_reg[i]
+                    self.eq_reg_step[i]
                 }
             } else {
                 self.delta_c + 1.0 / self.ds[k]

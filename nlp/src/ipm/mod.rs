@@ -19,7 +19,7 @@ use std::time::Instant;
 use crate::error::SolveError;
 use crate::numeric::NumericNlp;
 use crate::options::{IpmOptions, ScalingMethod};
-use crate::scaling::gradient_scale;
+use crate::scaling::{gradient_scale, gradient_scale_up};
 use crate::solution::{Solution, Stats, Status};
 
 use self::core::{Core, Setup, Shared, Start};
@@ -202,6 +202,14 @@ impl Ipm {
                         opts.nlp_scaling_max_gradient,
                         opts.nlp_scaling_min_value,
                     );
+                    // Upward scaling: equality rows only (see nlp_scaling_min_gradient).
+                    if red.g_l[k] == red.g_u[k] {
+                        red.g_scale[k] *= gradient_scale_up(
+                            rmax[k],
+                            opts.nlp_scaling_min_gradient,
+                            opts.nlp_scaling_max_value,
+                        );
+                    }
                 }
             }
         } else {
