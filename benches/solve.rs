@@ -6,6 +6,10 @@
 //! cargo bench --bench solve                 # criterion (10², 10³, 10⁴; 10⁵ timed once)
 //! cargo bench --bench solve -- --json       # one JSON line per problem and size
 //! ```
+//! `SOLVE_MAX_LOG_N=4` limits the JSON mode to sizes up to 10⁴ variables and
+//! `SOLVE_PROBLEM=ocp` (or `hanging_chain`) to one problem (the 10⁵ chain runs into its
+//! 120 s cap).
+//!
 //! The JSON mode prints what docs/performance.md compares with
 //! `python3 benches/reference/solve_casadi.py`: iterations, status, objective, median
 //! solve wall time (5 solves up to 10³ variables, 3 at 10⁴, 1 at 10⁵), compile time,
@@ -42,8 +46,19 @@ fn solve(compiled: &mut Compiled) -> Solution {
 }
 
 fn json_mode() {
+    let max_log_n: u32 = std::env::var("SOLVE_MAX_LOG_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(u32::MAX);
+    let only = std::env::var("SOLVE_PROBLEM").ok();
     for (name, build, sizes) in PROBLEMS {
+        if only.as_deref().is_some_and(|o| o != name) {
+            continue;
+        }
         for (log_n, size) in sizes {
+            if log_n > max_log_n {
+                continue;
+            }
             let pb = build(size);
             let t = Instant::now();
             let mut compiled = pb.compile().expect("compiles");

@@ -1,5 +1,6 @@
-//! Assembly, factorisation (faer supernodal LDLᵀ without pivoting), inertia and solution
-//! of the symmetric quasi-definite KKT system
+//! Assembly, factorisation (LDLᵀ without pivoting: faer's supernodal one, or our own
+//! simplicial one on faer's symbolic analysis), inertia and solution of the symmetric
+//! quasi-definite KKT system
 //!
 //! ```text
 //! K = [ W + diag(dx)   Jᵀ         ]
@@ -8,6 +9,8 @@
 //!
 //! The pattern, the AMD ordering and the symbolic factorisation are computed once in
 //! [`Kkt::new`]; every [`Kkt::factorize`] only scatters values through precomputed maps.
+//! When faer's analysis picks the simplicial factorisation, K is stored already permuted
+//! and factorised by [`Simplicial`] (up-looking LDLᵀ with the rows of L precomputed).
 //! faer has no inertia API, so the inertia is counted from the signs of D (Sylvester's law
 //! of inertia). Unpivoted LDLᵀ needs `dc > 0` on every row (see docs/dependencies.md).
 
@@ -70,7 +73,7 @@ pub enum KktError {
 pub enum KktFactorization {
     /// Supernodal (dense blocks; fastest when the factor has large dense parts).
     Supernodal,
-    /// Simplicial (column by column).
+    /// Simplicial (column by column; our own up-looking LDLᵀ on faer's analysis).
     Simplicial,
     /// Let faer decide from the flop ratio (the default). Measured on the gap-crossing
     /// crawl gait (n + m = 2678, 33 k factor entries) it picks simplicial, 2.5× faster
@@ -91,6 +94,9 @@ pub struct Kkt {
     diag_pos: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
+    /// Our own simplicial LDLᵀ (used when faer's analysis picks simplicial); `None` for
+    /// supernodal, which stays with faer.
+    simplicial: Option<Simplicial>,
     mem: MemBuffer,
     factored: bool,
     wx: Vec<f64>,
@@ -104,7 +110,6 @@ pub struct Kkt {
     /// Target relative residual (default 1e-12).
     pub residual_ratio_max: f64,
     last_residual_ratio: f64,
-    log_abs_det: f64,
 }
 
 impl std::fmt::Debug for Kkt {
@@ -218,6 +223,22 @@ impl Kkt {
         )
         .map_err(|e| KktError::Symbolic(format!("{e:?}")))?;
         let l_values = vec![0.0; symbolic.len_val()];
+        // Simplicial: store K already permuted by the AMD ordering (upper triangle, as
+        // the up-looking factorisation reads it) and factorise it ourselves with the row
+        // patterns of L precomputed, so that no factorisation permutes K or walks the
+        // elimination tree again (faer's `permute_self_adjoint_to_unsorted` and `ereach`
+        // took 35 % of the factorisation time on the gap-crossing crawl gait).
+        let (pattern, h_map, j_map, diag_pos, simplicial) =
+            match Simplicial::new(&symbolic, &pattern) {
+                Some((simp, ppat, pos)) => (
+                    ppat,
+                    h_map.iter().map(|&p| pos[p]).collect(),
+                    j_map.iter().map(|&p| pos[p]).collect(),
+                    diag_pos.iter().map(|&p| pos[p]).collect(),
+                    Some(simp),
+                ),
+                None => (pattern, h_map, j_map, diag_pos, None),
+            };
         let mem = MemBuffer::new(StackReq::any_of(&[
             symbolic.factorize_numeric_ldlt_scratch::<f64>(
                 Par::Seq,
@@ -236,6 +257,7 @@ impl Kkt {
             diag_pos,
             symbolic,
             l_values,
+            simplicial,
             mem,
             factored: false,
             wx: vec![0.0; dim],
@@ -246,7 +268,6 @@ impl Kkt {
             max_refinement_steps: 10,
             residual_ratio_max: 1e-12,
             last_residual_ratio: 0.0,
-            log_abs_det: 0.0,
         })
     }
 
@@ -326,6 +347,16 @@ impl Kkt {
         if self.values.iter().any(|v| !v.is_finite()) {
             return Err(KktError::NonFinite);
         }
+        if let Some(simp) = self.simplicial.as_mut() {
+            let inertia = simp.factorize(
+                self.pattern.col_ptr(),
+                self.pattern.row_idx(),
+                &self.values,
+                &mut self.l_values,
+            )?;
+            self.factored = true;
+            return Ok(inertia);
+        }
         let Kkt {
             pattern,
             values,
@@ -354,14 +385,12 @@ impl Kkt {
         Ok(inertia)
     }
 
-    fn inertia_from_d(&mut self) -> Result<Inertia, KktError> {
+    fn inertia_from_d(&self) -> Result<Inertia, KktError> {
         let mut inertia = Inertia::default();
-        let mut log_det = 0.0;
         let mut count = |d: f64| -> Result<(), KktError> {
             if !d.is_finite() {
                 return Err(KktError::NonFinite);
             }
-            log_det += d.abs().ln();
             if d > 0.0 {
                 inertia.positive += 1;
             } else if d < 0.0 {
@@ -371,11 +400,17 @@ impl Kkt {
             }
             Ok(())
         };
+        self.for_each_pivot(&mut count)?;
+        Ok(inertia)
+    }
+
+    /// Calls `f` with every pivot D_jj of the current factor (in factor order).
+    fn for_each_pivot<E>(&self, mut f: impl FnMut(f64) -> Result<(), E>) -> Result<(), E> {
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
                 let cp = s.col_ptr();
                 for j in 0..s.nrows() {
-                    count(self.l_values[cp[j]])?;
+                    f(self.l_values[cp[j]])?;
                 }
             }
             SymbolicCholeskyRaw::Supernodal(s) => {
@@ -389,21 +424,34 @@ impl Kkt {
                     }
                     let nrows = (cpv[k + 1] - cpv[k]) / ncols;
                     for j in 0..ncols {
-                        count(self.l_values[cpv[k] + j * nrows + j])?;
+                        f(self.l_values[cpv[k] + j * nrows + j])?;
                     }
                 }
             }
         }
-        self.log_abs_det = log_det;
-        Ok(inertia)
+        Ok(())
     }
 
-    /// ln |det K| of the last successful factorisation (the sum of ln |D_ii|).
+    /// ln |det K| of the current factorisation (the sum of ln |D_ii|; computed on demand,
+    /// NaN without a valid factorisation).
     pub fn log_abs_det(&self) -> f64 {
-        self.log_abs_det
+        if !self.factored {
+            return f64::NAN;
+        }
+        let mut sum = 0.0;
+        let _ = self.for_each_pivot(|d| -> Result<(), ()> {
+            sum += d.abs().ln();
+            Ok(())
+        });
+        sum
     }
 
+    /// x ← K⁻¹ x from the factor, in the space of `pattern` (permuted when simplicial).
     fn raw_solve(&mut self, x: &mut [f64]) {
+        if let Some(simp) = &self.simplicial {
+            simp.solve_in_place(&self.l_values, x);
+            return;
+        }
         let Kkt {
             symbolic,
             l_values,
@@ -483,9 +531,32 @@ impl Kkt {
         let mut wx = std::mem::take(&mut self.wx);
         let mut wr = std::mem::take(&mut self.wr);
         let mut wd = std::mem::take(&mut self.wd);
-        wb.copy_from_slice(rhs);
+        // The simplicial factor works in the AMD-permuted space: permute in (and out at
+        // the end); refinement runs there too, on the permuted K.
+        let mut pshift = Vec::new();
+        let shift = match self.simplicial.as_mut() {
+            Some(simp) => {
+                for (w, &o) in wb.iter_mut().zip(&simp.fwd) {
+                    *w = rhs[o];
+                }
+                match shift {
+                    Some(s) => {
+                        pshift = std::mem::take(&mut simp.pshift);
+                        for (w, &o) in pshift.iter_mut().zip(&simp.fwd) {
+                            *w = s[o];
+                        }
+                        Some(&pshift[..])
+                    }
+                    None => None,
+                }
+            }
+            None => {
+                wb.copy_from_slice(rhs);
+                shift
+            }
+        };
         let b_norm = inf_norm(&wb);
-        wx.copy_from_slice(rhs);
+        wx.copy_from_slice(&wb);
         self.raw_solve(&mut wx);
         let mut ratio = f64::INFINITY;
         let mut steps = 0;
@@ -530,7 +601,17 @@ impl Kkt {
             }
             steps += 1;
         }
-        rhs.copy_from_slice(&wx);
+        match self.simplicial.as_mut() {
+            Some(simp) => {
+                for (&v, &o) in wx.iter().zip(&simp.fwd) {
+                    rhs[o] = v;
+                }
+                if !pshift.is_empty() {
+                    simp.pshift = pshift;
+                }
+            }
+            None => rhs.copy_from_slice(&wx),
+        }
         self.wb = wb;
         self.wx = wx;
         self.wr = wr;
@@ -540,6 +621,238 @@ impl Kkt {
             return Err(KktError::NonFinite);
         }
         Ok(ratio)
+    }
+}
+
+/// Simplicial LDLᵀ of the AMD-permuted K (up-looking, Davis's LDL), on the pattern of L
+/// from faer's symbolic analysis. The rows of L (for each k, the columns j < k with
+/// L_kj ≠ 0 and the positions of those entries) are precomputed once, so a numeric
+/// factorisation does the arithmetic only. Ascending column order is a topological order
+/// of the elimination tree (parents have larger indices), as the algorithm needs.
+struct Simplicial {
+    /// Permutation: permuted index k is original index `fwd[k]`.
+    fwd: Vec<usize>,
+    /// Column pointers and row indices of L (diagonal first in each column, rows
+    /// ascending); the diagonal slot holds D.
+    l_col_ptr: Vec<usize>,
+    l_row_idx: Vec<usize>,
+    /// Rows of L below the diagonal: for row k, `row_col[row_ptr[k]..row_ptr[k+1]]` are
+    /// the columns j (ascending) and `row_pos[..]` the positions of L_kj in the values.
+    row_ptr: Vec<usize>,
+    row_col: Vec<usize>,
+    row_pos: Vec<usize>,
+    /// 1 / D.
+    d_inv: Vec<f64>,
+    /// Dense accumulator of the current row (all zero between rows).
+    x: Vec<f64>,
+    /// The permuted shift of `solve_shifted`.
+    pshift: Vec<f64>,
+}
+
+impl Simplicial {
+    /// Builds the permuted upper pattern of K and the map from positions in `pattern`
+    /// (the original upper triangle) to positions in the permuted one. `None` if faer's
+    /// analysis is supernodal (or, defensively, if the permuted K does not fit L's
+    /// pattern).
+    fn new(
+        symbolic: &SymbolicCholesky<usize>,
+        pattern: &SymbolicSparseColMat<usize>,
+    ) -> Option<(Simplicial, SymbolicSparseColMat<usize>, Vec<usize>)> {
+        let SymbolicCholeskyRaw::Simplicial(s) = symbolic.raw() else {
+            return None;
+        };
+        let dim = pattern.ncols();
+        let (fwd, inv): (Vec<usize>, Vec<usize>) = match symbolic.perm() {
+            Some(p) => {
+                let (f, i) = p.arrays();
+                (f.to_vec(), i.to_vec())
+            }
+            None => ((0..dim).collect(), (0..dim).collect()),
+        };
+        // Permuted upper triangle: original entry (r, c), r ≤ c, goes to
+        // (min, max) of (inv[r], inv[c]).
+        let cp = pattern.col_ptr();
+        let ri = pattern.row_idx();
+        let nnz = ri.len();
+        let mut count = vec![0usize; dim + 1];
+        let mut target = Vec::with_capacity(nnz);
+        for c in 0..dim {
+            for &r in &ri[cp[c]..cp[c + 1]] {
+                let (a, b) = (inv[r], inv[c]);
+                let (row, col) = if a <= b { (a, b) } else { (b, a) };
+                target.push((row, col));
+                count[col + 1] += 1;
+            }
+        }
+        for j in 0..dim {
+            count[j + 1] += count[j];
+        }
+        let col_ptr = count.clone();
+        let mut next = count;
+        let mut row_idx = vec![0usize; nnz];
+        let mut pos = vec![0usize; nnz];
+        // Fill column by column; then sort each column's rows, carrying `pos` along.
+        for (p, &(row, col)) in target.iter().enumerate() {
+            let q = next[col];
+            next[col] += 1;
+            row_idx[q] = row;
+            pos[p] = q;
+        }
+        let mut order: Vec<usize> = Vec::new();
+        let mut where_new = vec![0usize; nnz];
+        let mut sorted_rows = vec![0usize; nnz];
+        for j in 0..dim {
+            let (a, b) = (col_ptr[j], col_ptr[j + 1]);
+            order.clear();
+            order.extend(a..b);
+            order.sort_unstable_by_key(|&q| row_idx[q]);
+            for (t, &q) in order.iter().enumerate() {
+                where_new[q] = a + t;
+                sorted_rows[a + t] = row_idx[q];
+            }
+        }
+        for p in pos.iter_mut() {
+            *p = where_new[*p];
+        }
+        let ppat = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, sorted_rows);
+        let l_col_ptr = s.col_ptr().to_vec();
+        let l_row_idx = s.row_idx().to_vec();
+        if l_col_ptr.len() != dim + 1
+            || l_col_ptr[dim] != l_row_idx.len()
+            || l_row_idx.iter().any(|&r| r >= dim)
+        {
+            return None;
+        }
+        // Rows of L.
+        let mut row_ptr = vec![0usize; dim + 1];
+        for j in 0..dim {
+            if l_row_idx[l_col_ptr[j]] != j {
+                return None;
+            }
+            for &r in &l_row_idx[l_col_ptr[j] + 1..l_col_ptr[j + 1]] {
+                if r <= j {
+                    return None;
+                }
+                row_ptr[r + 1] += 1;
+            }
+        }
+        for k in 0..dim {
+            row_ptr[k + 1] += row_ptr[k];
+        }
+        let mut fill = row_ptr.clone();
+        let mut row_col = vec![0usize; row_ptr[dim]];
+        let mut row_pos = vec![0usize; row_ptr[dim]];
+        for j in 0..dim {
+            for p in l_col_ptr[j] + 1..l_col_ptr[j + 1] {
+                let r = l_row_idx[p];
+                row_col[fill[r]] = j;
+                row_pos[fill[r]] = p;
+                fill[r] += 1;
+            }
+        }
+        // Every off-diagonal entry (i, k), i < k, of the permuted K must be an entry
+        // L_ki of the factor.
+        let simp = Simplicial {
+            fwd,
+            l_col_ptr,
+            l_row_idx,
+            row_ptr,
+            row_col,
+            row_pos,
+            d_inv: vec![0.0; dim],
+            x: vec![0.0; dim],
+            pshift: vec![0.0; dim],
+        };
+        for k in 0..dim {
+            let cols = &simp.row_col[simp.row_ptr[k]..simp.row_ptr[k + 1]];
+            for &i in ppat.row_idx_of_col_raw(k) {
+                if i < k && cols.binary_search(&i).is_err() {
+                    return None;
+                }
+            }
+        }
+        Some((simp, ppat, pos))
+    }
+
+    /// Numeric LDLᵀ of the permuted upper triangle (`col_ptr`, `row_idx`, `values`) into
+    /// `l` (the L pattern's values, D on the diagonal slots). Returns the inertia;
+    /// `ZeroPivot` (permuted index) on an exactly zero pivot, `NonFinite` on a
+    /// non-finite one.
+    fn factorize(
+        &mut self,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        values: &[f64],
+        l: &mut [f64],
+    ) -> Result<Inertia, KktError> {
+        let dim = self.d_inv.len();
+        let x = &mut self.x[..dim];
+        let lcp = &self.l_col_ptr;
+        let lri = &self.l_row_idx;
+        let mut inertia = Inertia::default();
+        for k in 0..dim {
+            for p in col_ptr[k]..col_ptr[k + 1] {
+                x[row_idx[p]] += values[p];
+            }
+            let mut d = x[k];
+            x[k] = 0.0;
+            let (a, b) = (self.row_ptr[k], self.row_ptr[k + 1]);
+            for (&j, &pos) in self.row_col[a..b].iter().zip(&self.row_pos[a..b]) {
+                let xj = x[j];
+                x[j] = 0.0;
+                let start = lcp[j] + 1;
+                for (&i, &lij) in lri[start..pos].iter().zip(&l[start..pos]) {
+                    x[i] -= lij * xj;
+                }
+                let lkj = xj * self.d_inv[j];
+                d -= lkj * xj;
+                l[pos] = lkj;
+            }
+            if d == 0.0 || !d.is_finite() {
+                // Leave the accumulator clean for the next factorisation.
+                x.fill(0.0);
+                return Err(if d == 0.0 {
+                    KktError::ZeroPivot(k)
+                } else {
+                    KktError::NonFinite
+                });
+            }
+            l[lcp[k]] = d;
+            self.d_inv[k] = 1.0 / d;
+            if d > 0.0 {
+                inertia.positive += 1;
+            } else {
+                inertia.negative += 1;
+            }
+        }
+        Ok(inertia)
+    }
+
+    /// x ← (L D Lᵀ)⁻¹ x in the permuted space.
+    fn solve_in_place(&self, l: &[f64], x: &mut [f64]) {
+        let dim = self.d_inv.len();
+        let lcp = &self.l_col_ptr;
+        let lri = &self.l_row_idx;
+        for j in 0..dim {
+            let xj = x[j];
+            if xj != 0.0 {
+                let (a, b) = (lcp[j] + 1, lcp[j + 1]);
+                for (&i, &lij) in lri[a..b].iter().zip(&l[a..b]) {
+                    x[i] -= lij * xj;
+                }
+            }
+        }
+        for (xj, dj) in x.iter_mut().zip(&self.d_inv) {
+            *xj *= dj;
+        }
+        for j in (0..dim).rev() {
+            let (a, b) = (lcp[j] + 1, lcp[j + 1]);
+            let mut acc = x[j];
+            for (&i, &lij) in lri[a..b].iter().zip(&l[a..b]) {
+                acc -= lij * x[i];
+            }
+            x[j] = acc;
+        }
     }
 }
 
@@ -689,6 +1002,8 @@ mod tests {
             kind == KktFactorization::Supernodal
                 || (kind == KktFactorization::Auto && kkt.is_supernodal())
         );
+        // Simplicial analyses run on our own factorisation of the permuted K.
+        assert_eq!(kkt.simplicial.is_some(), !kkt.is_supernodal());
         let inertia = kkt.factorize(&c.hv, &c.dx, &c.jv, &c.dc).unwrap();
         let kd = dense(c);
         let eig = kd.self_adjoint_eigenvalues(Side::Lower).unwrap();
