@@ -381,13 +381,7 @@ pub fn desilva() -> Case {
         build,
         f_star: -1.0,
         f_tol: 1e-6,
-        // Since the SQP's individual merit weights and multiplier-based active set: both
-        // the SQP phase and the exact final phase reach f = -1 (residual 8e-13, pairs c0,
-        // c1 biactive) but the dual error never meets tol: MaximumIterationsExceeded.
-        known_failures: &[(
-            MpccBackend::Sqp,
-            "reaches f* = -1 but the KKT test is not met (MaximumIterationsExceeded)",
-        )],
+        known_failures: &[],
     }
 }
 

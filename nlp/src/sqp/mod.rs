@@ -761,7 +761,15 @@ impl Sqp {
             let mut accepted = false;
             let mut soc_used = false;
             let mut step_res = res.clone();
-            let slack = 10.0 * f64::EPSILON * phi0.abs().max(1.0);
+            // Rounding allowance of the merit: of f, and of every weighted row value (a row
+            // at its bound shows violations at the rounding level of g_i, which the weights
+            // up to ρ magnify; near a solution these decided the line search, see
+            // docs/performance.md, "SQP on the flagship").
+            let g_noise: f64 = (0..m)
+                .filter(|&i| !geo.cone_row[i])
+                .map(|i| merit_w[i] * g[i].abs().max(1.0))
+                .sum();
+            let slack = 10.0 * f64::EPSILON * (phi0.abs().max(1.0) + g_noise);
             let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             // A step at rounding level of x is taken without the merit test (IPOPT's 't').
             let tiny = d_norm <= 1e-9 * (1.0 + x_max);

@@ -66,7 +66,7 @@ pub struct SqpOptions {
     pub max_hessian_shift: f64,
     /// Largest augmented-Lagrangian weight ρ_a in B = H + δI + ρ_a·(J_AᵀJ_A + I_b); the
     /// test at this weight stands for "positive definite on the null space of the active
-    /// constraints" when the shift δ is chosen. Default 1e8.
+    /// constraints" when the shift δ is chosen. Default 1e6.
     pub max_augmented_weight: f64,
     // ---------- merit function and line search ----------
     /// Initial ℓ1 penalty ρ (merit φ = f + ρ·‖violation‖₁, also the cost of the QP's
@@ -125,7 +125,7 @@ impl Default for SqpOptions {
             first_hessian_shift: 1e-4,
             min_hessian_shift: 1e-20,
             max_hessian_shift: 1e20,
-            max_augmented_weight: 1e8,
+            max_augmented_weight: 1e6,
             penalty_init: 10.0,
             penalty_max: 1e8,
             penalty_increase: 10.0,
