@@ -71,6 +71,13 @@ pub fn format_summary(sol: &Solution) -> String {
         "Time: total {:.3}s, eval {:.3}s, factor {:.3}s, other {:.3}s",
         st.total_seconds, st.eval_seconds, st.factor_seconds, st.other_seconds
     );
+    if st.n_qp_solves > 0 {
+        let _ = writeln!(
+            s,
+            "QP solves: {} ({} QP iterations, {:.3}s)",
+            st.n_qp_solves, st.qp_iterations, st.qp_seconds
+        );
+    }
     let _ = writeln!(s, "EXIT: {:?}", sol.status);
     s
 }

@@ -110,6 +110,16 @@ pub struct Stats {
     pub other_seconds: f64,
     /// Objective scaling factor used.
     pub obj_scaling: f64,
+    /// QP subproblems solved (SQP only; second-order corrections and elastic-mode
+    /// re-solves included).
+    #[serde(default)]
+    pub n_qp_solves: usize,
+    /// Interior-point iterations of the QP solver, summed (SQP only).
+    #[serde(default)]
+    pub qp_iterations: usize,
+    /// Seconds in QP solves (SQP only).
+    #[serde(default)]
+    pub qp_seconds: f64,
 }
 
 /// Result of a solve. Multipliers use IPOPT's sign convention:

@@ -2,16 +2,18 @@
 //! solved by clarabel.
 //!
 //! Each iteration at x_k (with multipliers λ_k):
-//! 1. **Hessian.** B = ∇²L(x_k, λ_k) + δI, with the smallest δ in IPOPT's inertia-correction
-//!    sequence (0, then `first_hessian_shift` or δ_last/3, ×8 up to ×100 at first) for
-//!    which a faer LDLᵀ of B ([`Kkt`] with no constraint rows) has n positive pivots:
-//!    clarabel needs a convex QP. Alternatively damped BFGS ([`HessianApproximation`]).
+//! 1. **Hessian.** B = ∇²L(x_k, λ_k) + δI + ρ_a·(J_AᵀJ_A + I_b) over the strongly active
+//!    rows and bounds A ([`active_sets`]): δ is chosen for positive definiteness on the
+//!    null space of the active constraints and ρ_a as small as makes B itself positive
+//!    definite (inertia tests with a faer LDLᵀ, [`Convexify`]): clarabel needs a convex
+//!    QP. Alternatively damped BFGS ([`HessianApproximation`]).
 //! 2. **QP** ([`qp`]): the elastic subproblem min ½dᵀBd + ∇fᵀd + ρΣe over the linearised
 //!    constraints relaxed by elastic variables e ≥ 0, the bounds, and affine second-order
 //!    cones. It is always feasible. When e ≠ 0 (linearisation inconsistent, "elastic
 //!    mode"), ρ grows by `penalty_increase` and the QP is solved again, up to
 //!    `penalty_max`; past that the step minimises the linearised ℓ1 infeasibility.
-//! 3. **Line search** on the ℓ1 merit φ(x) = f(x) + ρ·‖viol(x)‖₁ with Armijo's test
+//! 3. **Line search** on the merit φ(x) = f(x) + Σ w_i·viol_i(x) (individual weights
+//!    w_i ∈ [|λ_i|, ρ], Powell 1978; w_i = ρ is the classical ℓ1 merit) with Armijo's test
 //!    φ(x + αd) ≤ φ(x) − η·α·pred, where pred = m(0) − m(d) ≥ 0 is the decrease of the
 //!    QP model of φ. If the full step is rejected, one second-order correction (the QP
 //!    again with constraint constants g(x+d) − J d) is tried before backtracking.
@@ -21,7 +23,8 @@
 //! (tol 1e-8, s_max, dual_inf_tol, constr_viol_tol, compl_inf_tol, acceptable_*), on
 //! the problem scaled by the same gradient-based factors.
 //!
-//! In the iteration table, `lg(mu)` is unused ("-"), `lg(rg)` is the Hessian shift δ,
+//! In the iteration table, `lg(mu)` is log10 of the augmented weight ρ_a ("-" when 0),
+//! `lg(rg)` is the Hessian shift δ,
 //! the 'r' mark after the iteration number flags elastic mode, and the step character
 //! is 'S' for an accepted second-order correction, 'f' otherwise.
 
@@ -148,16 +151,17 @@ struct Geometry {
 }
 
 impl Geometry {
-    /// ‖violation‖₁ of g and the cones (bounds are kept satisfied by construction).
-    fn l1(&self, g: &[f64], cone: &[f64]) -> f64 {
+    /// Weighted ℓ1 penalty Σ w_i·viol_i(g) + ρ·Σ cone violations (the merit's
+    /// infeasibility term; w = ρ everywhere is the classical ℓ1 penalty).
+    fn penalty(&self, g: &[f64], cone: &[f64], w: &[f64], rho: f64) -> f64 {
         let mut s = 0.0;
         for i in 0..g.len() {
             if !self.cone_row[i] {
-                s += viol(g[i], self.g_l[i], self.g_u[i]);
+                s += w[i] * viol(g[i], self.g_l[i], self.g_u[i]);
             }
         }
         for c in &self.cones {
-            s += cone_viol(&cone[c.offset..c.offset + c.dim]);
+            s += rho * cone_viol(&cone[c.offset..c.offset + c.dim]);
         }
         s
     }
@@ -470,6 +474,7 @@ impl Sqp {
             vec![]
         };
         let mut rho = o.penalty_init;
+        let mut merit_w = vec![0.0f64; m];
         let mut delta_last = 0.0f64;
         let mut acceptable = 0usize;
         let status;
@@ -491,6 +496,9 @@ impl Sqp {
         let mut lgrad = vec![0.0; n];
         let mut iter = 0usize;
         let mut qp_iterations = 0u64;
+        let mut n_qp = 0usize;
+        let mut qp_seconds = 0.0f64;
+        let mut conv_seconds = 0.0f64;
         let mut factor_seconds = 0.0;
         let mut n_fact = 0usize;
         let mut ls_failures = 0usize;
@@ -580,7 +588,10 @@ impl Sqp {
                     active_r: &active_r,
                     active_b: &active_b,
                 };
-                match conv.run(o, delta_last, rho_a_last, extra_shift, &mut n_fact) {
+                let t_conv = Instant::now();
+                let conv_res = conv.run(o, delta_last, rho_a_last, extra_shift, &mut n_fact);
+                conv_seconds += t_conv.elapsed().as_secs_f64();
+                match conv_res {
                     Some((d, rho_a)) => {
                         delta = d;
                         rho_a_last = rho_a;
@@ -627,7 +638,11 @@ impl Sqp {
                     dense_b: if dense { Some(&bfgs) } else { None },
                     rho,
                 };
-                let res = match qp.solve(&data) {
+                let t_qp = Instant::now();
+                let res = qp.solve(&data);
+                qp_seconds += t_qp.elapsed().as_secs_f64();
+                n_qp += 1;
+                let res = match res {
                     Ok(r) => r,
                     Err(e) => {
                         message = format!("QP setup failed: {e}");
@@ -687,9 +702,30 @@ impl Sqp {
             };
             delta = qp_shift;
             let elastic = res.e.iter().any(|v| *v > o.elastic_tol);
+            // ---- merit weights ----
+            // Powell (1978): w_i = max(|λ_i|, ½(w_i + |λ_i|)) with the QP's multipliers,
+            // kept in [floor, ρ]. Any w with |λ_i| ≤ w_i ≤ ρ keeps pred ≥ 0 (the step is
+            // a descent direction of the weighted merit), and rows with small
+            // multipliers no longer pay ρ for second-order violations: with one ρ ≥
+            // max|λ_i| (≈ 600 on the gap-crossing step-length rows), the bilinear moment
+            // rows' O(‖d‖²) violation priced every long step out.
+            if iter == 1 {
+                // No multiplier history yet: start from the classical weights ρ.
+                merit_w.iter_mut().for_each(|w| *w = rho);
+            }
+            for i in 0..m {
+                merit_w[i] = if o.individual_penalties {
+                    let l = res.lambda[i].abs();
+                    l.max(0.5 * (merit_w[i] + l))
+                        .max(o.penalty_weight_floor * rho)
+                        .min(rho)
+                } else {
+                    rho
+                };
+            }
             // ---- merit and predicted reduction ----
             let d = res.d.clone();
-            let phi0 = f + rho * geo.l1(&g, &cone);
+            let phi0 = f + geo.penalty(&g, &cone, &merit_w, rho);
             let mut jd = vec![0.0; m];
             for c in 0..n {
                 for p in jp.col_range(c) {
@@ -712,7 +748,8 @@ impl Sqp {
                 dbd += (0..n).map(|j| bound_weight[j] * d[j] * d[j]).sum::<f64>();
             }
             let gd: f64 = grad.iter().zip(&d).map(|(a, b)| a * b).sum();
-            let pred = -(gd + 0.5 * dbd) + rho * (geo.l1(&g, &cone) - geo.l1(&lin_g, &lin_c));
+            let pred = -(gd + 0.5 * dbd) + geo.penalty(&g, &cone, &merit_w, rho)
+                - geo.penalty(&lin_g, &lin_c, &merit_w, rho);
             // ---- line search ----
             let d_norm = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let mut alpha = 1.0;
@@ -724,7 +761,15 @@ impl Sqp {
             let mut accepted = false;
             let mut soc_used = false;
             let mut step_res = res.clone();
-            let slack = 10.0 * f64::EPSILON * phi0.abs().max(1.0);
+            // Rounding allowance of the merit: of f, and of every weighted row value (a row
+            // at its bound shows violations at the rounding level of g_i, which the weights
+            // up to ρ magnify; near a solution these decided the line search, see
+            // docs/performance.md, "SQP on the flagship").
+            let g_noise: f64 = (0..m)
+                .filter(|&i| !geo.cone_row[i])
+                .map(|i| merit_w[i] * g[i].abs().max(1.0))
+                .sum();
+            let slack = 10.0 * f64::EPSILON * (phi0.abs().max(1.0) + g_noise);
             let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             // A step at rounding level of x is taken without the merit test (IPOPT's 't').
             let tiny = d_norm <= 1e-9 * (1.0 + x_max);
@@ -739,7 +784,7 @@ impl Sqp {
                     && gt.iter().all(|v| v.is_finite())
                     && ct.iter().all(|v| v.is_finite());
                 if finite {
-                    let phi = ft + rho * geo.l1(&gt, &ct);
+                    let phi = ft + geo.penalty(&gt, &ct, &merit_w, rho);
                     if tiny || phi <= phi0 - o.armijo * alpha * pred.max(0.0) + slack {
                         accepted = true;
                         break;
@@ -748,9 +793,12 @@ impl Sqp {
                         // Second-order correction: constants g(x+d) − J d.
                         let gh: Vec<f64> = (0..m).map(|i| gt[i] - jd[i]).collect();
                         let chat: Vec<f64> = (0..n_cone).map(|k| ct[k] - cd[k]).collect();
-                        if let Ok(r2) = qp
-                            .resolve_with_g(&x, &geo.x_l, &geo.x_u, &gh, &geo.g_l, &geo.g_u, &chat)
-                        {
+                        let t_qp = Instant::now();
+                        let r2 = qp
+                            .resolve_with_g(&x, &geo.x_l, &geo.x_u, &gh, &geo.g_l, &geo.g_u, &chat);
+                        qp_seconds += t_qp.elapsed().as_secs_f64();
+                        n_qp += 1;
+                        if let Ok(r2) = r2 {
                             qp_iterations += r2.iterations as u64;
                             if matches!(
                                 r2.status,
@@ -765,7 +813,7 @@ impl Sqp {
                                 let mut gs = vec![0.0; m];
                                 let mut cs = vec![0.0; n_cone];
                                 sc.g(&xs, &mut gs, &mut cs);
-                                let phis = fs + rho * geo.l1(&gs, &cs);
+                                let phis = fs + geo.penalty(&gs, &cs, &merit_w, rho);
                                 if phis.is_finite() && phis <= phi0 - o.armijo * pred + slack {
                                     xt = xs;
                                     ft = fs;
@@ -791,7 +839,7 @@ impl Sqp {
                 objective: 0.0,
                 inf_pr: 0.0,
                 inf_du: 0.0,
-                mu: 0.0,
+                mu: rho_a_last,
                 d_norm,
                 regularization: delta,
                 alpha_du: alpha,
@@ -879,7 +927,10 @@ impl Sqp {
         stats.iterations = iter;
         stats.n_factorizations = n_fact;
         stats.factor_seconds = factor_seconds;
-        let _ = qp_iterations;
+        stats.n_qp_solves = n_qp;
+        stats.qp_iterations = qp_iterations as usize;
+        stats.qp_seconds = qp_seconds;
+        let _ = conv_seconds;
         let sol = finish(
             &mut sc,
             &geo,
@@ -929,25 +980,31 @@ fn quad(
 }
 
 /// Which rows of g and which variable bounds count as active for the
-/// augmented-Lagrangian convexification: equality rows, rows and bounds with a nonzero
-/// multiplier or (nearly) at their bound.
+/// augmented-Lagrangian convexification: equality rows, and inequality rows and bounds
+/// whose multiplier is nonzero with the sign of an active side (strongly active).
+///
+/// A row or bound merely at its bound, or with a multiplier of the wrong sign, is left
+/// out: the term ½ρ_a(J_i d)² penalises leaving the constraint in both directions, so on
+/// a constraint the step should leave it acts as a proximal term of weight ρ_a and the
+/// iterates creep (the gap-crossing planner crawled at ‖d‖ ≈ 1e-4 for 3000 iterations
+/// with complementarity error 5e3 when "at the bound" counted as active).
 fn active_sets(geo: &Geometry, x: &[f64], g: &[f64], mult: &Mult) -> (Vec<bool>, Vec<bool>) {
-    let near = |a: f64, b: f64| b.is_finite() && (a - b).abs() <= 1e-6 * (1.0 + b.abs());
+    const TOL: f64 = 1e-6;
+    // "Nearly at the bound": a multiplier left on a row the iterate has moved away from
+    // (e.g. the share ρ_a·J_i d of the last step) must not keep the row active.
+    let near = |a: f64, b: f64| (a - b).abs() <= 1e-3 * (1.0 + b.abs());
     let rows = (0..g.len())
         .map(|i| {
             !geo.cone_row[i]
                 && (geo.g_l[i] == geo.g_u[i]
-                    || mult.lambda[i].abs() > 1e-6
-                    || near(g[i], geo.g_l[i])
-                    || near(g[i], geo.g_u[i]))
+                    || (geo.g_u[i].is_finite() && mult.lambda[i] > TOL && near(g[i], geo.g_u[i]))
+                    || (geo.g_l[i].is_finite() && mult.lambda[i] < -TOL && near(g[i], geo.g_l[i])))
         })
         .collect();
     let bounds = (0..x.len())
         .map(|j| {
-            mult.z_l[j] > 1e-6
-                || mult.z_u[j] > 1e-6
-                || near(x[j], geo.x_l[j])
-                || near(x[j], geo.x_u[j])
+            (geo.x_l[j].is_finite() && mult.z_l[j] > TOL && near(x[j], geo.x_l[j]))
+                || (geo.x_u[j].is_finite() && mult.z_u[j] > TOL && near(x[j], geo.x_u[j]))
         })
         .collect();
     (rows, bounds)
@@ -957,10 +1014,11 @@ fn active_sets(geo: &Geometry, x: &[f64], g: &[f64], mult: &Mult) -> (Vec<bool>,
 /// rows and bounds. By the Schur complement, B is positive definite iff
 /// `[H + δI + ρ_a·I_b, J_Aᵀ; J_A, −I/ρ_a]` (inactive rows with a negligible −1e20 pivot)
 /// has inertia (n, m, 0) — the test IPOPT applies to its KKT matrix, counted from a faer
-/// LDLᵀ ([`Kkt`]). Order: (0, 0); then ρ_a = 1, 100, … 10⁶ with δ = 0 (the Hessian is
-/// positive definite on the null space of the active constraints, so the QP keeps the
-/// Newton step: for d with J_A d = −c_A the extra term is constant); then IPOPT's δ
-/// sequence with ρ_a = 0.
+/// LDLᵀ ([`Kkt`]). Order: (0, 0) unless the last iteration needed ρ_a > 0; (0, ρ₀) with
+/// ρ₀ = max(1, ρ_last/10); then δ by IPOPT's sequence with the test at ρ_a =
+/// `max_augmented_weight` (positive definite on the null space of the active
+/// constraints, so the QP keeps the Newton step there: for d with J_A d = −c_A the
+/// augmented term is constant); then the smallest ρ_a = ρ₀·10^k passing at that δ.
 struct Convexify<'a> {
     kkt: Option<&'a mut Kkt>,
     hv: &'a [f64],
@@ -1003,39 +1061,60 @@ impl Convexify<'_> {
                 .collect();
             matches!(kkt.factorize(hv, &dx, jv, &dc), Ok(i) if i.positive == n && i.negative == m)
         };
-        if extra == 0.0 {
-            if test(0.0, 0.0) {
-                return Some((0.0, 0.0));
+        let any_active = active_r.iter().chain(active_b).any(|&a| a);
+        let rho_max = o.max_augmented_weight;
+        // Smallest shift δ ≥ δ_min for which `ok(δ)` holds, IPOPT's sequence: δ_min (0
+        // when allowed), then first_hessian_shift or δ_last/3, ×100 at first, ×8 after.
+        let shift_search = |test: &mut dyn FnMut(f64) -> bool, allow_zero: bool| {
+            if allow_zero && test(0.0) {
+                return Some(0.0);
             }
-            let any_active = active_r.iter().chain(active_b).any(|&a| a);
-            if any_active {
-                let mut rho = if rho_last > 0.0 {
-                    (rho_last / 10.0).max(1.0)
-                } else {
-                    1.0
-                };
-                while rho <= 1e6 {
-                    if test(0.0, rho) {
-                        return Some((0.0, rho));
-                    }
-                    rho *= 100.0;
+            let mut delta = if delta_last == 0.0 {
+                o.first_hessian_shift
+            } else {
+                (delta_last / 3.0).max(o.min_hessian_shift)
+            };
+            delta = delta.max(extra);
+            let grow = if delta_last == 0.0 { 100.0 } else { 8.0 };
+            while delta <= o.max_hessian_shift {
+                if test(delta) {
+                    return Some(delta);
                 }
+                delta *= grow;
             }
-        }
-        let mut delta = if delta_last == 0.0 {
-            o.first_hessian_shift
-        } else {
-            (delta_last / 3.0).max(o.min_hessian_shift)
+            None
         };
-        delta = delta.max(extra);
-        let grow = if delta_last == 0.0 { 100.0 } else { 8.0 };
-        while delta <= o.max_hessian_shift {
-            if test(delta, 0.0) {
-                return Some((delta, 0.0));
-            }
-            delta *= grow;
+        if extra == 0.0 && rho_last == 0.0 && test(0.0, 0.0) {
+            return Some((0.0, 0.0));
         }
-        None
+        if !any_active {
+            return shift_search(&mut |d| test(d, 0.0), extra == 0.0).map(|d| (d, 0.0));
+        }
+        // The cheapest guess first: the last iteration's weight (or a tenth of it).
+        let rho0 = if rho_last > 0.0 {
+            (rho_last / 10.0).max(1.0)
+        } else {
+            1.0
+        };
+        if extra == 0.0 && test(0.0, rho0) {
+            return Some((0.0, rho0));
+        }
+        // δ for the reduced Hessian: the test in the limit ρ_a = rho_max is IPOPT's
+        // inertia test of [H + δI, J_Aᵀ; J_A, −I/rho_max] (active bounds nearly fixed),
+        // i.e. positive definiteness on the null space of the active constraints. A
+        // shift of the full-space Hessian (ρ_a = 0) would also pay for curvature across
+        // the constraints, which the augmented term supplies for free.
+        let delta = shift_search(&mut |d| test(d, rho_max), extra == 0.0)?;
+        // Then the smallest weight ρ_a (×10 from rho0) that makes B itself positive
+        // definite; rho_max passed above.
+        let mut rho = if delta == 0.0 { rho0 * 10.0 } else { rho0 };
+        while rho < rho_max {
+            if test(delta, rho) {
+                return Some((delta, rho));
+            }
+            rho *= 10.0;
+        }
+        Some((delta, rho_max))
     }
 }
 

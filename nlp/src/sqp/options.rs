@@ -64,6 +64,10 @@ pub struct SqpOptions {
     pub min_hessian_shift: f64,
     /// Largest shift before giving up with `ErrorInStepComputation`. Default 1e20.
     pub max_hessian_shift: f64,
+    /// Largest augmented-Lagrangian weight ρ_a in B = H + δI + ρ_a·(J_AᵀJ_A + I_b); the
+    /// test at this weight stands for "positive definite on the null space of the active
+    /// constraints" when the shift δ is chosen. Default 1e6.
+    pub max_augmented_weight: f64,
     // ---------- merit function and line search ----------
     /// Initial ℓ1 penalty ρ (merit φ = f + ρ·‖violation‖₁, also the cost of the QP's
     /// elastic variables). Default 10.
@@ -73,6 +77,13 @@ pub struct SqpOptions {
     /// Factor by which ρ grows when the linearised constraints need the elastic
     /// variables (infeasible or nearly infeasible QP). Default 10.
     pub penalty_increase: f64,
+    /// Individual merit weights (Powell 1978): the merit is f + Σ w_i·viol_i with
+    /// w_i = max(|λ_i|, ½(w_i + |λ_i|)) from the QP multipliers, kept within
+    /// [`penalty_weight_floor`·ρ, ρ]; false: w_i = ρ for every row (the classical ℓ1
+    /// merit). Default true.
+    pub individual_penalties: bool,
+    /// Lower bound of the individual merit weights, as a fraction of ρ. Default 1e-3.
+    pub penalty_weight_floor: f64,
     /// Armijo constant η in φ(x + αd) ≤ φ(x) − η·α·pred. Default 1e-4.
     pub armijo: f64,
     /// Backtracking factor. Default 0.5.
@@ -114,9 +125,12 @@ impl Default for SqpOptions {
             first_hessian_shift: 1e-4,
             min_hessian_shift: 1e-20,
             max_hessian_shift: 1e20,
+            max_augmented_weight: 1e6,
             penalty_init: 10.0,
             penalty_max: 1e8,
             penalty_increase: 10.0,
+            individual_penalties: true,
+            penalty_weight_floor: 1e-3,
             armijo: 1e-4,
             backtrack: 0.5,
             min_step: 1e-12,
@@ -168,8 +182,10 @@ impl SqpOptions {
             first_hessian_shift,
             min_hessian_shift,
             max_hessian_shift,
+            max_augmented_weight,
             penalty_init,
             penalty_max,
+            penalty_weight_floor,
             qp_tol,
             elastic_tol,
             min_step

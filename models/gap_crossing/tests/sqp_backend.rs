@@ -1,0 +1,59 @@
+//! The SQP back end (`--solver sqp`) on the flagship model: the crawl gait over the gap
+//! with 12 stances, through the built binary. Status solved, the independent checker
+//! passes, and the objective matches the interior-point method's on the same scenario.
+use gap_crossing::plan::SolutionFile;
+use std::path::Path;
+use std::process::Command;
+
+fn solve(solver: &str, dir: &Path) -> SolutionFile {
+    let _ = std::fs::remove_dir_all(dir);
+    let out = Command::new(env!("CARGO_BIN_EXE_gap_crossing"))
+        .args([
+            "solve",
+            "--solver",
+            solver,
+            "--gait",
+            "crawl",
+            "--set",
+            "n_step=12",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{solver}: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let path = dir.join("solution.json");
+    let check = Command::new(env!("CARGO_BIN_EXE_gap_crossing"))
+        .args(["check", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        check.status.success(),
+        "{solver}: {}",
+        String::from_utf8_lossy(&check.stdout)
+    );
+    SolutionFile::read(&path).unwrap()
+}
+
+#[test]
+fn sqp_solves_the_crawl_gait_and_matches_the_ipm() {
+    let base = std::env::temp_dir().join(format!("gap_crossing_sqp_{}", std::process::id()));
+    let sqp = solve("sqp", &base.join("sqp"));
+    assert_eq!(sqp.solver.name, "sqp");
+    assert_eq!(sqp.solver.status, "solved");
+    let ipm = solve("ipm", &base.join("ipm"));
+    assert_eq!(ipm.solver.status, "solved");
+    let rel = (sqp.solver.objective - ipm.solver.objective).abs() / ipm.solver.objective;
+    assert!(
+        rel <= 1e-4,
+        "SQP objective {} vs IPM {}",
+        sqp.solver.objective,
+        ipm.solver.objective
+    );
+    let _ = std::fs::remove_dir_all(&base);
+}
