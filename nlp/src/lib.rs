@@ -1,5 +1,6 @@
 //! Nonlinear programs: problem builder and solvers (work in progress).
 
+pub mod callback;
 pub mod compiled;
 pub mod constraint;
 pub mod error;
@@ -14,6 +15,7 @@ pub mod scaling;
 pub mod solution;
 pub mod sqp;
 
+pub use callback::{IterationCallback, IterationView, PhaseLabel};
 pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
 pub use error::SolveError;
@@ -21,7 +23,10 @@ pub use ipm::Ipm;
 pub use problem::{Block, BuildError, ComplementarityReport, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
-pub use mpcc::{solve_mpcc, MpccBackend, MpccError, MpccOptions, MpccPhase, MpccSolution};
+pub use mpcc::{
+    solve_mpcc, solve_mpcc_with_callback, MpccBackend, MpccError, MpccOptions, MpccPhase,
+    MpccSolution,
+};
 pub use numeric::{AffineCone, NumericNlp};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
 pub use solution::{IterationRecord, Solution, Stats, Status};

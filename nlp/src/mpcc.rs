@@ -23,13 +23,16 @@
 //! solution is returned.
 //!
 //! The result reports the complementarity residual and the biactive pairs
-//! ([`ComplementarityReport`]) and every phase.
+//! ([`ComplementarityReport`]) and every phase. [`solve_mpcc_with_callback`] forwards an
+//! iteration callback to every phase's solve, labelling each iteration with its phase.
 
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 use symx::Expr;
 use thiserror::Error;
 
+use crate::callback::{IterationCallback, IterationView, PhaseLabel};
 use crate::constraint::Relation;
 use crate::error::SolveError;
 use crate::ipm::Ipm;
@@ -103,8 +106,9 @@ pub struct MpccPhase {
 /// Result of [`solve_mpcc`].
 #[derive(Debug, Clone)]
 pub struct MpccSolution {
-    /// The returned solution (of the last successful phase); `objective` is f(x) of the
-    /// original problem. Its multipliers belong to the problem of that phase.
+    /// The returned solution (of the last successful phase, or of the phase a callback
+    /// stopped); `objective` is f(x) of the original problem. Its multipliers belong to
+    /// the problem of that phase.
     pub solution: Solution,
     /// Complementarity residual and biactive pairs at `solution.x`.
     pub report: ComplementarityReport,
@@ -130,14 +134,26 @@ fn run(
     o: &MpccOptions,
     pb: &Problem,
     x0: Option<&[f64]>,
+    callback: Option<&mut IterationCallback<'_>>,
+    phase: PhaseLabel,
 ) -> Result<Solution, MpccError> {
     let mut c = pb.compile()?;
     if let Some(x0) = x0 {
         c.set_initial_point(x0)?;
     }
+    // The phase's view: the solver's, labelled with the phase.
+    let mut labelled = callback.map(|cb| {
+        move |v: &IterationView<'_>| {
+            cb(&IterationView {
+                phase: Some(phase),
+                ..*v
+            })
+        }
+    });
+    let cb = labelled.as_mut().map(|f| f as &mut IterationCallback<'_>);
     Ok(match backend {
-        MpccBackend::Sqp => Sqp::new(o.sqp.clone()).solve(&mut c)?,
-        MpccBackend::Ipm => Ipm::new(o.ipm.clone()).solve(&mut c)?,
+        MpccBackend::Sqp => Sqp::new(o.sqp.clone()).solve_dyn(&mut c, None, cb)?,
+        MpccBackend::Ipm => Ipm::new(o.ipm.clone()).solve_dyn(&mut c, None, cb)?,
     })
 }
 
@@ -150,6 +166,28 @@ pub fn solve_mpcc(
     problem: &Problem,
     backend: MpccBackend,
     options: &MpccOptions,
+) -> Result<MpccSolution, MpccError> {
+    solve(problem, backend, options, None)
+}
+
+/// [`solve_mpcc`] with a per-iteration callback, forwarded to every phase's solve (see
+/// [`Ipm::solve_with_callback`]); [`IterationView::phase`] tells which phase an iteration
+/// belongs to. [`ControlFlow::Break`] ends the whole driver: the stopped phase's point is
+/// returned with status [`Status::UserRequestedStop`] and no later phase runs.
+pub fn solve_mpcc_with_callback(
+    problem: &Problem,
+    backend: MpccBackend,
+    options: &MpccOptions,
+    mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+) -> Result<MpccSolution, MpccError> {
+    solve(problem, backend, options, Some(&mut callback))
+}
+
+fn solve(
+    problem: &Problem,
+    backend: MpccBackend,
+    options: &MpccOptions,
+    mut callback: Option<&mut IterationCallback<'_>>,
 ) -> Result<MpccSolution, MpccError> {
     let t = Instant::now();
     let o = options;
@@ -173,9 +211,16 @@ pub fn solve_mpcc(
         Ok(rep)
     };
     // ---- first phase ----
+    let label = |phases: &Vec<MpccPhase>, kind: &'static str, penalty: f64| PhaseLabel {
+        index: phases.len(),
+        kind,
+        penalty,
+    };
+    let stopped = |sol: &Solution| sol.status == Status::UserRequestedStop;
     let mut best = match backend {
         MpccBackend::Sqp => {
-            let sol = run(backend, o, problem, None)?;
+            let phase = label(&phases, "sqp", 0.0);
+            let sol = run(backend, o, problem, None, callback.as_deref_mut(), phase)?;
             record(&mut phases, "sqp", 0.0, &sol)?;
             sol
         }
@@ -188,10 +233,13 @@ pub fn solve_mpcc(
                     obj += pi * (*a * *b);
                 }
                 let pb = problem.mpcc_copy(obj, false);
-                let sol = run(backend, o, &pb, x.as_deref())?;
+                let phase = label(&phases, "penalty", pi);
+                let cb = callback.as_deref_mut();
+                let sol = run(backend, o, &pb, x.as_deref(), cb, phase)?;
                 let rep = record(&mut phases, "penalty", pi, &sol)?;
                 x = Some(sol.x.clone());
-                if (ok(sol.status) && rep.residual <= o.switch_tol)
+                if stopped(&sol)
+                    || (ok(sol.status) && rep.residual <= o.switch_tol)
                     || pi * o.penalty_increase > o.penalty_max
                 {
                     break sol;
@@ -204,7 +252,7 @@ pub fn solve_mpcc(
     let f_at = |x: &[f64]| -> Result<f64, MpccError> { Ok(problem.evaluate(&[f], x)?[0]) };
     best.objective = f_at(&best.x)?;
     // ---- exact final phase ----
-    if o.exact_final_phase && !pairs.is_empty() {
+    if o.exact_final_phase && !pairs.is_empty() && !stopped(&best) {
         let vals = problem.evaluate(
             &pairs
                 .iter()
@@ -221,9 +269,10 @@ pub fn solve_mpcc(
             };
             pb.subject_to_named(&format!("{name}.branch"), side.eq(0.0))?;
         }
-        let sol = run(backend, o, &pb, Some(&best.x))?;
+        let phase = label(&phases, "final", 0.0);
+        let sol = run(backend, o, &pb, Some(&best.x), callback, phase)?;
         record(&mut phases, "final", 0.0, &sol)?;
-        if ok(sol.status) {
+        if ok(sol.status) || stopped(&sol) {
             best = sol;
         }
     }

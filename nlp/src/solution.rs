@@ -16,7 +16,8 @@ pub enum Status {
     SearchDirectionBecomesTooSmall,
     /// The iterates grew beyond `diverging_iterates_tol` (problem possibly unbounded).
     DivergingIterates,
-    /// A user callback asked to stop.
+    /// The iteration callback (`solve_with_callback`, see [`crate::callback`]) returned
+    /// `ControlFlow::Break`; the solution is the iterate it was shown.
     UserRequestedStop,
     /// A feasible point was found (feasibility-only problems).
     FeasiblePointFound,

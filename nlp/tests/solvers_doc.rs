@@ -24,6 +24,73 @@ mod example {
     }
 }
 
+mod callback_example {
+    // Keep in sync with the code block of docs/solvers.md, section 10 (checked below).
+    use nlp::{Ipm, IterationView, Problem, Relation, Status};
+    use std::ops::ControlFlow;
+
+    pub fn watch() -> Result<(), Box<dyn std::error::Error>> {
+        let mut pb = Problem::new();
+        let x = pb.variable("x", 2);
+        pb.set_initial(&x, &[-1.2, 1.0])?;
+        pb.minimize(100.0 * (x[1] - x[0].sq()).sq() + (1.0 - x[0]).sq());
+        pb.subject_to((x[0].sq() + x[1].sq()).le(1.5))?;
+        let mut compiled = pb.compile()?;
+        let mut path: Vec<Vec<f64>> = Vec::new();
+        // One line per iteration; stop early once x is feasible and x₀ > 0.9.
+        let sol = Ipm::default().solve_with_callback(&mut compiled, |v: &IterationView<'_>| {
+            let r = v.record();
+            let mark = if v.in_restoration() { 'r' } else { ' ' };
+            println!(
+                "{:3}{mark} f = {:.6e}, inf_pr = {:.1e}, x = {:?}",
+                r.iter,
+                r.objective,
+                r.inf_pr,
+                v.x()
+            );
+            path.push(v.x().to_vec());
+            if r.inf_pr < 1e-6 && v.x()[0] > 0.9 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })?;
+        assert_eq!(sol.status, Status::UserRequestedStop);
+        assert_eq!(path.len(), sol.stats.iterations + 1);
+        assert_eq!(path.last(), Some(&sol.x));
+        Ok(())
+    }
+}
+
+/// The lines of the first ```rust block after `after` in docs/solvers.md.
+fn doc_block(after: &str) -> Vec<&'static str> {
+    let doc = include_str!("../../docs/solvers.md");
+    let from = doc.find(after).unwrap();
+    let start = from + doc[from..].find("```rust\n").unwrap() + 8;
+    let end = start + doc[start..].find("```").unwrap();
+    doc[start..end]
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect()
+}
+
+#[test]
+fn solvers_md_callback_example_runs() {
+    callback_example::watch().unwrap();
+}
+
+#[test]
+fn solvers_md_callback_example_is_the_one_tested_here() {
+    let this = include_str!("solvers_doc.rs");
+    for line in doc_block("## 10. ") {
+        assert!(
+            this.contains(line),
+            "docs/solvers.md section 10 line not in the test: {line}"
+        );
+    }
+}
+
 #[test]
 fn solvers_md_example_runs() {
     example::main().unwrap();

@@ -95,6 +95,10 @@ pub struct Report {
     /// Largest residual of the (2)–(11) checks, whether or not within tolerance
     /// (mixed units: N, N·m, m, m²).
     pub max_residual: f64,
+    /// (10) in the source's product form: the largest over transitions of
+    /// `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²` (m⁴); 0 when at most one foot moves at each transition.
+    /// Informative only: (10) itself is checked by [`MOVE_TOL`] on each displacement.
+    pub residual_10: f64,
     /// Whether the goal requirement was checked.
     pub goal_checked: bool,
 }
@@ -161,6 +165,7 @@ struct Checker<'a> {
     tol: f64,
     out: Vec<Violation>,
     max_residual: f64,
+    residual_10: f64,
 }
 
 impl Checker<'_> {
@@ -274,8 +279,15 @@ impl Checker<'_> {
     fn transition(&mut self, k: usize, a: &Stance, b: &Stance, scheduled: Option<Foot>) -> usize {
         let s = self.s;
         let mut moved = Vec::new();
-        for i in Foot::ALL {
-            let d2 = dist2(a.feet.get(i), b.feet.get(i));
+        let d2s = Foot::ALL.map(|i| dist2(a.feet.get(i), b.feet.get(i)));
+        let mut products = 0.0;
+        for p in 0..4 {
+            for q in p + 1..4 {
+                products += d2s[p] * d2s[q];
+            }
+        }
+        self.residual_10 = self.residual_10.max(products);
+        for (i, d2) in Foot::ALL.into_iter().zip(d2s) {
             self.test(
                 "(5)",
                 &format!("step length ‖Δr‖² above {} (m²)", s.step_radius_sq),
@@ -331,6 +343,7 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
         tol: opts.tol,
         out: Vec::new(),
         max_residual: 0.0,
+        residual_10: 0.0,
     };
     if st.len() != s.n_step {
         c.out.push(Violation {
@@ -354,6 +367,7 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
         moves += c.transition(k + 1, &st[k], &st[k + 1], turn);
     }
     let max_residual = c.max_residual;
+    let residual_10 = c.residual_10;
     let mut out = c.out;
     let tol = opts.tol;
     if let Some(first) = st.first() {
@@ -402,6 +416,7 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
         stances: st.len(),
         moves,
         max_residual,
+        residual_10,
         goal_checked,
     }
 }

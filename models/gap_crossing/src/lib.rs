@@ -11,9 +11,12 @@
 //!   schedule;
 //! - [`check`]: the independent checker, recomputing every residual from a solution file
 //!   with plain `f64` arithmetic (no symbolic or solver code);
+//! - [`convergence`]: the per-iteration history of the solver runs (objective,
+//!   constraint violation, residual of (10)), recorded by the solvers' iteration callback;
 //! - [`render`]: hand-written SVG plots of a plan and of solver convergence.
 
 pub mod check;
+pub mod convergence;
 pub mod export;
 pub mod gait;
 pub mod model;

@@ -6,9 +6,10 @@
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use gap_crossing::check::{self, GoalCheck, Options};
+use gap_crossing::convergence::Convergence;
 use gap_crossing::gait;
 use gap_crossing::plan::{write_atomic, PlanError, SolutionFile, SolverInfo};
-use gap_crossing::render::{self, IterRecord};
+use gap_crossing::render;
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
 use gap_crossing::sweep::{self, Grid, GridError, PointResult};
@@ -82,7 +83,7 @@ struct RenderArgs {
     /// Solution file (JSON).
     file: PathBuf,
     /// Output directory (default: the solution file's directory). Writes plan.svg, and
-    /// convergence.svg when a convergence.json (iteration records) sits beside FILE.
+    /// convergence.svg when a convergence.json (convergence history) sits beside FILE.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
@@ -152,7 +153,7 @@ enum CliError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path}: not a list of iteration records: {message}")]
+    #[error("{path}: not a convergence history: {message}")]
     Records { path: PathBuf, message: String },
     #[error("solution file {path}: its scenario is invalid: {source}")]
     FileScenario {
@@ -205,21 +206,9 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let file = &outcome.file;
     let report = check::check(file);
 
-    // Convergence records of all solver runs, numbered on. The complementarity residual
-    // per iteration is the interior point's: the barrier parameter μ that the products of
-    // slacks and multipliers are driven to. The residual of (10) is known only at the end
-    // of each run (iterates are not recorded): it is printed in the summary below.
-    let mut records = Vec::new();
-    for phase in &outcome.phases {
-        for r in &phase.records {
-            records.push(IterRecord {
-                iter: records.len(),
-                objective: r.objective,
-                inf_pr: r.inf_pr,
-                compl: r.mu,
-            });
-        }
-    }
+    // Convergence history of all solver runs, numbered on, with the residual of (10) at
+    // every iterate (recorded by the solvers' iteration callback).
+    let history = Convergence::from_phases(&outcome.phases);
     let solved = file.solver.status == "solved" && report.ok();
     if !solved {
         // Nothing partial is left as if it were a result.
@@ -239,7 +228,7 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let conv_json = a.out.join("convergence.json");
     write_file(
         &conv_json,
-        &serde_json::to_string_pretty(&records).unwrap_or_default(),
+        &serde_json::to_string_pretty(&history).unwrap_or_default(),
     )?;
     write_file(&a.out.join("plan.svg"), &render::plan_svg(file))?;
     let title = format!(
@@ -248,7 +237,7 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     );
     write_file(
         &a.out.join("convergence.svg"),
-        &render::convergence_svg(&records, &title),
+        &render::convergence_svg(&history, &title),
     )?;
 
     let moves = gap_crossing::plan::Plan::from_flat(&s, &file.plan().to_flat())
@@ -258,10 +247,7 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     for phase in &outcome.phases {
         println!(
             "  {:<42} {:?}, {} iterations, (10) residual {:.1e}",
-            phase.name,
-            phase.status,
-            phase.records.len().saturating_sub(1),
-            phase.complementarity
+            phase.name, phase.status, phase.iterations, phase.complementarity
         );
     }
     println!("status:     {} ({} gait)", file.solver.status, s.gait);
@@ -454,12 +440,14 @@ fn render_cmd(a: &RenderArgs) -> Result<ExitCode, CliError> {
             .unwrap_or_else(|| PathBuf::from(".")),
     };
     let records_path = a.file.with_file_name("convergence.json");
-    let records: Option<Vec<IterRecord>> = if records_path.exists() {
+    let records: Option<Convergence> = if records_path.exists() {
         let text = std::fs::read_to_string(&records_path).map_err(io(&records_path))?;
-        Some(serde_json::from_str(&text).map_err(|e| CliError::Records {
-            path: records_path.clone(),
-            message: e.to_string(),
-        })?)
+        Some(
+            Convergence::from_json(&text).map_err(|e| CliError::Records {
+                path: records_path.clone(),
+                message: e.to_string(),
+            })?,
+        )
     } else {
         None
     };

@@ -14,6 +14,7 @@
 //!
 //!   So the free gait is never worse than the crawl gait, and its complementarity is
 //!   exact rather than approximate.
+use crate::convergence::ResidualProbe;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError, PENALTY};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
@@ -21,9 +22,10 @@ use crate::scenario::{Foot, Gait, Scenario};
 use crate::terrain::{GapTerrain, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
-    BuildError, IpmOptions, IterationRecord, NumericNlp, Solution, SolveError, Sqp, SqpOptions,
-    Status,
+    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError, Sqp,
+    SqpOptions, Status,
 };
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 /// Complementarity residual below which the free gait's first phase stops raising `π`.
@@ -70,10 +72,14 @@ impl Settings {
         }
     }
 
-    fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
+    fn solve(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+    ) -> Result<Solution, SolveError> {
         match self.backend {
-            Backend::Ipm => Ipm::new(self.ipm.clone()).solve(nlp),
-            Backend::Sqp => Sqp::new(self.sqp.clone()).solve(nlp),
+            Backend::Ipm => Ipm::new(self.ipm.clone()).solve_with_callback(nlp, callback),
+            Backend::Sqp => Sqp::new(self.sqp.clone()).solve_with_callback(nlp, callback),
         }
     }
 }
@@ -85,8 +91,17 @@ pub struct Phase {
     pub name: String,
     /// The solver's status.
     pub status: Status,
-    /// Iteration records, IPOPT columns.
+    /// The solver's iteration count (restoration iterations included).
+    pub iterations: usize,
+    /// Iteration records, IPOPT columns: `iterations + 1` rows, plus the starting row of
+    /// each restoration phase.
     pub records: Vec<IterationRecord>,
+    /// Residual of (10) at each iterate, one per record ([`complementarity_residual`]
+    /// of the iterate, recorded by the solver's iteration callback).
+    pub residuals: Vec<f64>,
+    /// The run had a fixed foot schedule ([`Formulation::Scheduled`]): (10) holds by
+    /// construction, every residual is exactly 0.
+    pub scheduled: bool,
     /// Residual of (10) at the end of the run: max over transitions of `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²`.
     pub complementarity: f64,
 }
@@ -98,6 +113,8 @@ pub struct Outcome {
     pub file: SolutionFile,
     /// The solver runs, in order.
     pub phases: Vec<Phase>,
+    /// Index in `phases` of the run whose solution is the plan.
+    pub chosen: usize,
 }
 
 /// What can stop a planning run (a failed solve is an `Outcome` with a failing status).
@@ -117,7 +134,7 @@ pub enum PlanningError {
 pub fn complementarity_residual(s: &Scenario, x: &[f64]) -> f64 {
     (1..s.n_step)
         .map(|k| {
-            let d: Vec<f64> = Foot::ALL.iter().map(|&i| step_sq(x, k, i)).collect();
+            let d = Foot::ALL.map(|i| step_sq(x, k, i));
             let mut r = 0.0;
             for a in 0..4 {
                 for b in a + 1..4 {
@@ -206,6 +223,8 @@ pub fn scheduled_guess(
 struct Run {
     solution: Solution,
     flat: Vec<f64>,
+    /// Index of its [`Phase`].
+    phase: usize,
 }
 
 fn run(
@@ -222,6 +241,7 @@ fn run(
     }
     let model = model::build(s, terrain, formulation, guess)?;
     let mut compiled = model.problem.compile()?;
+    let mut probe = ResidualProbe::new(s, &model)?;
     let penalties: &[f64] = if model.has_penalty {
         &PENALTIES
     } else {
@@ -236,7 +256,11 @@ fn run(
         if let Some(prev) = &last {
             compiled.set_initial_point(&prev.solution.x)?;
         }
-        let solution = settings.solve(&mut compiled)?;
+        let mut residuals = Vec::new();
+        let solution = settings.solve(&mut compiled, |v| {
+            residuals.push(probe.at(v.x()));
+            ControlFlow::Continue(())
+        })?;
         let flat = model.problem.evaluate(&model.layout, &solution.x)?;
         let complementarity = complementarity_residual(s, &flat);
         phases.push(Phase {
@@ -246,12 +270,19 @@ fn run(
                 name.to_string()
             },
             status: solution.status,
+            iterations: solution.stats.iterations,
             records: solution.stats.records.clone(),
+            residuals,
+            scheduled: matches!(formulation, Formulation::Scheduled(_)),
             complementarity,
         });
         let success = solution.status.is_success();
         let done = !success || complementarity <= COMPLEMENTARITY_TOL;
-        let this = Run { solution, flat };
+        let this = Run {
+            solution,
+            flat,
+            phase: phases.len() - 1,
+        };
         // Keep the successful run with the lowest objective: a larger penalty can only
         // make the choice of steps more conservative.
         if success
@@ -350,10 +381,7 @@ pub fn plan_on(
         }
         .into(),
         status: status_name(last.solution.status).into(),
-        iterations: phases
-            .iter()
-            .map(|p| p.records.len().saturating_sub(1))
-            .sum(),
+        iterations: phases.iter().map(|p| p.iterations).sum(),
         objective: plan.cost(s),
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
@@ -361,6 +389,7 @@ pub fn plan_on(
     Ok(Outcome {
         file: SolutionFile::new(s.clone(), solver, plan),
         phases,
+        chosen: last.phase,
     })
 }
 

@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use crate::callback::Observer;
 use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, probing_mu, tau};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
@@ -19,10 +20,12 @@ use crate::options::{IpmOptions, MuOracle, MuStrategy};
 use crate::solution::{IterationRecord, Stats, Status};
 
 /// State shared by the outer loop and nested restoration loops.
-pub(crate) struct Shared {
+pub(crate) struct Shared<'c> {
     pub stats: Stats,
     pub start: Instant,
     pub iter: usize,
+    /// The user's iteration callback, called by `record`.
+    pub observer: Option<Observer<'c>>,
 }
 
 /// How to start the iteration.
@@ -1554,6 +1557,11 @@ impl<'p> Core<'p> {
             alpha_pr_char: ch,
             ls,
         });
+        if let (Some(obs), Some(rec)) = (shared.observer.as_mut(), shared.stats.records.last()) {
+            let (x, lambda) = obs.buffers();
+            self.nlp.user_point(&self.w[..self.n], &self.y, x, lambda);
+            obs.call(rec);
+        }
         if self.setup_in_resto {
             shared.stats.restoration_iterations += 1;
         }
@@ -1614,6 +1622,15 @@ impl<'p> Core<'p> {
         let mut pending_resto = self.opts.start_with_resto && !self.setup_in_resto;
         let max_resto_iter_end = shared.iter + self.opts.max_resto_iter;
         loop {
+            // The iteration callback (called by `record`) asked to stop (IPOPT tests
+            // this before convergence).
+            if shared.observer.as_ref().is_some_and(|o| o.stopped()) {
+                return self.outcome(
+                    Status::UserRequestedStop,
+                    "stopped by the iteration callback",
+                    false,
+                );
+            }
             // ---------------- convergence
             let (e0, eu) = self.nlp_error(0.0, false);
             if !self.setup_in_resto {

@@ -14,8 +14,10 @@ pub mod filter;
 pub(crate) mod reduced;
 mod restoration;
 
+use std::ops::ControlFlow;
 use std::time::Instant;
 
+use crate::callback::{IterationCallback, IterationView, Observer};
 use crate::error::SolveError;
 use crate::numeric::NumericNlp;
 use crate::options::{IpmOptions, ScalingMethod};
@@ -139,7 +141,44 @@ impl Ipm {
 
     /// Solves from the problem's initial point.
     pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
-        self.run(nlp, None)
+        self.run(nlp, None, None)
+    }
+
+    /// [`Ipm::solve`] with a per-iteration callback (IPOPT's `intermediate_callback`):
+    /// `callback` sees every iteration, restoration iterations and iteration 0 included,
+    /// once per row of `Solution::stats.records`, before the convergence test; returning
+    /// [`ControlFlow::Break`] ends the solve with [`Status::UserRequestedStop`] at that
+    /// point. See [`crate::callback`].
+    pub fn solve_with_callback(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+    ) -> Result<Solution, SolveError> {
+        self.run(nlp, None, Some(&mut callback))
+    }
+
+    /// [`Ipm::solve_warm`] with a per-iteration callback (see [`Ipm::solve_with_callback`]).
+    pub fn solve_warm_with_callback(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        previous: &Solution,
+        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+    ) -> Result<Solution, SolveError> {
+        self.check_warm(nlp, previous)?;
+        self.run(nlp, Some(previous), Some(&mut callback))
+    }
+
+    /// The solve behind every entry point, with the callback as a trait object.
+    pub(crate) fn solve_dyn(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        warm: Option<&Solution>,
+        callback: Option<&mut IterationCallback<'_>>,
+    ) -> Result<Solution, SolveError> {
+        if let Some(prev) = warm {
+            self.check_warm(nlp, prev)?;
+        }
+        self.run(nlp, warm, callback)
     }
 
     /// Warm start from a previous solution (IPOPT's `warm_start_init_point = yes`): x, λ,
@@ -150,6 +189,11 @@ impl Ipm {
         nlp: &mut dyn NumericNlp,
         previous: &Solution,
     ) -> Result<Solution, SolveError> {
+        self.check_warm(nlp, previous)?;
+        self.run(nlp, Some(previous), None)
+    }
+
+    fn check_warm(&self, nlp: &dyn NumericNlp, previous: &Solution) -> Result<(), SolveError> {
         previous.check_warm_start(nlp.n(), nlp.m())?;
         for (i, &x) in previous.x.iter().enumerate() {
             if !x.is_finite() {
@@ -160,13 +204,14 @@ impl Ipm {
                 });
             }
         }
-        self.run(nlp, Some(previous))
+        Ok(())
     }
 
     fn run(
         &self,
         nlp: &mut dyn NumericNlp,
         warm: Option<&Solution>,
+        callback: Option<&mut IterationCallback<'_>>,
     ) -> Result<Solution, SolveError> {
         let start_time = Instant::now();
         let opts = &self.options;
@@ -174,11 +219,18 @@ impl Ipm {
         if let Some(prev) = warm {
             v.x0.copy_from_slice(&prev.x);
         }
+        let observer = callback.map(|cb| {
+            let clamp = opts
+                .honor_original_bounds
+                .then_some((&v.x_l[..], &v.x_u[..]));
+            Observer::new(cb, v.x_l.len(), v.g_l.len(), clamp)
+        });
         let mut red = Reduced::new(nlp, &v.x_l, &v.x_u, &v.g_l, &v.g_u, &v.x0);
         let mut shared = Shared {
             stats: Stats::default(),
             start: start_time,
             iter: 0,
+            observer,
         };
         let n = red.free.len();
         let m = red.rows.len();

@@ -17,6 +17,10 @@ pub(crate) trait IpmProblem: NumericNlp {
     fn restoration_accepts(&mut self, _w: &[f64]) -> bool {
         false
     }
+
+    /// Writes the point `x` (this problem's variables) and multipliers `y` (this
+    /// problem's rows) in the user's spaces, for the iteration callback.
+    fn user_point(&self, x: &[f64], y: &[f64], x_user: &mut [f64], lambda_user: &mut [f64]);
 }
 
 /// Evaluation counters and time spent in user callbacks.
@@ -298,4 +302,17 @@ impl NumericNlp for Reduced<'_> {
     }
 }
 
-impl IpmProblem for Reduced<'_> {}
+impl IpmProblem for Reduced<'_> {
+    /// Fixed variables at their values, free ones from `x`; λ = y·s_g/s_f (rows without
+    /// bounds: 0), as in the returned solution.
+    fn user_point(&self, x: &[f64], y: &[f64], x_user: &mut [f64], lambda_user: &mut [f64]) {
+        x_user.copy_from_slice(&self.x_full);
+        for (k, &j) in self.free.iter().enumerate() {
+            x_user[j] = x[k];
+        }
+        lambda_user.iter_mut().for_each(|v| *v = 0.0);
+        for (k, &i) in self.rows.iter().enumerate() {
+            lambda_user[i] = y[k] * self.g_scale[k] / self.obj_scale;
+        }
+    }
+}

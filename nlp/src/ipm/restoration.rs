@@ -135,6 +135,11 @@ impl NumericNlp for Resto<'_> {
 }
 
 impl IpmProblem for Resto<'_> {
+    /// The x part of `[x, p, n]`; the restoration rows are the outer problem's rows.
+    fn user_point(&self, x: &[f64], y: &[f64], x_user: &mut [f64], lambda_user: &mut [f64]) {
+        self.outer.user_point(&x[..self.n], y, x_user, lambda_user);
+    }
+
     fn restoration_accepts(&mut self, w: &[f64]) -> bool {
         let (n, m) = (self.n, self.m);
         let x = &w[..n];
@@ -403,6 +408,11 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
             Ok(())
         }
         Status::MaximumIterationsExceeded | Status::MaximumWallTimeExceeded => {
+            let _ = core.restart_from(&w_o, &zl_o, &zu_o);
+            Err(fail(core, outcome.status, outcome.message))
+        }
+        Status::UserRequestedStop => {
+            // The callback saw the restoration iterate: return its x.
             let _ = core.restart_from(&w_o, &zl_o, &zu_o);
             Err(fail(core, outcome.status, outcome.message))
         }

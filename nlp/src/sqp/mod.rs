@@ -33,10 +33,12 @@
 pub mod options;
 pub(crate) mod qp;
 
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 use faer::sparse::SymbolicSparseColMat;
 
+use crate::callback::{IterationCallback, IterationView, Observer};
 use crate::error::SolveError;
 use crate::kkt::Kkt;
 use crate::numeric::{AffineCone, NumericNlp};
@@ -251,7 +253,43 @@ impl Sqp {
 
     /// Solves from the problem's initial point.
     pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
-        self.run(nlp, None)
+        self.run(nlp, None, None)
+    }
+
+    /// [`Sqp::solve`] with a per-iteration callback, as
+    /// [`Ipm::solve_with_callback`](crate::Ipm::solve_with_callback): called once per row
+    /// of `Solution::stats.records` (iteration 0 included) before the convergence test;
+    /// [`ControlFlow::Break`] ends the solve with [`Status::UserRequestedStop`].
+    pub fn solve_with_callback(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+    ) -> Result<Solution, SolveError> {
+        self.run(nlp, None, Some(&mut callback))
+    }
+
+    /// [`Sqp::solve_warm`] with a per-iteration callback (see [`Sqp::solve_with_callback`]).
+    pub fn solve_warm_with_callback(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        previous: &Solution,
+        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+    ) -> Result<Solution, SolveError> {
+        previous.check_warm_start(nlp.n(), nlp.m())?;
+        self.run(nlp, Some(previous), Some(&mut callback))
+    }
+
+    /// The solve behind every entry point, with the callback as a trait object.
+    pub(crate) fn solve_dyn(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        warm: Option<&Solution>,
+        callback: Option<&mut IterationCallback<'_>>,
+    ) -> Result<Solution, SolveError> {
+        if let Some(prev) = warm {
+            prev.check_warm_start(nlp.n(), nlp.m())?;
+        }
+        self.run(nlp, warm, callback)
     }
 
     /// Starts from a previous solution's x and multipliers (λ, z_L, z_U): with a good
@@ -262,13 +300,14 @@ impl Sqp {
         previous: &Solution,
     ) -> Result<Solution, SolveError> {
         previous.check_warm_start(nlp.n(), nlp.m())?;
-        self.run(nlp, Some(previous))
+        self.run(nlp, Some(previous), None)
     }
 
     fn run(
         &self,
         nlp: &mut dyn NumericNlp,
         warm: Option<&Solution>,
+        callback: Option<&mut IterationCallback<'_>>,
     ) -> Result<Solution, SolveError> {
         let start = Instant::now();
         let o = &self.options;
@@ -493,6 +532,7 @@ impl Sqp {
             alpha_pr_char: ' ',
             ls: 0,
         };
+        let mut observer = callback.map(|cb| Observer::new(cb, n, m, None));
         let mut lgrad = vec![0.0; n];
         let mut iter = 0usize;
         let mut qp_iterations = 0u64;
@@ -530,6 +570,14 @@ impl Sqp {
                     println!("{}", crate::log::header());
                 }
                 println!("{}", crate::log::format_record(&record));
+            }
+            if let Some(obs) = observer.as_mut() {
+                let (l, sg, os) = (&mult.lambda, &sc.g_scale, sc.obj_scale);
+                if obs.call_sqp(&record, &x, l, sg, os, &cones, &mult.z_cone) {
+                    status = Status::UserRequestedStop;
+                    message = "stopped by the iteration callback".into();
+                    break;
+                }
             }
             let unscaled_pr = unscaled_violation(&geo, &sc.g_scale, &x, &g, &cone);
             if have_mult
