@@ -114,9 +114,12 @@ pub struct IpmOptions {
     /// g, and multipliers and KKT regularisation see O(1) rows. The objective is never
     /// scaled up (a sum of many small terms has small gradient entries without being
     /// small, and its multipliers would grow with the factor). 0 gives IPOPT's
-    /// behaviour. Default 1: the hanging chain with 50 000 links (row gradients 8e-5,
+    /// behaviour. Default 0.5: the hanging chain with 50 000 links (row gradients 8e-5,
     /// entries of g in units of 1.6e-9) fails without it and solves to the discrete
-    /// catenary in 8 iterations with it; see docs/solvers.md.
+    /// catenary in 8 iterations with it (0.5, 1 and 2 all do); 1 and 2 also scale
+    /// gap-crossing rows with gradients in [0.5, 2), which made one crawl scenario end in
+    /// restoration failure (1) or the flat crawl take 223 instead of 173 iterations (2).
+    /// See docs/solvers.md.
     pub nlp_scaling_min_gradient: f64,
     /// **Not an IPOPT option.** Largest factor of the upward scaling by
     /// `nlp_scaling_min_gradient` (a row whose gradient vanishes at x0 is left alone; one
@@ -282,7 +285,7 @@ impl Default for IpmOptions {
             nlp_scaling_method: ScalingMethod::GradientBased,
             nlp_scaling_max_gradient: 100.0,
             nlp_scaling_min_value: 1e-8,
-            nlp_scaling_min_gradient: 1.0,
+            nlp_scaling_min_gradient: 0.5,
             nlp_scaling_max_value: 1e4,
             obj_scaling_factor: 1.0,
             bound_push: 1e-2,

@@ -58,6 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "bound_frac" => opts.bound_frac = v.parse()?,
                 "mu_linear_decrease_factor" => opts.mu_linear_decrease_factor = v.parse()?,
                 "barrier_tol_factor" => opts.barrier_tol_factor = v.parse()?,
+                "nlp_scaling_min_gradient" => opts.nlp_scaling_min_gradient = v.parse()?,
                 other => return Err(format!("unknown option {other}").into()),
             }
         }
