@@ -245,6 +245,9 @@ pub struct IpmOptions {
     pub max_resto_iter: usize,
     /// Bound multipliers larger than this are reset to 1 after restoration. Default 1e3.
     pub bound_mult_reset_threshold: f64,
+    /// After restoration the constraint multipliers are the least-squares estimate if it
+    /// is no larger than this (max-norm), else 0; 0 means always 0. Default 0.
+    pub constr_mult_reset_threshold: f64,
     /// Start with a restoration phase. Default false.
     pub start_with_resto: bool,
     // ---------- output ----------
@@ -337,6 +340,7 @@ impl Default for IpmOptions {
             resto_proximity_weight: 1.0,
             max_resto_iter: 3000,
             bound_mult_reset_threshold: 1e3,
+            constr_mult_reset_threshold: 1e3,
             start_with_resto: false,
             print_level: 0,
         }
@@ -423,6 +427,7 @@ impl IpmOptions {
             bound_relax_factor,
             nlp_scaling_min_gradient,
             constr_mult_init_max,
+            constr_mult_reset_threshold,
             tiny_step_tol,
             tiny_step_y_tol,
             kappa_d,

@@ -579,7 +579,7 @@ impl<'p> Core<'p> {
                         self.y.iter_mut().for_each(|v| *v = 0.0);
                         self.eval_current()?;
                         if self.m > 0 {
-                            self.least_squares_multipliers();
+                            self.least_squares_multipliers(self.opts.constr_mult_init_max);
                             // Hessian at the new multipliers.
                             self.nlp
                                 .eval_hess_l(&self.w[..n], 1.0, &self.y, &mut self.hess);
@@ -601,8 +601,8 @@ impl<'p> Core<'p> {
     }
 
     /// y = argmin ‖∇f + Aᵀy − z_L + z_U‖₂ (IPOPT's least-squares estimate), set to 0 if
-    /// larger than constr_mult_init_max.
-    pub fn least_squares_multipliers(&mut self) {
+    /// larger than `max_norm` (max-norm) or not computable.
+    pub fn least_squares_multipliers(&mut self, max_norm: f64) {
         let (n, m) = (self.n, self.m);
         if m == 0 {
             return;
@@ -705,7 +705,7 @@ impl<'p> Core<'p> {
                 .is_ok();
         if ok {
             let ymax = inf_norm(&self.rhs[n..]);
-            if ymax <= self.opts.constr_mult_init_max && ymax.is_finite() {
+            if ymax <= max_norm && ymax.is_finite() {
                 self.y.copy_from_slice(&self.rhs[n..]);
                 return;
             }
@@ -1775,30 +1775,43 @@ impl<'p> Core<'p> {
 
     // ------------------------------------------------------------------ for restoration
 
-    /// Replaces the iterate by a restoration result and re-evaluates everything.
-    pub fn restart_from(&mut self, w: &[f64], zl: &[f64], zu: &[f64]) -> Result<(), String> {
-        self.w.copy_from_slice(w);
-        let thr = self.opts.bound_mult_reset_threshold;
-        for j in 0..self.nw {
-            self.zl[j] = if self.has_l[j] {
-                if zl[j] > thr {
-                    1.0
-                } else {
-                    zl[j].max(1e-20)
-                }
-            } else {
-                0.0
-            };
-            self.zu[j] = if self.has_u[j] {
-                if zu[j] > thr {
-                    1.0
-                } else {
-                    zu[j].max(1e-20)
-                }
-            } else {
-                0.0
-            };
+    /// Replaces the iterate by a restoration result `w` and re-evaluates everything.
+    ///
+    /// Multipliers as IPOPT sets them after a successful restoration
+    /// (`MinC_1NrmRestorationPhase`): the bound multipliers take one primal-dual Newton
+    /// step for complementarity, the whole move of the restoration phase counting as the
+    /// primal step (Δz = (μ − z·Δs)/s − z, cut by the fraction to the boundary), and are
+    /// all reset to 1 if one exceeds `bound_mult_reset_threshold`; the constraint
+    /// multipliers are the least-squares estimate if `constr_mult_reset_threshold` > 0 and
+    /// it is no larger than that, else 0.
+    pub fn restart_from(&mut self, w: &[f64]) -> Result<(), String> {
+        let (mu, nw) = (self.mu, self.nw);
+        let mut dzl = vec![0.0; nw];
+        let mut dzu = vec![0.0; nw];
+        for j in 0..nw {
+            if self.has_l[j] {
+                let (s, s_new) = (self.w[j] - self.wl[j], w[j] - self.wl[j]);
+                dzl[j] = (mu + self.zl[j] * (s - s_new)) / s - self.zl[j];
+            }
+            if self.has_u[j] {
+                let (s, s_new) = (self.wu[j] - self.w[j], self.wu[j] - w[j]);
+                dzu[j] = (mu + self.zu[j] * (s - s_new)) / s - self.zu[j];
+            }
         }
+        let alpha = self.max_step_dual(&dzl, &dzu, tau(mu, &self.opts));
+        let mut z_max: f64 = 0.0;
+        for j in 0..nw {
+            self.zl[j] += alpha * dzl[j];
+            self.zu[j] += alpha * dzu[j];
+            z_max = z_max.max(self.zl[j]).max(self.zu[j]);
+        }
+        if z_max > self.opts.bound_mult_reset_threshold {
+            for j in 0..nw {
+                self.zl[j] = if self.has_l[j] { 1.0 } else { 0.0 };
+                self.zu[j] = if self.has_u[j] { 1.0 } else { 0.0 };
+            }
+        }
+        self.w.copy_from_slice(w);
         self.y.iter_mut().for_each(|v| *v = 0.0);
         let n = self.n;
         let x = &self.w[..n];
@@ -1816,18 +1829,15 @@ impl<'p> Core<'p> {
         let mut c = std::mem::take(&mut self.c);
         self.constraint_residual(&self.w, &self.g, &mut c);
         self.c = c;
-        self.least_squares_multipliers();
+        if self.opts.constr_mult_reset_threshold > 0.0 {
+            self.least_squares_multipliers(self.opts.constr_mult_reset_threshold);
+        }
         self.nlp
             .eval_hess_l(&self.w[..n], 1.0, &self.y, &mut self.hess);
         if !all_finite(&self.hess) {
             return Err("non-finite Hessian at the restoration result".into());
         }
         Ok(())
-    }
-
-    /// θ(w) = ‖c‖₁ for the current point.
-    pub fn theta(&self) -> f64 {
-        one_norm(&self.c)
     }
 
     /// Current Hessian regularisation and δ_w bookkeeping accessors.

@@ -49,7 +49,9 @@ struct Resto<'a> {
     kappa_d: f64,
     mu_outer: f64,
     filter: Filter,
-    theta_target: f64,
+    /// IPOPT's exit test (`RestoFilterConvergenceCheck`): the original problem's
+    /// max-norm infeasibility must fall to κ_resto × its value at the start.
+    inf_pr_target: f64,
     theta_max: f64,
     gbuf: Vec<f64>,
     wbuf: Vec<f64>,
@@ -148,7 +150,7 @@ impl IpmProblem for Resto<'_> {
         if self.gbuf.iter().any(|v| !v.is_finite()) {
             return false;
         }
-        let mut theta = 0.0;
+        let (mut theta, mut inf_pr) = (0.0, 0.0f64);
         for i in 0..m {
             let k = self.slack_of_row[i];
             let c = if k == usize::MAX {
@@ -157,8 +159,9 @@ impl IpmProblem for Resto<'_> {
                 self.gbuf[i] - s[k]
             };
             theta += c.abs();
+            inf_pr = inf_pr.max(c.abs());
         }
-        if theta > self.theta_target || theta > self.theta_max {
+        if inf_pr > self.inf_pr_target || theta > self.theta_max {
             return false;
         }
         let f = self.outer.eval_f(x);
@@ -292,7 +295,6 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         zl[n + 2 * m + k] = core.zl[n + k].min(rho);
         zu[n + 2 * m + k] = core.zu[n + k].min(rho);
     }
-    let theta = core.theta();
     let theta_max = core.theta_max();
     let resto = Resto {
         n,
@@ -321,7 +323,8 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         kappa_d: opts.kappa_d,
         mu_outer: core.mu,
         filter: core.filter.clone(),
-        theta_target: opts.required_infeasibility_reduction * theta,
+        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.c))
+            .max(opts.tol.min(opts.constr_viol_tol)),
         theta_max,
         gbuf: vec![0.0; m],
         wbuf: vec![0.0; n + ni],
@@ -368,10 +371,6 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
     // Map the inner point back: x = w[..n], s = w[n+2m..].
     let mut w_o = outcome.w[..n].to_vec();
     w_o.extend_from_slice(&outcome.w[n + 2 * m..]);
-    let mut zl_o = outcome.zl[..n].to_vec();
-    zl_o.extend_from_slice(&outcome.zl[n + 2 * m..]);
-    let mut zu_o = outcome.zu[..n].to_vec();
-    zu_o.extend_from_slice(&outcome.zu[n + 2 * m..]);
     let fail = |core: &Core<'_>, status: Status, msg: String| Outcome {
         status,
         w: core.w.clone(),
@@ -383,7 +382,7 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
     };
     match outcome.status {
         Status::SolveSucceeded => {
-            if let Err(msg) = core.restart_from(&w_o, &zl_o, &zu_o) {
+            if let Err(msg) = core.restart_from(&w_o) {
                 return Err(fail(core, Status::RestorationFailed, msg));
             }
             if outcome.resto_converged {
@@ -408,19 +407,19 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
             Ok(())
         }
         Status::MaximumIterationsExceeded | Status::MaximumWallTimeExceeded => {
-            let _ = core.restart_from(&w_o, &zl_o, &zu_o);
+            let _ = core.restart_from(&w_o);
             Err(fail(core, outcome.status, outcome.message))
         }
         Status::UserRequestedStop => {
             // The callback saw the restoration iterate: return its x.
-            let _ = core.restart_from(&w_o, &zl_o, &zu_o);
+            let _ = core.restart_from(&w_o);
             Err(fail(core, outcome.status, outcome.message))
         }
         Status::InvalidNumberDetected => {
             Err(fail(core, Status::RestorationFailed, outcome.message))
         }
         _ => {
-            let _ = core.restart_from(&w_o, &zl_o, &zu_o);
+            let _ = core.restart_from(&w_o);
             Err(fail(core, Status::RestorationFailed, outcome.message))
         }
     }
