@@ -28,10 +28,10 @@ pub fn solve(
     for k in 0..n {
         let xk = x.column(k)?;
         let k1 = f(&xk, u[k]);
-        let k2 = f(&(&xk + &(dt / 2.0 * &k1)), u[k]);
-        let k3 = f(&(&xk + &(dt / 2.0 * &k2)), u[k]);
-        let k4 = f(&(&xk + &(dt * &k3)), u[k]);
-        let x_next = &xk + &(dt / 6.0 * &(k1 + 2.0 * &k2 + 2.0 * &k3 + k4));
+        let k2 = f(&(&xk + dt / 2.0 * &k1), u[k]);
+        let k3 = f(&(&xk + dt / 2.0 * &k2), u[k]);
+        let k4 = f(&(&xk + dt * &k3), u[k]);
+        let x_next = &xk + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
         opti.subject_to(x.column(k + 1)?.eq(&x_next))?; // close the gaps
     }
     for k in 0..=n {

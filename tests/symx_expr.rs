@@ -374,6 +374,14 @@ fn matrix_operations() {
     assert!(m.slice(1..2, 1..3).unwrap()[(0, 1)].is(m[(1, 2)]));
     assert!((&Matrix::eye(2) * &m)[(1, 2)].is(m[(1, 2)]));
     assert!(m.map(|e| e * 0.0).iter().all(|e| e.is_constant_value(0.0)));
+    // Owned and borrowed operands give the same (hash-consed) nodes.
+    let s = Expr::sym("s");
+    let by_ref = &v + &(s * &w);
+    for (a, b) in by_ref.iter().zip((&v + s * w.clone()).iter()) {
+        assert!(a.is(*b));
+    }
+    let diff = &v - 2.0 * w.clone();
+    assert!(diff[1].is(v[1] - 2.0 * w[1]));
 }
 
 // ---------------------------------------------------------------------------------------

@@ -432,6 +432,12 @@ macro_rules! elementwise {
                 (&self).$method(rhs)
             }
         }
+        impl $trait<Matrix> for &Matrix {
+            type Output = Matrix;
+            fn $method(self, rhs: Matrix) -> Matrix {
+                self.$method(&rhs)
+            }
+        }
     )*};
 }
 elementwise! { Add add; Sub sub; }
@@ -480,6 +486,20 @@ impl Mul<&Matrix> for f64 {
     type Output = Matrix;
     fn mul(self, m: &Matrix) -> Matrix {
         m.map(|e| self * e)
+    }
+}
+
+impl Mul<Matrix> for Expr {
+    type Output = Matrix;
+    fn mul(self, m: Matrix) -> Matrix {
+        self * &m
+    }
+}
+
+impl Mul<Matrix> for f64 {
+    type Output = Matrix;
+    fn mul(self, m: Matrix) -> Matrix {
+        self * &m
     }
 }
 
