@@ -50,15 +50,21 @@ impl Status {
 /// One row of the IPOPT-style iteration table.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IterationRecord {
-    /// Iteration number.
+    /// Iteration number. The counter runs on through a restoration phase (IPOPT's
+    /// convention): the outer iteration whose line search failed gives its number to the
+    /// restoration's first row, each restoration step takes the next one.
     pub iter: usize,
-    /// True during the feasibility restoration phase (printed as 'r').
+    /// True during the feasibility restoration phase (printed as 'r' after the number).
     pub restoration: bool,
-    /// Unscaled objective (the original objective also during restoration).
+    /// Unscaled objective of the original problem, also during restoration (at the
+    /// restoration iterate's x, as IPOPT prints it).
     pub objective: f64,
-    /// Unscaled constraint violation (max-norm).
+    /// Unscaled constraint violation of the original problem (max-norm), also during
+    /// restoration.
     pub inf_pr: f64,
-    /// Scaled dual infeasibility (max-norm).
+    /// Dual infeasibility (max-norm), unscaled: divided by the objective scale factor
+    /// (IPOPT prints the scaled value; the two differ when the objective is scaled). In
+    /// restoration: the restoration problem's, as in IPOPT.
     pub inf_du: f64,
     /// Barrier parameter μ (printed as lg(mu)).
     pub mu: f64,
@@ -70,11 +76,13 @@ pub struct IterationRecord {
     pub alpha_du: f64,
     /// Primal step size.
     pub alpha_pr: f64,
-    /// IPOPT's step-type character after alpha_pr: 'f' (f-type), 'h' (h-type), upper
-    /// case with second-order correction, 'r' after restoration, 't' tiny step, ' ' for
-    /// the initial row.
+    /// IPOPT's step-type character after alpha_pr: 'f' (f-type: switching and Armijo
+    /// conditions hold, the filter is not augmented), 'h' (h-type), upper case with
+    /// second-order correction, 'R' on a restoration phase's first row (alpha_pr and ls
+    /// are then those of the failed line search), 't' tiny step, ' ' for the initial row.
     pub alpha_pr_char: char,
-    /// Number of line-search trials.
+    /// Number of trial step sizes of the backtracking line search (second-order
+    /// corrections are not counted, as in IPOPT).
     pub ls: usize,
 }
 

@@ -200,13 +200,20 @@ fn restoration_iterations_are_reported_and_can_be_stopped() {
         .iter()
         .position(|&r| r)
         .expect("restoration");
-    // One call per record: iterations + 1, plus the starting row of each restoration
-    // phase (it repeats the iteration number of the failed step).
-    let entries = (1..seen.records.len())
+    // One call per record and one record per iteration number (IPOPT's convention: the
+    // iteration whose line search failed is the restoration phase's first row, "kr" with
+    // alpha_pr char 'R'), plus row 0.
+    assert_eq!(seen.records.len(), sol.stats.iterations + 1);
+    for (k, r) in seen.records.iter().enumerate() {
+        assert_eq!(r.iter, k);
+    }
+    let entries: Vec<_> = (1..seen.records.len())
         .filter(|&k| seen.restoration[k] && !seen.restoration[k - 1])
-        .count();
-    assert!(entries >= 1);
-    assert_eq!(seen.records.len(), sol.stats.iterations + 1 + entries);
+        .collect();
+    assert!(!entries.is_empty());
+    for &k in &entries {
+        assert_eq!(seen.records[k].alpha_pr_char, 'R');
+    }
     assert_last_point(&seen, &sol, "restoration problem");
 
     // Stop at the first restoration row: the point is the restoration iterate's x.

@@ -164,6 +164,9 @@ pub(crate) struct Core<'p> {
     g_scale: Vec<f64>,
     mu_strategy: MuStrategy,
     resto_calls: usize,
+    /// The outer iteration's failed line search (alpha_pr, ls) that starts a restoration
+    /// phase; shown in the restoration's first log row as IPOPT does ("12r … 4.8e-7R 22").
+    pub resto_start: Option<(f64, usize)>,
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
@@ -356,6 +359,7 @@ impl<'p> Core<'p> {
             g_scale: setup.g_scale.clone(),
             mu_strategy: setup.mu_strategy,
             resto_calls: 0,
+            resto_start: None,
         })
     }
 
@@ -1329,6 +1333,11 @@ impl<'p> Core<'p> {
 
     // ------------------------------------------------------------------ line search
 
+    /// IPOPT's acceptance test of a trial point (FilterLSAcceptor::CheckAcceptabilityOfTrialPoint):
+    /// θ_t ≤ θ_max, then, when θ ≤ θ_min and the switching condition holds, Armijo on φ_μ,
+    /// else sufficient reduction of θ or φ_μ against the current iterate; and the filter.
+    /// `alpha` is the step size used in the switching and Armijo conditions (for a
+    /// second-order correction, the step of the rejected trial point).
     fn is_acceptable(
         &self,
         alpha: f64,
@@ -1337,27 +1346,49 @@ impl<'p> Core<'p> {
         gpd: f64,
         theta_t: f64,
         phi_t: f64,
-    ) -> Option<bool> {
+    ) -> bool {
         let o = &self.opts;
         if !(theta_t <= self.theta_max) || !phi_t.is_finite() {
-            return None;
-        }
-        if !self.filter.acceptable(theta_t, phi_t) {
-            return None;
-        }
-        let switching = gpd < 0.0 && alpha * (-gpd).powf(o.s_phi) > o.delta * theta.powf(o.s_theta);
-        if theta <= self.theta_min && switching {
-            let tol = 10.0 * f64::EPSILON * phi.abs();
-            if phi_t - phi - o.eta_phi * alpha * gpd <= tol {
-                return Some(true); // f-type
-            }
-            return None;
+            return false;
         }
         let tol = 10.0 * f64::EPSILON * phi.abs();
-        if theta_t <= (1.0 - o.gamma_theta) * theta || phi_t - (phi - o.gamma_phi * theta) <= tol {
-            return Some(false); // h-type
+        let ok = if theta <= self.theta_min && self.switching(alpha, theta, gpd) {
+            phi_t - phi - o.eta_phi * alpha * gpd <= tol
+        } else {
+            theta_t <= (1.0 - o.gamma_theta) * theta || phi_t - (phi - o.gamma_phi * theta) <= tol
+        };
+        ok && self.filter.acceptable(theta_t, phi_t)
+    }
+
+    /// The switching condition α (−∇φ_μᵀd)^s_φ > δ θ^s_θ (with ∇φ_μᵀd < 0).
+    fn switching(&self, alpha: f64, theta: f64, gpd: f64) -> bool {
+        let o = &self.opts;
+        gpd < 0.0 && alpha * (-gpd).powf(o.s_phi) > o.delta * theta.powf(o.s_theta)
+    }
+
+    /// Classifies an accepted step as IPOPT does (FilterLSAcceptor::UpdateForNextIteration,
+    /// Wächter & Biegler 2006, Algorithm A step A-8): an f-type step satisfies the switching
+    /// condition and the Armijo condition, whether or not θ ≤ θ_min; any other step
+    /// augments the filter with the current iterate. Returns true for an f-type step.
+    fn update_filter_after_step(
+        &mut self,
+        alpha: f64,
+        theta: f64,
+        phi: f64,
+        gpd: f64,
+        phi_t: f64,
+    ) -> bool {
+        let o = &self.opts;
+        let tol = 10.0 * f64::EPSILON * phi.abs();
+        let ftype =
+            self.switching(alpha, theta, gpd) && phi_t - phi - o.eta_phi * alpha * gpd <= tol;
+        if !ftype {
+            self.filter.add(
+                (1.0 - self.opts.gamma_theta) * theta,
+                phi - self.opts.gamma_phi * theta,
+            );
         }
-        None
+        ftype
     }
 
     fn alpha_min(&self, theta: f64, gpd: f64) -> f64 {
@@ -1386,7 +1417,8 @@ impl<'p> Core<'p> {
         let mut ls = 0usize;
         let n = self.n;
         loop {
-            if alpha < alpha_min {
+            // The first trial step is always tried, even below α_min (IPOPT).
+            if ls > 0 && !(alpha > alpha_min) {
                 return (LsResult::Failed, alpha, 0.0, ' ', ls);
             }
             ls += 1;
@@ -1397,17 +1429,12 @@ impl<'p> Core<'p> {
             if finite {
                 let theta_t = one_norm(&self.c_t);
                 let phi_t = self.barrier(&self.w_t, self.f_t, self.mu);
-                if let Some(ftype) = self.is_acceptable(alpha, theta, phi, gpd, theta_t, phi_t) {
+                if self.is_acceptable(alpha, theta, phi, gpd, theta_t, phi_t) {
                     for i in 0..self.m {
                         self.y_t[i] = self.y[i] + alpha * self.dy[i];
                     }
                     if self.eval_trial_derivs() {
-                        if !ftype {
-                            self.filter.add(
-                                (1.0 - self.opts.gamma_theta) * theta,
-                                phi - self.opts.gamma_phi * theta,
-                            );
-                        }
+                        let ftype = self.update_filter_after_step(alpha, theta, phi, gpd, phi_t);
                         let alpha_du = self.max_step_dual(&self.dzl, &self.dzu, self.tau);
                         self.take_dual_step(alpha_du, false);
                         self.accept_trial();
@@ -1424,37 +1451,42 @@ impl<'p> Core<'p> {
                     && self.opts.max_soc > 0
                     && self.m > 0
                 {
-                    // Second-order corrections.
-                    for i in 0..self.m {
-                        self.c_soc[i] = alpha * self.c[i] + self.c_t[i];
-                    }
-                    let mut theta_soc_old = theta;
-                    let mut theta_t_soc = theta_t;
-                    for _ in 0..self.opts.max_soc {
+                    // Second-order corrections (IPOPT's TrySecondOrderCorrection):
+                    // c_soc ← α_soc·c_soc + c(trial), starting from c_soc = c and
+                    // α_soc = α; another correction is tried while the last one
+                    // reduced θ by κ_soc against the trial point before it. The
+                    // acceptance tests use the original step size α.
+                    self.c_soc.copy_from_slice(&self.c);
+                    let mut a_soc = alpha;
+                    let mut theta_trial = theta_t;
+                    let mut theta_soc_old = 0.0;
+                    for count in 0..self.opts.max_soc {
+                        if count > 0 && !(theta_trial <= self.opts.kappa_soc * theta_soc_old) {
+                            break;
+                        }
+                        theta_soc_old = theta_trial;
+                        for i in 0..self.m {
+                            self.c_soc[i] = a_soc * self.c_soc[i] + self.c_t[i];
+                        }
                         if !self.solve_direction(shared, self.mu, true) {
                             break;
                         }
-                        let a_soc = self.max_step_primal(&self.dw_s, self.tau);
+                        a_soc = self.max_step_primal(&self.dw_s, self.tau);
                         for j in 0..self.nw {
                             self.w_t[j] = self.w[j] + a_soc * self.dw_s[j];
                         }
-                        ls += 1;
                         if !self.eval_trial_fc() {
                             break;
                         }
                         let th = one_norm(&self.c_t);
                         let ph = self.barrier(&self.w_t, self.f_t, self.mu);
-                        if let Some(ftype) = self.is_acceptable(alpha, theta, phi, gpd, th, ph) {
+                        if self.is_acceptable(alpha, theta, phi, gpd, th, ph) {
                             for i in 0..self.m {
                                 self.y_t[i] = self.y[i] + a_soc * self.dy_s[i];
                             }
                             if self.eval_trial_derivs() {
-                                if !ftype {
-                                    self.filter.add(
-                                        (1.0 - self.opts.gamma_theta) * theta,
-                                        phi - self.opts.gamma_phi * theta,
-                                    );
-                                }
+                                let ftype =
+                                    self.update_filter_after_step(alpha, theta, phi, gpd, ph);
                                 let alpha_du =
                                     self.max_step_dual(&self.dzl_s, &self.dzu_s, self.tau);
                                 self.take_dual_step(alpha_du, true);
@@ -1469,14 +1501,7 @@ impl<'p> Core<'p> {
                             }
                             break;
                         }
-                        if th > self.opts.kappa_soc * theta_soc_old {
-                            break;
-                        }
-                        theta_soc_old = theta_t_soc.min(th);
-                        theta_t_soc = th;
-                        for i in 0..self.m {
-                            self.c_soc[i] = a_soc * self.c_soc[i] + self.c_t[i];
-                        }
+                        theta_trial = th;
                     }
                 }
             }
@@ -1529,7 +1554,7 @@ impl<'p> Core<'p> {
     // ------------------------------------------------------------------ records
 
     fn record(
-        &self,
+        &mut self,
         shared: &mut Shared,
         d_norm: f64,
         alpha_du: f64,
@@ -1538,16 +1563,24 @@ impl<'p> Core<'p> {
         ls: usize,
         dual: f64,
     ) {
-        let primal_u = self
-            .c
-            .iter()
-            .zip(&self.g_scale)
-            .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s));
+        // In restoration, the objective and inf_pr columns are the original problem's at
+        // the current x and s (IPOPT's RestoIterationOutput); inf_du and lg(mu) are the
+        // restoration problem's.
+        let (objective, inf_pr) = match self.nlp.original_measures(&self.w) {
+            Some(v) => v,
+            None => (
+                self.f / self.obj_scale,
+                self.c
+                    .iter()
+                    .zip(&self.g_scale)
+                    .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s)),
+            ),
+        };
         shared.stats.records.push(IterationRecord {
             iter: shared.iter,
             restoration: self.setup_in_resto,
-            objective: self.f / self.obj_scale,
-            inf_pr: primal_u,
+            objective,
+            inf_pr,
             inf_du: dual,
             mu: self.mu,
             d_norm,
@@ -1618,7 +1651,10 @@ impl<'p> Core<'p> {
             return self.outcome(Status::InvalidNumberDetected, msg, false);
         }
         let (_, eu) = self.errors(0.0, false);
-        self.record(shared, 0.0, 0.0, 0.0, ' ', 0, eu[0]);
+        match self.resto_start.take() {
+            Some((a_pr, ls)) => self.record(shared, 0.0, 0.0, a_pr, 'R', ls, eu[0]),
+            None => self.record(shared, 0.0, 0.0, 0.0, ' ', 0, eu[0]),
+        }
         let mut pending_resto = self.opts.start_with_resto && !self.setup_in_resto;
         let max_resto_iter_end = shared.iter + self.opts.max_resto_iter;
         loop {
@@ -1717,7 +1753,11 @@ impl<'p> Core<'p> {
                         }
                         continue;
                     }
+                    // The restoration phase's first row reports the failed line search
+                    // (IPOPT: "12r", alpha_pr 'R', and its ls count, one more than the
+                    // trial steps).
                     shared.iter -= 1;
+                    self.resto_start = Some((a_pr, ls + 1));
                 } else if self.setup_in_resto {
                     return self.outcome(
                         Status::ErrorInStepComputation,
@@ -1755,6 +1795,9 @@ impl<'p> Core<'p> {
                 );
             }
             self.resto_calls += 1;
+            // The restoration phase's first row takes the next iteration number (IPOPT's
+            // count: the iteration whose line search failed is that row).
+            shared.iter += 1;
             // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9).
             let theta = one_norm(&self.c);
             let phi = self.barrier(&self.w, self.f, self.mu);
@@ -1843,6 +1886,11 @@ impl<'p> Core<'p> {
     /// Current Hessian regularisation and δ_w bookkeeping accessors.
     pub fn theta_max(&self) -> f64 {
         self.theta_max
+    }
+
+    /// Objective scale factor (for the unscaled objective).
+    pub fn obj_scale(&self) -> f64 {
+        self.obj_scale
     }
 
     /// Constraint scale factors (for unscaled violations).

@@ -21,6 +21,14 @@ pub(crate) trait IpmProblem: NumericNlp {
     /// Writes the point `x` (this problem's variables) and multipliers `y` (this
     /// problem's rows) in the user's spaces, for the iteration callback.
     fn user_point(&self, x: &[f64], y: &[f64], x_user: &mut [f64], lambda_user: &mut [f64]);
+
+    /// For the iteration log of a restoration phase: the original problem's unscaled
+    /// objective and unscaled constraint violation (max-norm) at the inner iterate `w`,
+    /// which IPOPT prints in the objective and inf_pr columns of the 'r' rows. `None`
+    /// (the default): not a restoration problem.
+    fn original_measures(&mut self, _w: &[f64]) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// Evaluation counters and time spent in user callbacks.

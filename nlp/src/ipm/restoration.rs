@@ -55,6 +55,9 @@ struct Resto<'a> {
     theta_max: f64,
     gbuf: Vec<f64>,
     wbuf: Vec<f64>,
+    // unscaling of the outer problem, for the iteration log
+    obj_scale: f64,
+    g_scale: Vec<f64>,
 }
 
 impl NumericNlp for Resto<'_> {
@@ -140,6 +143,25 @@ impl IpmProblem for Resto<'_> {
     /// The x part of `[x, p, n]`; the restoration rows are the outer problem's rows.
     fn user_point(&self, x: &[f64], y: &[f64], x_user: &mut [f64], lambda_user: &mut [f64]) {
         self.outer.user_point(&x[..self.n], y, x_user, lambda_user);
+    }
+
+    fn original_measures(&mut self, w: &[f64]) -> Option<(f64, f64)> {
+        let (n, m) = (self.n, self.m);
+        let x = &w[..n];
+        let s = &w[n + 2 * m..];
+        let f = self.outer.eval_f(x) / self.obj_scale;
+        self.outer.eval_g(x, &mut self.gbuf);
+        let mut viol: f64 = 0.0;
+        for i in 0..m {
+            let k = self.slack_of_row[i];
+            let c = if k == usize::MAX {
+                self.gbuf[i] - self.g_eq[i]
+            } else {
+                self.gbuf[i] - s[k]
+            };
+            viol = viol.max(c.abs() / self.g_scale[i]);
+        }
+        Some((f, viol))
     }
 
     fn restoration_accepts(&mut self, w: &[f64]) -> bool {
@@ -328,6 +350,8 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         theta_max,
         gbuf: vec![0.0; m],
         wbuf: vec![0.0; n + ni],
+        obj_scale: core.obj_scale(),
+        g_scale: core.g_scale().to_vec(),
         outer: &mut *core.nlp,
     };
     let mut resto = resto;
@@ -357,6 +381,9 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
                 })
             }
         };
+        // IPOPT's first 'r' row reports the failed line search of the outer iteration
+        // (alpha_pr, 'R', ls).
+        inner.resto_start = core.resto_start.take();
         inner.run(
             shared,
             Start::Exact {
