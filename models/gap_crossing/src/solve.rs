@@ -7,11 +7,13 @@
 //!   exactly in every candidate, and the plan is the best of:
 //!   1. the crawl schedule, solved as above (so the free gait is never worse than it);
 //!   2. the biped-pair schedule FR, FL, BR, BL ([`gait::PAIR_ORDER`]), solved from the
-//!      same heuristic with that order;
+//!      same heuristic with that order, on a second thread alongside 1;
 //!   3. the schedule search ([`crate::schedule_search`]) from the better of 1 and 2:
 //!      adjacent swaps of the schedule whose exact per-stance evaluation lowers the
 //!      cost, each round re-solved with every variable free from the improved plan,
 //!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
+//!
+//!   With the SQP back end, 2 and 3 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::convergence::ResidualProbe;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
@@ -38,6 +40,12 @@ pub const SEARCH_MU_INIT: f64 = 1e-6;
 /// Bound push (absolute and relative, variables and slacks) of the schedule search's
 /// re-solves (default 1e-2, which moves a foot on a keep-out edge by 2 cm).
 pub const SEARCH_BOUND_PUSH: f64 = 1e-8;
+
+/// Iteration budget of the SQP back end on the free gait's solves other than the crawl
+/// schedule (biped-pair schedule, schedule-search re-solves); past it a candidate counts
+/// as failed and the planner keeps what it has (the crawl-schedule plan at worst). The
+/// IPM needs 117 and 20–80 iterations for them and is not capped.
+pub const SQP_CANDIDATE_MAX_ITER: usize = 150;
 
 /// Which back end solves the problem.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -71,6 +79,16 @@ impl Settings {
     /// close to a local minimum (the schedule search's): the interior-point method
     /// starts with a small barrier parameter and hardly pushes the point off its bounds,
     /// as IPOPT users do for warm starts ([`SEARCH_MU_INIT`], [`SEARCH_BOUND_PUSH`]).
+    /// The settings of the free gait's solves other than the crawl schedule: with the
+    /// SQP back end, at most [`SQP_CANDIDATE_MAX_ITER`] iterations.
+    fn candidate(&self) -> Settings {
+        let mut c = self.clone();
+        if c.backend == Backend::Sqp {
+            c.sqp.max_iter = c.sqp.max_iter.min(SQP_CANDIDATE_MAX_ITER);
+        }
+        c
+    }
+
     fn warm(&self) -> Settings {
         let mut w = self.clone();
         w.ipm.mu_init = SEARCH_MU_INIT;
@@ -329,6 +347,7 @@ fn free_gait(
     // The two starting schedules are independent: solved on two threads.
     let crawl = gait::crawl_schedule(s.n_step);
     let pair = gait::pair_schedule(s.n_step);
+    let candidate = settings.candidate();
     let (crawl_run, pair_run) = rayon::join(
         || {
             let guess = gait::crawl(s);
@@ -349,7 +368,7 @@ fn free_gait(
                 terrain,
                 &pair,
                 &guess,
-                settings,
+                &candidate,
                 "free gait: biped-pair schedule",
             )
         },
@@ -362,7 +381,7 @@ fn free_gait(
     if !best.solution.status.is_success() {
         return Ok(best);
     }
-    let search_settings = settings.warm();
+    let search_settings = candidate.warm();
     let mut stance_solver = StanceSolver::new(s, terrain)?;
     for round in 1..=SEARCH_ROUNDS {
         let current = Plan::from_flat(s, &best.flat)?;
