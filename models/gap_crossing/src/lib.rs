@@ -23,6 +23,7 @@ pub mod model;
 pub mod plan;
 pub mod render;
 pub mod scenario;
+pub mod schedule_search;
 pub mod solve;
 pub mod sweep;
 

@@ -185,47 +185,12 @@ pub fn build(
         forces.push([f0?, f1?, f2?, f3?]);
     }
 
-    let m_total = s.masses.total();
-    let gravity = constant3([0.0, 0.0, -s.gravity]);
     for k in 0..n {
         let label = k + 1;
-        let [rb, rf] = &coms[k];
-        // (2) static centroidal balance: forces and moments about the whole-body CoM.
-        let total_force = forces[k].iter().fold(&gravity * m_total, |acc, f| acc + f);
-        pb.subject_to_named(
-            &format!("(2) force balance, stance {label}"),
-            total_force.eq(0.0),
-        )?;
-        let r_w = (rb * s.masses.b + rf * s.masses.f) * (1.0 / m_total);
-        let mut moment = Matrix::zeros(3, 1);
-        for i in Foot::ALL {
-            let arm = &feet[k][i.index()] - &r_w;
-            moment = moment + arm.cross(&forces[k][i.index()]).expect("3-vectors");
-        }
-        pb.subject_to_named(
-            &format!("(2) moment balance, stance {label}"),
-            moment.eq(0.0),
-        )?;
-
+        force_balance(&mut pb, s, label, &coms[k], &feet[k], &forces[k])?;
         for i in Foot::ALL {
             let r = &feet[k][i.index()];
-            let f = &forces[k][i.index()];
-            let [hx, hy] = terrain.gradient(r[0], r[1]);
-            // (4) friction cone with n = (−h_x, −h_y, 1)/‖·‖: F·n ≥ F_thr and
-            // ‖F_t‖ ≤ μ F·n with F_t = F − (F·n)n, written in the convex smoothed form
-            // √(‖F‖² − (F·n)² + ε²) ≤ μ F·n (conservative by at most ε, see CONE_SMOOTHING).
-            let n_raw = vec3(&[-hx, -hy, Expr::one()]);
-            let n_norm = n_raw.sumsqr().sqrt();
-            let f_n = f.dot(&n_raw).expect("3-vectors") / n_norm;
-            pb.subject_to_named(
-                &format!("(4) normal force {}, stance {label}", i.name()),
-                f_n.ge(s.friction.f_thr),
-            )?;
-            let tangential = (f.sumsqr() - f_n.sq() + CONE_SMOOTHING * CONE_SMOOTHING).sqrt();
-            pb.subject_to_named(
-                &format!("(4) friction cone {}, stance {label}", i.name()),
-                (tangential - s.friction.mu * f_n).le(0.0),
-            )?;
+            friction_cone(&mut pb, s, terrain, label, i, r, &forces[k][i.index()])?;
             if k == 0 || !moved[k][i.index()] {
                 continue;
             }
@@ -265,15 +230,7 @@ pub fn build(
                 nlp::bounded(bounds.min, d2, bounds.max),
             )?;
         }
-        // (11) rigid legs.
-        for i in Foot::ALL {
-            let com = if i.biped() == Biped::B { rb } else { rf };
-            let d2 = (com - foot(i)).sumsqr();
-            pb.subject_to_named(
-                &format!("(11) leg {}, stance {label}", i.name()),
-                d2.eq(s.leg_length_sq),
-            )?;
-        }
+        rigid_legs(&mut pb, s, label, &coms[k], &feet[k])?;
     }
 
     // (10) in lifted form, free gait only.
@@ -309,12 +266,7 @@ pub fn build(
     // (1) cost.
     let mut terms = Vec::new();
     for k in 0..n {
-        for (j, goal) in [(0, s.goal.b), (1, s.goal.f)] {
-            terms.push(s.weights.com * (&coms[k][j] - &constant3(goal)).sumsqr());
-        }
-        for f in &forces[k] {
-            terms.push(s.weights.force * f.sumsqr());
-        }
+        stance_cost(s, &coms[k], &forces[k], &mut terms);
     }
     let mut cost: Expr = terms.into_iter().sum();
     let has_penalty = !complementarity.is_empty();
@@ -343,6 +295,131 @@ pub fn build(
         step_lengths,
         has_penalty,
     })
+}
+
+/// The terms of cost (1) for one stance: w_CoM Σ_j ‖r_j − goal_j‖² + w_F Σ_i ‖F_i‖².
+fn stance_cost(s: &Scenario, coms: &[Matrix; 2], forces: &[Matrix; 4], terms: &mut Vec<Expr>) {
+    for (j, goal) in [(0, s.goal.b), (1, s.goal.f)] {
+        terms.push(s.weights.com * (&coms[j] - &constant3(goal)).sumsqr());
+    }
+    for f in forces {
+        terms.push(s.weights.force * f.sumsqr());
+    }
+}
+
+/// (2) static centroidal balance of one stance: forces and moments about the whole-body
+/// CoM.
+fn force_balance(
+    pb: &mut Problem,
+    s: &Scenario,
+    label: usize,
+    coms: &[Matrix; 2],
+    feet: &[Matrix; 4],
+    forces: &[Matrix; 4],
+) -> Result<(), BuildError> {
+    let m_total = s.masses.total();
+    let gravity = constant3([0.0, 0.0, -s.gravity]);
+    let [rb, rf] = coms;
+    let total_force = forces.iter().fold(&gravity * m_total, |acc, f| acc + f);
+    pb.subject_to_named(
+        &format!("(2) force balance, stance {label}"),
+        total_force.eq(0.0),
+    )?;
+    let r_w = (rb * s.masses.b + rf * s.masses.f) * (1.0 / m_total);
+    let mut moment = Matrix::zeros(3, 1);
+    for i in Foot::ALL {
+        let arm = &feet[i.index()] - &r_w;
+        moment = moment + arm.cross(&forces[i.index()]).expect("3-vectors");
+    }
+    pb.subject_to_named(
+        &format!("(2) moment balance, stance {label}"),
+        moment.eq(0.0),
+    )
+}
+
+/// (4) friction cone of foot `i` at `r` with force `f`, with n = (−h_x, −h_y, 1)/‖·‖:
+/// F·n ≥ F_thr and ‖F_t‖ ≤ μ F·n with F_t = F − (F·n)n, written in the convex smoothed
+/// form √(‖F‖² − (F·n)² + ε²) ≤ μ F·n (conservative by at most ε, see CONE_SMOOTHING).
+fn friction_cone(
+    pb: &mut Problem,
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    label: usize,
+    i: Foot,
+    r: &Matrix,
+    f: &Matrix,
+) -> Result<(), BuildError> {
+    let [hx, hy] = terrain.gradient(r[0], r[1]);
+    let n_raw = vec3(&[-hx, -hy, Expr::one()]);
+    let n_norm = n_raw.sumsqr().sqrt();
+    let f_n = f.dot(&n_raw).expect("3-vectors") / n_norm;
+    pb.subject_to_named(
+        &format!("(4) normal force {}, stance {label}", i.name()),
+        f_n.ge(s.friction.f_thr),
+    )?;
+    let tangential = (f.sumsqr() - f_n.sq() + CONE_SMOOTHING * CONE_SMOOTHING).sqrt();
+    pb.subject_to_named(
+        &format!("(4) friction cone {}, stance {label}", i.name()),
+        (tangential - s.friction.mu * f_n).le(0.0),
+    )
+}
+
+/// (11) rigid legs of one stance.
+fn rigid_legs(
+    pb: &mut Problem,
+    s: &Scenario,
+    label: usize,
+    coms: &[Matrix; 2],
+    feet: &[Matrix; 4],
+) -> Result<(), BuildError> {
+    for i in Foot::ALL {
+        let com = if i.biped() == Biped::B {
+            &coms[0]
+        } else {
+            &coms[1]
+        };
+        let d2 = (com - &feet[i.index()]).sumsqr();
+        pb.subject_to_named(
+            &format!("(11) leg {}, stance {label}", i.name()),
+            d2.eq(s.leg_length_sq),
+        )?;
+    }
+    Ok(())
+}
+
+/// Name of the parameter holding the feet of the [`build_stance`] problem: 12 numbers,
+/// BR, BL, FR, FL (x, y, z each).
+pub const STANCE_FEET: &str = "stance feet";
+
+/// One stance with its feet given: the CoMs and forces that minimise the stance's terms
+/// of (1) subject to (2), (4) and (11), with the four footholds a parameter named
+/// [`STANCE_FEET`]. Variables: r_B, r_F, then F_BR, F_BL, F_FR, F_FL (18). The feet's own
+/// equations ((3), (5)–(9), the keep-out) are not in it: they involve only the footholds.
+pub fn build_stance(s: &Scenario, terrain: &dyn Terrain) -> Result<Problem, BuildError> {
+    let mut pb = Problem::new();
+    let label = 0;
+    let p = pb.parameter(STANCE_FEET, 12);
+    pb.set_value(&p, &[0.0; 12])?;
+    let feet: [Matrix; 4] = std::array::from_fn(|c| vec3(&p[3 * c..3 * c + 3]));
+    let coms = Biped::ALL.map(|j| pb.variable(&format!("r_{}", j.name()), 3));
+    let forces = Foot::ALL.map(|i| pb.variable(&format!("F_{}", i.name()), 3));
+    force_balance(&mut pb, s, label, &coms, &feet, &forces)?;
+    for i in Foot::ALL {
+        friction_cone(
+            &mut pb,
+            s,
+            terrain,
+            label,
+            i,
+            &feet[i.index()],
+            &forces[i.index()],
+        )?;
+    }
+    rigid_legs(&mut pb, s, label, &coms, &feet)?;
+    let mut terms = Vec::new();
+    stance_cost(s, &coms, &forces, &mut terms);
+    pb.minimize(terms.into_iter().sum());
+    Ok(pb)
 }
 
 #[cfg(test)]

@@ -2,23 +2,24 @@
 //!
 //! - `crawl` gait: one solve of the scheduled problem (order BR, FR, BL, FL), from the
 //!   crawl-gait heuristic.
-//! - `free` gait: every returned plan satisfies (10) exactly (non-moving feet share
-//!   variables), and is the better of two candidates:
-//!   1. the crawl schedule, solved as above;
-//!   2. the schedule chosen by the optimiser: the lifted complementarity problem
-//!      ([`Formulation::Complementarity`]) is solved from candidate 1 with the exact
-//!      penalty `π` ([`PENALTIES`], raised until `Σ_{i<j} s_i s_j` ≤
-//!      [`COMPLEMENTARITY_TOL`]); the foot that moves most at each transition gives a
-//!      schedule, which is solved exactly from a consistent warm start
-//!      ([`scheduled_guess`]) unless it is the crawl schedule again.
+//! - `free` gait: the optimiser picks which foot moves at each transition, (10). Every
+//!   solve is of a scheduled problem (non-moving feet share variables), so (10) holds
+//!   exactly in every candidate, and the plan is the best of:
+//!   1. the crawl schedule, solved as above (so the free gait is never worse than it);
+//!   2. the biped-pair schedule FR, FL, BR, BL ([`gait::PAIR_ORDER`]), solved from the
+//!      same heuristic with that order, on a second thread alongside 1;
+//!   3. the schedule search ([`crate::schedule_search`]) from the better of 1 and 2:
+//!      adjacent swaps of the schedule whose exact per-stance evaluation lowers the
+//!      cost, each round re-solved with every variable free from the improved plan,
+//!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
 //!
-//!   So the free gait is never worse than the crawl gait, and its complementarity is
-//!   exact rather than approximate.
+//!   With the SQP back end, 2 and 3 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::convergence::ResidualProbe;
 use crate::gait;
-use crate::model::{self, Formulation, ModelError, PENALTY};
+use crate::model::{self, Formulation, ModelError};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
 use crate::scenario::{Foot, Gait, Scenario};
+use crate::schedule_search::{self, StanceSolver};
 use crate::terrain::{GapTerrain, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
@@ -28,21 +29,26 @@ use nlp::{
 use std::ops::ControlFlow;
 use std::time::Instant;
 
-/// Complementarity residual below which the free gait's first phase stops raising `π`.
-pub const COMPLEMENTARITY_TOL: f64 = 1e-10;
+/// Largest number of schedule-search rounds (each: evaluate every adjacent swap, then
+/// one solve of the improved schedule) of the free gait.
+pub const SEARCH_ROUNDS: usize = 4;
 
-/// Penalty values tried in turn by the free gait's complementarity phase. Starting from
-/// the (complementary) crawl solution, one large value keeps the iterates near
-/// complementary points; small values let several feet move at once, and raising `π`
-/// afterwards did not recover a better complementary plan in our runs.
-pub const PENALTIES: [f64; 1] = [1e8];
+/// Initial barrier parameter of the schedule search's re-solves (default 0.1): on the
+/// lateral-goal test scenario, 161 iterations over its rounds instead of 238, same plans.
+pub const SEARCH_MU_INIT: f64 = 1e-6;
 
-/// Iteration budget of the SQP back end on the step-choosing (penalised) run. That run
-/// does not converge with the SQP (3000 iterations, ≈ 9 min at n_step 60, see
-/// docs/gap-crossing.md); past this budget the planner keeps the crawl-schedule plan, as
-/// it does whenever the step-choosing run fails. The IPM solves it in about 140
-/// iterations and is not capped.
-pub const SQP_CHOOSE_MAX_ITER: usize = 300;
+/// Bound push (absolute and relative, variables and slacks) of the schedule search's
+/// re-solves (default 1e-2, which moves a foot on a keep-out edge by 2 cm).
+pub const SEARCH_BOUND_PUSH: f64 = 1e-8;
+
+/// Iteration budget of the SQP back end on the free gait's solves other than the crawl
+/// schedule (biped-pair schedule, schedule-search re-solves); past it a candidate counts
+/// as failed and the planner keeps what it has (the crawl-schedule plan at worst). The
+/// SQP did not converge on either in our runs (the pair schedule ran past 9 min
+/// uncapped; with 150 iterations each the default free gait took 140 s against 87 s for
+/// the previous pipeline, same load). The IPM needs 117 and 17–80 iterations for them
+/// and is not capped.
+pub const SQP_CANDIDATE_MAX_ITER: usize = 100;
 
 /// Which back end solves the problem.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -70,6 +76,30 @@ impl Settings {
     pub fn set_print_level(&mut self, level: u8) {
         self.ipm.print_level = level;
         self.sqp.print_level = level;
+    }
+
+    /// The settings of a re-solve that starts from a plan satisfying every equation,
+    /// close to a local minimum (the schedule search's): the interior-point method
+    /// starts with a small barrier parameter and hardly pushes the point off its bounds,
+    /// as IPOPT users do for warm starts ([`SEARCH_MU_INIT`], [`SEARCH_BOUND_PUSH`]).
+    /// The settings of the free gait's solves other than the crawl schedule: with the
+    /// SQP back end, at most [`SQP_CANDIDATE_MAX_ITER`] iterations.
+    fn candidate(&self) -> Settings {
+        let mut c = self.clone();
+        if c.backend == Backend::Sqp {
+            c.sqp.max_iter = c.sqp.max_iter.min(SQP_CANDIDATE_MAX_ITER);
+        }
+        c
+    }
+
+    fn warm(&self) -> Settings {
+        let mut w = self.clone();
+        w.ipm.mu_init = SEARCH_MU_INIT;
+        w.ipm.bound_push = SEARCH_BOUND_PUSH;
+        w.ipm.bound_frac = SEARCH_BOUND_PUSH;
+        w.ipm.slack_bound_push = SEARCH_BOUND_PUSH;
+        w.ipm.slack_bound_frac = SEARCH_BOUND_PUSH;
+        w
     }
 
     fn print_level(&self) -> u8 {
@@ -158,157 +188,108 @@ fn step_sq(x: &[f64], k: usize, i: Foot) -> f64 {
     (0..3).map(|d| (x[b + d] - x[a + d]).powi(2)).sum()
 }
 
-/// (10) residual under which the complementarity phase's point warm-starts the exact
-/// phase as it is.
-pub const NEARLY_COMPLEMENTARY: f64 = 1e-4;
-
-/// Squared move (m²) below which a transition counts as "no foot moves" when reading a
-/// schedule off a plan: 1e-6 m², a millimetre.
-pub const NEGLIGIBLE_MOVE_SQ: f64 = 1e-6;
-
-/// The foot that moves most at each transition of a flat plan; where no foot moves more
-/// than [`NEGLIGIBLE_MOVE_SQ`], the `fallback` schedule's foot (any foot would do).
-pub fn schedule_of(s: &Scenario, x: &[f64], fallback: &[Foot]) -> Vec<Foot> {
-    (1..s.n_step)
-        .map(|k| {
-            let (foot, moved) = Foot::ALL
-                .into_iter()
-                .map(|i| (i, step_sq(x, k, i)))
-                .max_by(|a, b| a.1.total_cmp(&b.1))
-                .unwrap_or((Foot::BR, 0.0));
-            if moved > NEGLIGIBLE_MOVE_SQ {
-                foot
-            } else {
-                fallback[k - 1]
-            }
-        })
-        .collect()
-}
-
-/// A warm start for the scheduled problem with `schedule` built from a free-gait plan
-/// `flat`: at each transition only the scheduled foot moves, toward where `flat` has it,
-/// at most [`gait::CRAWL_MAX_MOVE`] in x–y, never into a keep-out zone, on the terrain;
-/// CoMs and forces are rebuilt to fit ([`gait::plan_for_footholds`]).
-pub fn scheduled_guess(
-    s: &Scenario,
-    terrain: &dyn Terrain,
-    flat: &[f64],
-    schedule: &[Foot],
-) -> Vec<f64> {
-    let mut feet = s.start.feet;
-    let mut footholds = vec![feet];
-    for (t, &i) in schedule.iter().enumerate() {
-        let k = t + 1;
-        let cur = feet.get(i);
-        let o = foot_offset(k, i);
-        let (dx, dy) = (flat[o] - cur[0], flat[o + 1] - cur[1]);
-        let dist = dx.hypot(dy);
-        let scale = if dist > gait::CRAWL_MAX_MOVE {
-            gait::CRAWL_MAX_MOVE / dist
-        } else {
-            1.0
-        };
-        let mut x = cur[0] + dx * scale;
-        let y = cur[1] + dy * scale;
-        for (lo, hi) in terrain.keep_out() {
-            if x > lo && x < hi {
-                // Stay on the side the foot comes from.
-                x = if cur[0] <= lo {
-                    lo - gait::GAP_CLEARANCE
-                } else {
-                    hi + gait::GAP_CLEARANCE
-                };
-            }
-        }
-        *feet.get_mut(i) = [x, y, terrain.height_at(x, y)];
-        footholds.push(feet);
-    }
-    gait::plan_for_footholds(s, &footholds).to_flat()
-}
-
-#[derive(Clone)]
+/// A solved candidate of the plan.
 struct Run {
     solution: Solution,
     flat: Vec<f64>,
+    schedule: Vec<Foot>,
     /// Index of its [`Phase`].
     phase: usize,
 }
 
+impl Run {
+    /// Whether this run succeeded with a lower objective than `other` (or `other` failed).
+    fn beats(&self, other: &Run) -> bool {
+        self.solution.status.is_success()
+            && (!other.solution.status.is_success()
+                || self.solution.objective < other.solution.objective)
+    }
+}
+
+/// One scheduled solve, not yet recorded: what [`solve_scheduled`] returns, so that
+/// independent solves can run on separate threads and be logged in a fixed order.
+struct Solved {
+    name: String,
+    run: Run,
+    phase: Phase,
+}
+
+/// Solves the scheduled problem with `schedule` from `guess` (which also fixes the sides
+/// of the keep-out zones, see [`model::build`]). Prints nothing: the solver's log is
+/// printed by [`record`], from the iteration records.
+fn solve_scheduled(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    schedule: &[Foot],
+    guess: &[f64],
+    settings: &Settings,
+    name: &str,
+) -> Result<Solved, PlanningError> {
+    let formulation = Formulation::Scheduled(schedule.to_vec());
+    let model = model::build(s, terrain, &formulation, guess)?;
+    let mut compiled = model.problem.compile()?;
+    let mut probe = ResidualProbe::new(s, &model)?;
+    let mut residuals = Vec::new();
+    let mut quiet = settings.clone();
+    quiet.set_print_level(0);
+    let solution = quiet.solve(&mut compiled, |v| {
+        residuals.push(probe.at(v.x()));
+        ControlFlow::Continue(())
+    })?;
+    let flat = model.problem.evaluate(&model.layout, &solution.x)?;
+    let phase = Phase {
+        name: name.to_string(),
+        status: solution.status,
+        iterations: solution.stats.iterations,
+        records: solution.stats.records.clone(),
+        residuals,
+        scheduled: true,
+        complementarity: complementarity_residual(s, &flat),
+    };
+    Ok(Solved {
+        name: name.to_string(),
+        run: Run {
+            solution,
+            flat,
+            schedule: schedule.to_vec(),
+            phase: 0,
+        },
+        phase,
+    })
+}
+
+/// Appends a solve's [`Phase`] and prints its log (at the settings' print level: the
+/// iteration table from 5, the summary from 3).
+fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
+    let level = settings.print_level();
+    if level > 0 {
+        println!("\n== {}", solved.name);
+    }
+    if level >= 5 {
+        print!("{}", nlp::log::format_table(&solved.phase.records));
+    }
+    if level >= 3 {
+        print!("{}", nlp::log::format_summary(&solved.run.solution));
+    }
+    phases.push(solved.phase);
+    Run {
+        phase: phases.len() - 1,
+        ..solved.run
+    }
+}
+
+/// [`solve_scheduled`] then [`record`].
 fn run(
     s: &Scenario,
     terrain: &dyn Terrain,
-    formulation: &Formulation,
+    schedule: &[Foot],
     guess: &[f64],
     settings: &Settings,
     phases: &mut Vec<Phase>,
     name: &str,
 ) -> Result<Run, PlanningError> {
-    if settings.print_level() > 0 {
-        println!("\n== {name}");
-    }
-    let model = model::build(s, terrain, formulation, guess)?;
-    let mut compiled = model.problem.compile()?;
-    let mut probe = ResidualProbe::new(s, &model)?;
-    let mut settings = settings.clone();
-    if model.has_penalty && settings.backend == Backend::Sqp {
-        settings.sqp.max_iter = settings.sqp.max_iter.min(SQP_CHOOSE_MAX_ITER);
-    }
-    let penalties: &[f64] = if model.has_penalty {
-        &PENALTIES
-    } else {
-        &[0.0]
-    };
-    let mut last: Option<Run> = None;
-    let mut best: Option<Run> = None;
-    for &penalty in penalties {
-        if model.has_penalty {
-            compiled.set_parameter(PENALTY, &[penalty])?;
-        }
-        if let Some(prev) = &last {
-            compiled.set_initial_point(&prev.solution.x)?;
-        }
-        let mut residuals = Vec::new();
-        let solution = settings.solve(&mut compiled, |v| {
-            residuals.push(probe.at(v.x()));
-            ControlFlow::Continue(())
-        })?;
-        let flat = model.problem.evaluate(&model.layout, &solution.x)?;
-        let complementarity = complementarity_residual(s, &flat);
-        phases.push(Phase {
-            name: if model.has_penalty {
-                format!("{name}, penalty {penalty:e}")
-            } else {
-                name.to_string()
-            },
-            status: solution.status,
-            iterations: solution.stats.iterations,
-            records: solution.stats.records.clone(),
-            residuals,
-            scheduled: matches!(formulation, Formulation::Scheduled(_)),
-            complementarity,
-        });
-        let success = solution.status.is_success();
-        let done = !success || complementarity <= COMPLEMENTARITY_TOL;
-        let this = Run {
-            solution,
-            flat,
-            phase: phases.len() - 1,
-        };
-        // Keep the successful run with the lowest objective: a larger penalty can only
-        // make the choice of steps more conservative.
-        if success
-            && best
-                .as_ref()
-                .is_none_or(|b| this.solution.objective < b.solution.objective)
-        {
-            best = Some(this.clone());
-        }
-        last = Some(this);
-        if done {
-            break;
-        }
-    }
-    Ok(best.or(last).expect("at least one penalty is tried"))
+    let solved = solve_scheduled(s, terrain, schedule, guess, settings, name)?;
+    Ok(record(solved, settings, phases))
 }
 
 /// Plans scenario `s` (its `gait` field chooses the formulation) on the spec's gap terrain.
@@ -319,70 +300,24 @@ pub fn plan(s: &Scenario, settings: &Settings) -> Result<Outcome, PlanningError>
 /// Plans scenario `s` on any terrain.
 pub fn plan_on(
     s: &Scenario,
-    terrain: &dyn Terrain,
+    terrain: &(dyn Terrain + Sync),
     settings: &Settings,
 ) -> Result<Outcome, PlanningError> {
     let started = Instant::now();
     let mut phases = Vec::new();
+    let crawl = gait::crawl_schedule(s.n_step);
     let guess = gait::crawl(s);
     let last = match s.gait {
-        Gait::Crawl => {
-            let f = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
-            run(s, terrain, &f, &guess, settings, &mut phases, "crawl gait")?
-        }
-        Gait::Free => {
-            // Two exact candidates, the better one wins: the crawl schedule, and the
-            // schedule chosen by the lifted complementarity problem.
-            let crawl = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
-
-            let crawl_run = run(
-                s,
-                terrain,
-                &crawl,
-                &guess,
-                settings,
-                &mut phases,
-                "free gait: crawl schedule",
-            )?;
-            let choice = run(
-                s,
-                terrain,
-                &Formulation::Complementarity,
-                &crawl_run.flat,
-                settings,
-                &mut phases,
-                "free gait: choose the steps",
-            )?;
-            let mut best = crawl_run;
-            let crawl_schedule = gait::crawl_schedule(s.n_step);
-            let schedule = schedule_of(s, &choice.flat, &crawl_schedule);
-            if choice.solution.status.is_success() && schedule != crawl_schedule {
-                // A nearly complementary point (non-moving feet displaced by ≲ 1e-2 m) is
-                // already a good start; otherwise rebuild a consistent one.
-                let nearly = complementarity_residual(s, &choice.flat) <= NEARLY_COMPLEMENTARY;
-                let warm = if nearly {
-                    choice.flat.clone()
-                } else {
-                    scheduled_guess(s, terrain, &choice.flat, &schedule)
-                };
-                let exact = run(
-                    s,
-                    terrain,
-                    &Formulation::Scheduled(schedule),
-                    &warm,
-                    settings,
-                    &mut phases,
-                    "free gait: exact steps",
-                )?;
-                let better = exact.solution.status.is_success()
-                    && (!best.solution.status.is_success()
-                        || exact.solution.objective < best.solution.objective);
-                if better {
-                    best = exact;
-                }
-            }
-            best
-        }
+        Gait::Crawl => run(
+            s,
+            terrain,
+            &crawl,
+            &guess,
+            settings,
+            &mut phases,
+            "crawl gait",
+        )?,
+        Gait::Free => free_gait(s, terrain, settings, &mut phases)?,
     };
     let plan = Plan::from_flat(s, &last.flat)?;
     let solver = SolverInfo {
@@ -402,6 +337,83 @@ pub fn plan_on(
         phases,
         chosen: last.phase,
     })
+}
+
+/// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
+/// schedule and the schedule search from the better of the two.
+fn free_gait(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    settings: &Settings,
+    phases: &mut Vec<Phase>,
+) -> Result<Run, PlanningError> {
+    // The two starting schedules are independent: solved on two threads.
+    let crawl = gait::crawl_schedule(s.n_step);
+    let pair = gait::pair_schedule(s.n_step);
+    let candidate = settings.candidate();
+    let (crawl_run, pair_run) = rayon::join(
+        || {
+            let guess = gait::crawl(s);
+            solve_scheduled(
+                s,
+                terrain,
+                &crawl,
+                &guess,
+                settings,
+                "free gait: crawl schedule",
+            )
+        },
+        || {
+            let footholds = gait::footholds_for_schedule(s, &pair);
+            let guess = gait::plan_for_footholds(s, &footholds).to_flat();
+            solve_scheduled(
+                s,
+                terrain,
+                &pair,
+                &guess,
+                &candidate,
+                "free gait: biped-pair schedule",
+            )
+        },
+    );
+    let mut best = record(crawl_run?, settings, phases);
+    let pair_run = record(pair_run?, settings, phases);
+    if pair_run.beats(&best) {
+        best = pair_run;
+    }
+    if !best.solution.status.is_success() {
+        return Ok(best);
+    }
+    // Schedule search from the better plan: each round's proposal satisfies every
+    // equation of its schedule with a lower cost; the re-solve frees every variable.
+    let search_settings = candidate.warm();
+    let mut stance_solver = StanceSolver::new(s, terrain)?;
+    for round in 1..=SEARCH_ROUNDS {
+        let current = Plan::from_flat(s, &best.flat)?;
+        let Some(proposal) =
+            schedule_search::propose(s, &mut stance_solver, &current, &best.schedule)
+        else {
+            break;
+        };
+        let next = run(
+            s,
+            terrain,
+            &proposal.schedule,
+            &proposal.plan.to_flat(),
+            &search_settings,
+            phases,
+            &format!(
+                "free gait: schedule search {round} ({} swap{})",
+                proposal.swaps,
+                if proposal.swaps == 1 { "" } else { "s" }
+            ),
+        )?;
+        if !next.beats(&best) {
+            break;
+        }
+        best = next;
+    }
+    Ok(best)
 }
 
 /// The status word written to the solution file (`solved` for success).

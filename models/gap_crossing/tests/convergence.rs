@@ -26,12 +26,15 @@ fn free_gait_history_has_every_iteration_and_the_checkers_residual() {
     let out = solve::plan(&s, &Settings::default()).unwrap();
     let report = check::check(&out.file);
     assert!(report.ok(), "{report}");
-    // The three runs of the free gait: crawl schedule, complementarity, exact steps.
-    assert_eq!(
-        out.phases.len(),
-        3,
-        "{:?}",
-        out.phases.iter().map(|p| &p.name)
+    // The runs of the free gait: crawl schedule, biped-pair schedule, then the schedule
+    // search's rounds (one on the default scenario).
+    let names: Vec<&str> = out.phases.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+    assert_eq!(names[0], "free gait: crawl schedule");
+    assert_eq!(names[1], "free gait: biped-pair schedule");
+    assert!(
+        names[2].starts_with("free gait: schedule search 1"),
+        "{names:?}"
     );
     let history = Convergence::from_phases(&out.phases);
     assert_eq!(history.phases.len(), 3);
