@@ -53,14 +53,6 @@ const KNOWN_FAILURES: &[(&str, Status, &str)] = &[
         Status::MaximumIterationsExceeded,
         "badly scaled, stalls with individual merit weights",
     ),
-    // Reaches f* = 97.5875 (violation 1e-13) but stops at the acceptable level: dual
-    // error 2.7e-7 after 365 iterations; the merit's rounding allowance (which lets the
-    // gap-crossing planner finish) also accepts its noise-level steps.
-    (
-        "hs116",
-        Status::SolvedToAcceptableLevel,
-        "f* reached, dual error stalls at 3e-7",
-    ),
 ];
 
 /// Problems observed with two outcomes between runs of the same binary: the listed

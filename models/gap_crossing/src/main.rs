@@ -1,4 +1,4 @@
-//! `gap_crossing`: the quadruped gap-crossing planner's command line.
+//! `gap-crossing`: the quadruped gap-crossing planner's command line.
 //!
 //! Exit codes: 0 success; 1 `solve` found no valid plan, `check` found violations, or
 //! some `sweep` point was not solved and checked; 2 any error (bad arguments, bad files,
@@ -20,7 +20,7 @@ use std::process::ExitCode;
 ///
 /// With no subcommand, `solve` runs with its defaults (the spec's default scenario).
 #[derive(Parser, Debug)]
-#[command(name = "gap_crossing", version, args_conflicts_with_subcommands = true)]
+#[command(name = "gap-crossing", version, args_conflicts_with_subcommands = true)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -63,9 +63,20 @@ struct SolveArgs {
     /// Output directory.
     #[arg(long, value_name = "DIR", default_value = "out")]
     out: PathBuf,
+    #[command(flatten)]
+    solver: SolverArgs,
+}
+
+/// Back end and its options, shared by `solve` and `sweep`.
+#[derive(Args, Debug, Default)]
+struct SolverArgs {
     /// Solver: interior point (`ipm`) or SQP (`sqp`).
     #[arg(long, value_enum)]
     solver: Option<SolverArg>,
+    /// Set an option of the chosen back end by its name in `IpmOptions` / `SqpOptions`
+    /// (IPOPT-style), e.g. `--opt tol=1e-10 --opt max_iter=500 --opt print_level=0`.
+    #[arg(long = "opt", value_name = "KEY=VALUE")]
+    opt: Vec<String>,
 }
 
 #[derive(Args, Debug)]
@@ -103,6 +114,8 @@ struct SweepArgs {
     /// Also write each point's solution file as DIR/points/NNNN.json (solved or not).
     #[arg(long)]
     solutions: bool,
+    #[command(flatten)]
+    solver: SolverArgs,
 }
 
 #[derive(Args, Debug)]
@@ -166,6 +179,8 @@ enum CliError {
     Grid(#[from] GridError),
     #[error("cannot start {0} worker threads: {1}")]
     Threads(usize, String),
+    #[error("{0}")]
+    Opt(String),
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
@@ -192,8 +207,104 @@ fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
     Ok(s)
 }
 
-fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
-    let s = scenario(&a.scenario)?;
+/// Sets `--opt KEY=VALUE` options on `options` through its serde form: serialise, set
+/// the key, deserialise (so every option has the name and type of its struct field), then
+/// validate. The value is read as the field's current JSON type: a number, `true`/`false`,
+/// or a string (the enum options, e.g. `mu_strategy=adaptive`).
+fn apply_opts<T, V>(
+    options: &mut T,
+    opts: &[String],
+    backend: &str,
+    validate: V,
+) -> Result<(), CliError>
+where
+    T: serde::Serialize + serde::de::DeserializeOwned,
+    V: Fn(&T) -> Result<(), nlp::SolveError>,
+{
+    use serde_json::Value;
+    if opts.is_empty() {
+        return Ok(());
+    }
+    let mut v = serde_json::to_value(&*options)
+        .map_err(|e| CliError::Opt(format!("cannot serialise the {backend} options: {e}")))?;
+    let map = v
+        .as_object_mut()
+        .ok_or_else(|| CliError::Opt(format!("the {backend} options are not a map")))?;
+    let valid = || {
+        let mut keys: Vec<&str> = map.keys().map(String::as_str).collect();
+        keys.sort_unstable();
+        keys.join(", ")
+    };
+    let mut parsed = Vec::new();
+    for kv in opts {
+        let Some((key, value)) = kv.split_once('=') else {
+            return Err(CliError::Opt(format!("--opt {kv:?}: expected KEY=VALUE")));
+        };
+        let (key, value) = (key.trim(), value.trim());
+        let Some(old) = map.get(key) else {
+            return Err(CliError::Opt(format!(
+                "--opt {key}: unknown {backend} option; valid keys: {}",
+                valid()
+            )));
+        };
+        let new = match old {
+            Value::Bool(_) => match value {
+                "true" | "yes" => Some(Value::Bool(true)),
+                "false" | "no" => Some(Value::Bool(false)),
+                _ => None,
+            },
+            Value::Number(_) => {
+                if let Ok(u) = value.parse::<u64>() {
+                    Some(Value::from(u))
+                } else if let Ok(i) = value.parse::<i64>() {
+                    Some(Value::from(i))
+                } else {
+                    value
+                        .parse::<f64>()
+                        .ok()
+                        .and_then(serde_json::Number::from_f64)
+                        .map(Value::Number)
+                }
+            }
+            Value::String(_) => Some(Value::String(value.to_string())),
+            _ => serde_json::from_str(value).ok(),
+        };
+        let Some(new) = new else {
+            return Err(CliError::Opt(format!(
+                "--opt {key}={value}: bad value, expected {} (default {old})",
+                match old {
+                    Value::Bool(_) => "true or false",
+                    Value::Number(_) => "a number",
+                    _ => "a value",
+                }
+            )));
+        };
+        parsed.push((key.to_string(), value.to_string(), new));
+    }
+    for (key, _, new) in &parsed {
+        map.insert(key.clone(), new.clone());
+    }
+    // Deserialise once per key first, so a bad value names its key.
+    for (key, value, new) in &parsed {
+        let mut one = serde_json::to_value(&*options).unwrap_or_default();
+        if let Some(m) = one.as_object_mut() {
+            m.insert(key.clone(), new.clone());
+        }
+        if let Err(e) = serde_json::from_value::<T>(one) {
+            return Err(CliError::Opt(format!(
+                "--opt {key}={value}: bad value: {e}"
+            )));
+        }
+    }
+    let new: T = serde_json::from_value(v)
+        .map_err(|e| CliError::Opt(format!("--opt: bad {backend} options: {e}")))?;
+    validate(&new).map_err(|e| CliError::Opt(format!("--opt: {e}")))?;
+    *options = new;
+    Ok(())
+}
+
+/// The back end chosen by `--solver` with its `--opt` options applied.
+fn settings(a: &SolverArgs, print_level: u8) -> Result<Settings, CliError> {
     let mut settings = Settings {
         backend: match a.solver {
             None | Some(SolverArg::Ipm) => Backend::Ipm,
@@ -201,7 +312,17 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
         },
         ..Settings::default()
     };
-    settings.set_print_level(5);
+    settings.set_print_level(print_level);
+    match settings.backend {
+        Backend::Ipm => apply_opts(&mut settings.ipm, &a.opt, "ipm", |o| o.validate())?,
+        Backend::Sqp => apply_opts(&mut settings.sqp, &a.opt, "sqp", |o| o.validate())?,
+    }
+    Ok(settings)
+}
+
+fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
+    let s = scenario(&a.scenario)?;
+    let settings = settings(&a.solver, 5)?;
     let outcome = solve::plan(&s, &settings)?;
     let file = &outcome.file;
     let report = check::check(file);
@@ -289,6 +410,9 @@ fn foot_moves(p: &gap_crossing::plan::Plan) -> String {
 
 fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
     let grid = Grid::load(&a.grid)?;
+    // Points run in parallel: no iteration logs (`print_level` is ignored here).
+    let mut settings = settings(&a.solver, 0)?;
+    settings.set_print_level(0);
     let threads = a.threads.unwrap_or_else(rayon::current_num_threads).max(1);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -335,7 +459,7 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         }
         bar.inc(1);
     };
-    let results = pool.install(|| sweep::run(&grid, &Settings::default(), &done));
+    let results = pool.install(|| sweep::run(&grid, &settings, &done));
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
     for e in save_errors.into_inner().unwrap_or_default() {

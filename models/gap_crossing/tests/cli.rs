@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_gap_crossing");
+const BIN: &str = env!("CARGO_BIN_EXE_gap-crossing");
 
 fn run(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().expect("binary runs")
@@ -360,4 +360,131 @@ fn guess_then_check_then_render() {
     let out = run(&["check", s.join("guess.json").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out.stdout).contains("goal"));
+}
+
+/// `--opt KEY=VALUE` sets an option of the chosen back end by its serde name.
+#[test]
+fn solve_opt_sets_backend_options() {
+    let d = tmp("opt");
+    let out_dir = d.join("out");
+    let solve = |opts: &[&str]| {
+        let mut args = vec![
+            "solve",
+            "--gait",
+            "crawl",
+            "--set",
+            "n_step=6",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(opts);
+        run(&args)
+    };
+    // Valid: print_level=0 silences the iteration table; tol is a float, max_iter an
+    // integer; the plan is still solved.
+    let out = solve(&[
+        "--opt",
+        "print_level=0",
+        "--opt",
+        "tol=1e-9",
+        "--opt",
+        "max_iter=500",
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+    assert!(stdout.contains("status:     solved"), "{stdout}");
+    assert!(!stdout.contains("objective    inf_pr"), "{stdout}");
+    // The option really reaches the solver: one iteration is not enough.
+    let out = solve(&["--opt", "max_iter=1", "--opt", "print_level=0"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stderr).contains("maximum_iterations_exceeded"),
+        "{}",
+        text(&out.stderr)
+    );
+    // Enum options by their serde (kebab-case) value; SQP options with --solver sqp.
+    let out = solve(&["--opt", "mu_strategy=adaptive", "--opt", "print_level=0"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let out = solve(&[
+        "--solver",
+        "sqp",
+        "--opt",
+        "second_order_correction=false",
+        "--opt",
+        "print_level=0",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+
+    // Unknown key: exit 2, the key named, the valid keys listed.
+    let out = solve(&["--opt", "toll=1e-9"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("toll") && err.contains("valid keys") && err.contains("max_iter"),
+        "{err}"
+    );
+    // An IPM-only option with the SQP back end is unknown there.
+    let out = solve(&["--solver", "sqp", "--opt", "mu_strategy=adaptive"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("mu_strategy"));
+
+    // Bad values: exit 2 naming the key.
+    for (opt, key) in [
+        ("max_iter=many", "max_iter"),
+        ("max_iter=1.5", "max_iter"),
+        ("print_level=300", "print_level"),
+        ("tol=-1", "tol"),
+        ("mu_strategy=fast", "mu_strategy"),
+        ("tol", "tol"),
+    ] {
+        let out = solve(&["--opt", opt]);
+        assert_eq!(out.status.code(), Some(2), "{opt}");
+        let err = text(&out.stderr);
+        assert!(err.contains(key), "{opt}: {err}");
+    }
+    let out = solve(&["--solver", "sqp", "--opt", "individual_penalties=maybe"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("individual_penalties"));
+}
+
+#[test]
+fn sweep_takes_solver_options() {
+    let d = tmp("sweep_opt");
+    let grid = write(
+        &d,
+        "grid.json",
+        &serde_json::json!({ "base": { "n_step": 6, "gait": "crawl" }, "axes": {} }),
+    );
+    let out_dir = d.join("out");
+    let sweep = |opts: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            "--grid",
+            &grid,
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--threads",
+            "1",
+        ];
+        args.extend_from_slice(opts);
+        run(&args)
+    };
+    let out = sweep(&["--opt", "max_iter=1"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("maximum_iterations_exceeded"),
+        "{}",
+        text(&out.stdout)
+    );
+    let out = sweep(&["--solver", "sqp", "--opt", "max_iter=200"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    let out = sweep(&["--opt", "bogus=1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("bogus"));
 }

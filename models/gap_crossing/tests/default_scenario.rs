@@ -9,7 +9,7 @@ use std::process::Command;
 fn default_scenario_solves_and_checks() {
     let dir = std::env::temp_dir().join(format!("gap_crossing_default_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let out = Command::new(env!("CARGO_BIN_EXE_gap_crossing"))
+    let out = Command::new(env!("CARGO_BIN_EXE_gap-crossing"))
         .args(["solve", "--out", dir.to_str().unwrap()])
         .output()
         .unwrap();
@@ -21,7 +21,7 @@ fn default_scenario_solves_and_checks() {
         String::from_utf8_lossy(&out.stderr)
     );
     let path = dir.join("solution.json");
-    let check = Command::new(env!("CARGO_BIN_EXE_gap_crossing"))
+    let check = Command::new(env!("CARGO_BIN_EXE_gap-crossing"))
         .args(["check", path.to_str().unwrap()])
         .output()
         .unwrap();

@@ -7,7 +7,7 @@ use std::process::Command;
 
 fn solve(solver: &str, dir: &Path) -> SolutionFile {
     let _ = std::fs::remove_dir_all(dir);
-    let out = Command::new(env!("CARGO_BIN_EXE_gap_crossing"))
+    let out = Command::new(env!("CARGO_BIN_EXE_gap-crossing"))
         .args([
             "solve",
             "--solver",
@@ -28,7 +28,7 @@ fn solve(solver: &str, dir: &Path) -> SolutionFile {
         String::from_utf8_lossy(&out.stderr)
     );
     let path = dir.join("solution.json");
-    let check = Command::new(env!("CARGO_BIN_EXE_gap_crossing"))
+    let check = Command::new(env!("CARGO_BIN_EXE_gap-crossing"))
         .args(["check", path.to_str().unwrap()])
         .output()
         .unwrap();

@@ -12,6 +12,9 @@
 //!    cones. It is always feasible. When e ≠ 0 (linearisation inconsistent, "elastic
 //!    mode"), ρ grows by `penalty_increase` and the QP is solved again, up to
 //!    `penalty_max`; past that the step minimises the linearised ℓ1 infeasibility.
+//!    Without elastic variables or cones in use, clarabel's solution is then *polished*
+//!    ([`polish`], option `qp_polish`): the equality QP on its active set, solved exactly
+//!    with the faer LDLᵀ, replaces it when that is a KKT point of the QP.
 //! 3. **Line search** on the merit φ(x) = f(x) + Σ w_i·viol_i(x) (individual weights
 //!    w_i ∈ [|λ_i|, ρ], Powell 1978; w_i = ρ is the classical ℓ1 merit) with Armijo's test
 //!    φ(x + αd) ≤ φ(x) − η·α·pred, where pred = m(0) − m(d) ≥ 0 is the decrease of the
@@ -31,6 +34,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod options;
+mod polish;
 pub(crate) mod qp;
 
 use std::ops::ControlFlow;
@@ -543,6 +547,7 @@ impl Sqp {
         let mut n_fact = 0usize;
         let mut ls_failures = 0usize;
         let mut extra_shift = 0.0f64;
+        let mut n_polished = 0usize;
         loop {
             // ---- convergence test ----
             let err = kkt_errors(
@@ -749,6 +754,33 @@ impl Sqp {
                 break;
             };
             delta = qp_shift;
+            // ---- polish: the exact solution of the equality QP on clarabel's active set
+            // (see polish.rs; not with cones or elastic variables in use) ----
+            let polish_data = polish::PolishData {
+                x: &x,
+                x_l: &geo.x_l,
+                x_u: &geo.x_u,
+                g: &g,
+                g_l: &geo.g_l,
+                g_u: &geo.g_u,
+                grad: &grad,
+                jp: &jp,
+                jv: &jv,
+                hp: &hp,
+                hv: &hv,
+                shift: qp_shift,
+                row_weight: &row_weight,
+                bound_weight: &bound_weight,
+            };
+            let can_polish = o.qp_polish && !dense && n_cone == 0;
+            let res = polished(
+                kkt.as_mut().filter(|_| can_polish),
+                o,
+                &polish_data,
+                res,
+                &mut n_fact,
+                &mut n_polished,
+            );
             let elastic = res.e.iter().any(|v| *v > o.elastic_tol);
             // ---- merit weights ----
             // Powell (1978): w_i = max(|λ_i|, ½(w_i + |λ_i|)) with the QP's multipliers,
@@ -993,8 +1025,33 @@ impl Sqp {
         );
         if o.print_level >= 3 {
             print!("{}", crate::log::format_summary(&sol));
+            println!("Polished QP solutions: {n_polished} of {n_qp}");
         }
         Ok(sol)
+    }
+}
+
+/// The QP result `res` polished ([`polish::polish`]) when a KKT matrix is given and no
+/// elastic variable is in use; `res` itself otherwise or when polishing is rejected.
+fn polished(
+    kkt: Option<&mut Kkt>,
+    o: &SqpOptions,
+    data: &polish::PolishData,
+    res: QpResult,
+    n_fact: &mut usize,
+    n_polished: &mut usize,
+) -> QpResult {
+    match kkt {
+        Some(kkt) if res.e.iter().all(|v| *v <= o.elastic_tol) => {
+            match polish::polish(kkt, data, &res, n_fact) {
+                Some(p) => {
+                    *n_polished += 1;
+                    p
+                }
+                None => res,
+            }
+        }
+        _ => res,
     }
 }
 

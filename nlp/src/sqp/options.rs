@@ -100,6 +100,12 @@ pub struct SqpOptions {
     /// An elastic variable above this value means the linearised constraint could not be
     /// satisfied (elastic mode). Default 1e-8.
     pub elastic_tol: f64,
+    /// Polish each QP step: solve the equality QP on clarabel's active set exactly with
+    /// the faer LDLᵀ and keep it when it is a KKT point of the QP (not with cones or
+    /// elastic variables in use). Clarabel's own accuracy is relative to its scaled
+    /// problem; on reduced Hessians with curvatures far apart its step error stalled the
+    /// SQP (docs/performance.md, "SQP on the flagship"). Default true.
+    pub qp_polish: bool,
     /// Print level: 0 silent, ≥ 5 iteration table, ≥ 3 summary. Default 0.
     pub print_level: u8,
 }
@@ -138,6 +144,7 @@ impl Default for SqpOptions {
             qp_tol: 1e-10,
             qp_max_iter: 200,
             elastic_tol: 1e-8,
+            qp_polish: true,
             print_level: 0,
         }
     }
