@@ -9,6 +9,7 @@ pub mod kkt;
 pub mod log;
 pub mod mpcc;
 pub mod numeric;
+pub mod option_names;
 pub mod options;
 pub mod problem;
 pub mod scaling;
@@ -28,6 +29,7 @@ pub use mpcc::{
     MpccSolution,
 };
 pub use numeric::{AffineCone, NumericNlp};
+pub use option_names::{NamedOptions, OptionError};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
 pub use solution::{IterationRecord, Solution, Stats, Status};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};

@@ -13,6 +13,7 @@ use gap_crossing::render;
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
 use gap_crossing::sweep::{self, Grid, GridError, PointResult};
+use nlp::NamedOptions;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -207,102 +208,6 @@ fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
     Ok(s)
 }
 
-/// Sets `--opt KEY=VALUE` options on `options` through its serde form: serialise, set
-/// the key, deserialise (so every option has the name and type of its struct field), then
-/// validate. The value is read as the field's current JSON type: a number, `true`/`false`,
-/// or a string (the enum options, e.g. `mu_strategy=adaptive`).
-fn apply_opts<T, V>(
-    options: &mut T,
-    opts: &[String],
-    backend: &str,
-    validate: V,
-) -> Result<(), CliError>
-where
-    T: serde::Serialize + serde::de::DeserializeOwned,
-    V: Fn(&T) -> Result<(), nlp::SolveError>,
-{
-    use serde_json::Value;
-    if opts.is_empty() {
-        return Ok(());
-    }
-    let mut v = serde_json::to_value(&*options)
-        .map_err(|e| CliError::Opt(format!("cannot serialise the {backend} options: {e}")))?;
-    let map = v
-        .as_object_mut()
-        .ok_or_else(|| CliError::Opt(format!("the {backend} options are not a map")))?;
-    let valid = || {
-        let mut keys: Vec<&str> = map.keys().map(String::as_str).collect();
-        keys.sort_unstable();
-        keys.join(", ")
-    };
-    let mut parsed = Vec::new();
-    for kv in opts {
-        let Some((key, value)) = kv.split_once('=') else {
-            return Err(CliError::Opt(format!("--opt {kv:?}: expected KEY=VALUE")));
-        };
-        let (key, value) = (key.trim(), value.trim());
-        let Some(old) = map.get(key) else {
-            return Err(CliError::Opt(format!(
-                "--opt {key}: unknown {backend} option; valid keys: {}",
-                valid()
-            )));
-        };
-        let new = match old {
-            Value::Bool(_) => match value {
-                "true" | "yes" => Some(Value::Bool(true)),
-                "false" | "no" => Some(Value::Bool(false)),
-                _ => None,
-            },
-            Value::Number(_) => {
-                if let Ok(u) = value.parse::<u64>() {
-                    Some(Value::from(u))
-                } else if let Ok(i) = value.parse::<i64>() {
-                    Some(Value::from(i))
-                } else {
-                    value
-                        .parse::<f64>()
-                        .ok()
-                        .and_then(serde_json::Number::from_f64)
-                        .map(Value::Number)
-                }
-            }
-            Value::String(_) => Some(Value::String(value.to_string())),
-            _ => serde_json::from_str(value).ok(),
-        };
-        let Some(new) = new else {
-            return Err(CliError::Opt(format!(
-                "--opt {key}={value}: bad value, expected {} (default {old})",
-                match old {
-                    Value::Bool(_) => "true or false",
-                    Value::Number(_) => "a number",
-                    _ => "a value",
-                }
-            )));
-        };
-        parsed.push((key.to_string(), value.to_string(), new));
-    }
-    for (key, _, new) in &parsed {
-        map.insert(key.clone(), new.clone());
-    }
-    // Deserialise once per key first, so a bad value names its key.
-    for (key, value, new) in &parsed {
-        let mut one = serde_json::to_value(&*options).unwrap_or_default();
-        if let Some(m) = one.as_object_mut() {
-            m.insert(key.clone(), new.clone());
-        }
-        if let Err(e) = serde_json::from_value::<T>(one) {
-            return Err(CliError::Opt(format!(
-                "--opt {key}={value}: bad value: {e}"
-            )));
-        }
-    }
-    let new: T = serde_json::from_value(v)
-        .map_err(|e| CliError::Opt(format!("--opt: bad {backend} options: {e}")))?;
-    validate(&new).map_err(|e| CliError::Opt(format!("--opt: {e}")))?;
-    *options = new;
-    Ok(())
-}
-
 /// The back end chosen by `--solver` with its `--opt` options applied.
 fn settings(a: &SolverArgs, print_level: u8) -> Result<Settings, CliError> {
     let mut settings = Settings {
@@ -314,9 +219,10 @@ fn settings(a: &SolverArgs, print_level: u8) -> Result<Settings, CliError> {
     };
     settings.set_print_level(print_level);
     match settings.backend {
-        Backend::Ipm => apply_opts(&mut settings.ipm, &a.opt, "ipm", |o| o.validate())?,
-        Backend::Sqp => apply_opts(&mut settings.sqp, &a.opt, "sqp", |o| o.validate())?,
+        Backend::Ipm => settings.ipm.set_by_name(&a.opt),
+        Backend::Sqp => settings.sqp.set_by_name(&a.opt),
     }
+    .map_err(|e| CliError::Opt(format!("--opt: {e}")))?;
     Ok(settings)
 }
 

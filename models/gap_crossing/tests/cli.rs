@@ -420,7 +420,7 @@ fn solve_opt_sets_backend_options() {
     assert_eq!(out.status.code(), Some(2));
     let err = text(&out.stderr);
     assert!(
-        err.contains("toll") && err.contains("valid keys") && err.contains("max_iter"),
+        err.contains("toll") && err.contains("valid options") && err.contains("max_iter"),
         "{err}"
     );
     // An IPM-only option with the SQP back end is unknown there.

@@ -1,0 +1,61 @@
+//! Options set by name from text (`NamedOptions::set_by_name`), both back ends.
+use nlp::{IpmOptions, MuStrategy, NamedOptions, OptionError, SqpOptions};
+
+#[test]
+fn sets_numbers_integers_booleans_and_enums() {
+    let mut o = IpmOptions::default();
+    o.set_by_name(&[
+        "tol=1e-10",
+        "max_iter = 42",
+        "mu_strategy=adaptive",
+        "start_with_resto=true",
+    ])
+    .unwrap();
+    assert_eq!(o.tol, 1e-10);
+    assert_eq!(o.max_iter, 42);
+    assert_eq!(o.mu_strategy, MuStrategy::Adaptive);
+    assert!(o.start_with_resto);
+    let mut s = SqpOptions::default();
+    s.set_by_name(&["max_iter=7"]).unwrap();
+    assert_eq!(s.max_iter, 7);
+}
+
+#[test]
+fn errors_name_the_option_and_leave_the_options_unchanged() {
+    let mut o = IpmOptions::default();
+    let before = o.clone();
+    type Expect = fn(&OptionError) -> bool;
+    let cases: [(&str, Expect); 6] = [
+        (
+            "toll=1",
+            |e| matches!(e, OptionError::Unknown { key, valid } if key == "toll" && valid.contains("max_iter")),
+        ),
+        ("tol", |e| matches!(e, OptionError::Syntax(a) if a == "tol")),
+        (
+            "max_iter=many",
+            |e| matches!(e, OptionError::BadValue { key, .. } if key == "max_iter"),
+        ),
+        (
+            "max_iter=1.5",
+            |e| matches!(e, OptionError::BadValue { key, .. } if key == "max_iter"),
+        ),
+        (
+            "mu_strategy=fast",
+            |e| matches!(e, OptionError::BadValue { key, .. } if key == "mu_strategy"),
+        ),
+        ("tol=-1", |e| {
+            matches!(e, OptionError::Invalid(_)) && e.to_string().contains("tol")
+        }),
+    ];
+    for (assignment, expected) in cases {
+        // The bad assignment comes after a good one: neither is applied.
+        let err = o.set_by_name(&["max_iter=5", assignment]).unwrap_err();
+        assert!(expected(&err), "{assignment}: {err}");
+        assert_eq!(o, before, "{assignment} changed the options");
+    }
+    // An option of the other back end is unknown here.
+    let err = SqpOptions::default()
+        .set_by_name(&["mu_strategy=adaptive"])
+        .unwrap_err();
+    assert!(matches!(err, OptionError::Unknown { .. }), "{err}");
+}
