@@ -139,6 +139,16 @@ impl NumericNlp for Resto<'_> {
     }
 }
 
+impl Resto<'_> {
+    /// Residual of the outer problem's row `i` (its value in `gbuf`) with slacks `s`.
+    fn outer_residual(&self, i: usize, s: &[f64]) -> f64 {
+        match self.slack_of_row[i] {
+            usize::MAX => self.gbuf[i] - self.g_eq[i],
+            k => self.gbuf[i] - s[k],
+        }
+    }
+}
+
 impl IpmProblem for Resto<'_> {
     /// The x part of `[x, p, n]`; the restoration rows are the outer problem's rows.
     fn user_point(&self, x: &[f64], y: &[f64], x_user: &mut [f64], lambda_user: &mut [f64]) {
@@ -153,13 +163,7 @@ impl IpmProblem for Resto<'_> {
         self.outer.eval_g(x, &mut self.gbuf);
         let mut viol: f64 = 0.0;
         for i in 0..m {
-            let k = self.slack_of_row[i];
-            let c = if k == usize::MAX {
-                self.gbuf[i] - self.g_eq[i]
-            } else {
-                self.gbuf[i] - s[k]
-            };
-            viol = viol.max(c.abs() / self.g_scale[i]);
+            viol = viol.max(self.outer_residual(i, s).abs() / self.g_scale[i]);
         }
         Some((f, viol))
     }
@@ -174,14 +178,9 @@ impl IpmProblem for Resto<'_> {
         }
         let (mut theta, mut inf_pr) = (0.0, 0.0f64);
         for i in 0..m {
-            let k = self.slack_of_row[i];
-            let c = if k == usize::MAX {
-                self.gbuf[i] - self.g_eq[i]
-            } else {
-                self.gbuf[i] - s[k]
-            };
-            theta += c.abs();
-            inf_pr = inf_pr.max(c.abs());
+            let c = self.outer_residual(i, s).abs();
+            theta += c;
+            inf_pr = inf_pr.max(c);
         }
         if inf_pr > self.inf_pr_target || theta > self.theta_max {
             return false;
