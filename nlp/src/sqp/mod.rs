@@ -672,7 +672,8 @@ impl Sqp {
             let mut qp_shift = delta;
             let mut tries = 0;
             let mut elastic_prev: Option<(QpResult, f64, f64)> = None;
-            let res: Option<QpResult> = loop {
+            // The accepted QP's result and the data it was solved with (for polishing).
+            let res: Option<(QpResult, QpData)> = loop {
                 let data = QpData {
                     x: &x,
                     x_l: &geo.x_l,
@@ -737,7 +738,7 @@ impl Sqp {
                         if e_sum > 0.9 * prev_sum {
                             let (prev, _, prev_rho) = elastic_prev.take().expect("checked");
                             rho = prev_rho;
-                            break Some(prev);
+                            break Some((prev, data));
                         }
                     }
                     if rho < o.penalty_max && tries < 12 {
@@ -746,37 +747,21 @@ impl Sqp {
                         continue;
                     }
                 }
-                break Some(res);
+                break Some((res, data));
             };
             factor_seconds += t_fact.elapsed().as_secs_f64();
-            let Some(res) = res else {
+            let Some((res, data)) = res else {
                 status = Status::ErrorInStepComputation;
                 break;
             };
             delta = qp_shift;
             // ---- polish: the exact solution of the equality QP on clarabel's active set
             // (see polish.rs; not with cones or elastic variables in use) ----
-            let polish_data = polish::PolishData {
-                x: &x,
-                x_l: &geo.x_l,
-                x_u: &geo.x_u,
-                g: &g,
-                g_l: &geo.g_l,
-                g_u: &geo.g_u,
-                grad: &grad,
-                jp: &jp,
-                jv: &jv,
-                hp: &hp,
-                hv: &hv,
-                shift: qp_shift,
-                row_weight: &row_weight,
-                bound_weight: &bound_weight,
-            };
             let can_polish = o.qp_polish && !dense && n_cone == 0;
             let res = polished(
                 kkt.as_mut().filter(|_| can_polish),
                 o,
-                &polish_data,
+                (&data, &jp, &hp),
                 res,
                 &mut n_fact,
                 &mut n_polished,
@@ -1036,14 +1021,18 @@ impl Sqp {
 fn polished(
     kkt: Option<&mut Kkt>,
     o: &SqpOptions,
-    data: &polish::PolishData,
+    (data, jp, hp): (
+        &QpData,
+        &SymbolicSparseColMat<usize>,
+        &SymbolicSparseColMat<usize>,
+    ),
     res: QpResult,
     n_fact: &mut usize,
     n_polished: &mut usize,
 ) -> QpResult {
     match kkt {
         Some(kkt) if res.e.iter().all(|v| *v <= o.elastic_tol) => {
-            match polish::polish(kkt, data, &res, n_fact) {
+            match polish::polish(kkt, data, jp, hp, &res, n_fact) {
                 Some(p) => {
                     *n_polished += 1;
                     p

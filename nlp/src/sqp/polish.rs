@@ -22,29 +22,8 @@
 
 use faer::sparse::SymbolicSparseColMat;
 
-use super::qp::QpResult;
+use super::qp::{QpData, QpResult};
 use crate::kkt::Kkt;
-
-/// The data of one QP (scaled problem) at the iterate x.
-#[derive(Clone, Copy)]
-pub(crate) struct PolishData<'a> {
-    pub x: &'a [f64],
-    pub x_l: &'a [f64],
-    pub x_u: &'a [f64],
-    pub g: &'a [f64],
-    pub g_l: &'a [f64],
-    pub g_u: &'a [f64],
-    pub grad: &'a [f64],
-    pub jp: &'a SymbolicSparseColMat<usize>,
-    pub jv: &'a [f64],
-    pub hp: &'a SymbolicSparseColMat<usize>,
-    pub hv: &'a [f64],
-    /// Shift δ of B.
-    pub shift: f64,
-    /// ρ_a on the rows / bounds of the augmented term (0 elsewhere).
-    pub row_weight: &'a [f64],
-    pub bound_weight: &'a [f64],
-}
 
 /// Side of a row or bound in the working set.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -56,10 +35,13 @@ enum Side {
 }
 
 /// The polished QP result, or `None` when clarabel's active set does not give a KKT point
-/// of the QP (then clarabel's solution stands). Counts one factorisation in `n_fact`.
+/// of the QP (then clarabel's solution stands). `jp`, `hp` are the patterns of
+/// `p.jac` and `p.hess`. Counts one factorisation in `n_fact`.
 pub(crate) fn polish(
     kkt: &mut Kkt,
-    p: &PolishData,
+    p: &QpData,
+    jp: &SymbolicSparseColMat<usize>,
+    hp: &SymbolicSparseColMat<usize>,
     res: &QpResult,
     n_fact: &mut usize,
 ) -> Option<QpResult> {
@@ -70,8 +52,8 @@ pub(crate) fn polish(
     // J d and the linearised rows of clarabel's step.
     let mut jd = vec![0.0; m];
     for c in 0..n {
-        for q in p.jp.col_range(c) {
-            jd[p.jp.row_idx()[q]] += p.jv[q] * res.d[c];
+        for q in jp.col_range(c) {
+            jd[jp.row_idx()[q]] += p.jac[q] * res.d[c];
         }
     }
     // ---- working set from clarabel's solution: active when the multiplier exceeds the
@@ -111,7 +93,7 @@ pub(crate) fn polish(
         }
     }
     // ---- the equality QP on W ----
-    let hmax = p.hv.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+    let hmax = p.hess.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let big = 1e14 * hmax;
     let target = |j: usize| match var_side[j] {
         Side::Lower => p.x_l[j] - p.x[j],
@@ -126,7 +108,7 @@ pub(crate) fn polish(
         .map(|i| if row_side[i] == Side::Free { 1e20 } else { REG })
         .collect();
     *n_fact += 1;
-    match kkt.factorize(p.hv, &dx, p.jv, &dc) {
+    match kkt.factorize(p.hess, &dx, p.jac, &dc) {
         Ok(inertia) if inertia.positive == n && inertia.negative == m => {}
         _ => return None,
     }
@@ -178,15 +160,15 @@ pub(crate) fn polish(
     let mut s = p.grad.to_vec();
     for c in 0..n {
         s[c] += (p.shift + p.bound_weight[c]) * d[c];
-        for q in p.hp.col_range(c) {
-            let r = p.hp.row_idx()[q];
-            s[r] += p.hv[q] * d[c];
+        for q in hp.col_range(c) {
+            let r = hp.row_idx()[q];
+            s[r] += p.hess[q] * d[c];
             if r != c {
-                s[c] += p.hv[q] * d[r];
+                s[c] += p.hess[q] * d[r];
             }
         }
-        for q in p.jp.col_range(c) {
-            s[c] += p.jv[q] * lambda[p.jp.row_idx()[q]];
+        for q in jp.col_range(c) {
+            s[c] += p.jac[q] * lambda[jp.row_idx()[q]];
         }
     }
     let mut z_l = vec![0.0; n];
@@ -228,8 +210,8 @@ pub(crate) fn polish(
     let tol = |b: f64| 1e-9 * (1.0 + b.abs());
     let mut jd = vec![0.0; m];
     for c in 0..n {
-        for q in p.jp.col_range(c) {
-            jd[p.jp.row_idx()[q]] += p.jv[q] * d[c];
+        for q in jp.col_range(c) {
+            jd[jp.row_idx()[q]] += p.jac[q] * d[c];
         }
     }
     for i in 0..m {
