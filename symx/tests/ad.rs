@@ -1,7 +1,7 @@
 //! Automatic differentiation: forward (JVP), reverse (VJP), gradient, Jacobian, Hessian and
 //! Lagrangian Hessian agree with each other, with the compiled evaluation and with central
 //! finite differences on random expression trees; `if_else` derivatives never pick up NaN
-//! from the untaken branch (CasADi #1805). The 10⁶-node chain is in tests/symx_chain.rs.
+//! from the untaken branch (CasADi #1805). The 10⁶-node chain is in symx/tests/symx_chain.rs.
 //!
 //! Tolerances. Finite differences use the central formula with step `h = 1e-5·max(1,|xⱼ|)`:
 //! truncation error `h²|f'''|/6 ≈ 2·10⁻¹¹|f'''|` plus rounding `ε|f|/h ≈ 2·10⁻¹¹|f|`, so for
