@@ -18,9 +18,9 @@ pub fn solve(
     options: IpmOptions,
 ) -> Result<(Solution, usize), Box<dyn std::error::Error>> {
     let mut opti = Problem::new();
-    let x = opti.variable_matrix("X", 2, n + 1); // state trajectory: position, speed
-    let u = opti.variable("U", n); // control trajectory (throttle)
-    let t = opti.scalar_variable("T"); // final time
+    let x = opti.variable_matrix("X", 2, n + 1)?; // state trajectory: position, speed
+    let u = opti.variable("U", n)?; // control trajectory (throttle)
+    let t = opti.scalar_variable("T")?; // final time
     opti.minimize(t);
 
     let f = |x: &Matrix, u: Expr| Matrix::from_vec(vec![x[1], u - x[1]]); // dx/dt = f(x, u)

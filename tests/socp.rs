@@ -42,7 +42,7 @@ fn assert_close(what: &str, got: f64, want: f64, tol: f64) {
 #[test]
 fn unit_disc_linear_objective() {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 2);
+    let x = pb.variable("x", 2).unwrap();
     pb.minimize(x[0] + x[1]);
     pb.subject_to_cone("disc", &[x[0], x[1]], Expr::constant(1.0))
         .unwrap();
@@ -64,9 +64,9 @@ fn unit_disc_linear_objective() {
 #[test]
 fn distance_to_a_line() {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 2);
-    let t = pb.scalar_variable("t");
-    let a = pb.parameter("a", 2);
+    let x = pb.variable("x", 2).unwrap();
+    let t = pb.scalar_variable("t").unwrap();
+    let a = pb.parameter("a", 2).unwrap();
     pb.set_value(&a, &[1.0, 2.0]).unwrap();
     pb.set_initial(&[t], &[10.0]).unwrap();
     pb.minimize(t);
@@ -92,8 +92,8 @@ fn distance_to_a_line() {
 #[test]
 fn distance_to_a_plane() {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 3);
-    let t = pb.scalar_variable("t");
+    let x = pb.variable("x", 3).unwrap();
+    let t = pb.scalar_variable("t").unwrap();
     let a = [1.0, 2.0, 3.0];
     pb.minimize(t);
     let v: Vec<Expr> = (0..3).map(|i| x[i] - a[i]).collect();
@@ -115,7 +115,7 @@ fn distance_to_a_plane() {
 #[test]
 fn non_affine_cone() {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 2);
+    let x = pb.variable("x", 2).unwrap();
     pb.minimize(-x[1]);
     pb.subject_to_cone("bowl", &[x[0], x[1]], 2.0 - x[0].sq())
         .unwrap();
@@ -131,6 +131,6 @@ fn non_affine_cone() {
 #[test]
 fn empty_cone_is_rejected() {
     let mut pb = Problem::new();
-    let t = pb.scalar_variable("t");
+    let t = pb.scalar_variable("t").unwrap();
     assert!(pb.subject_to_cone("c", &[], t).is_err());
 }

@@ -15,7 +15,7 @@ use symx::{Expr, Matrix};
 pub fn hanging_chain(links: usize) -> Problem {
     let n = 2 * (links + 1);
     let mut pb = Problem::new();
-    let w = pb.variable("w", n);
+    let w = pb.variable("w", n).expect("w");
     let x = |i: usize| w[2 * i];
     let y = |i: usize| w[2 * i + 1];
     let seg2 = (2.0 / links as f64).powi(2);
@@ -54,7 +54,7 @@ pub fn van_der_pol(intervals: usize) -> Problem {
     let n = 3 * nn + 2;
     let h = 10.0 / nn as f64;
     let mut pb = Problem::new();
-    let w = pb.variable("w", n);
+    let w = pb.variable("w", n).expect("w");
     let x1 = |k: usize| w[3 * k];
     let x2 = |k: usize| w[3 * k + 1];
     let u = |k: usize| w[3 * k + 2];

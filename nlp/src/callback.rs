@@ -10,7 +10,7 @@
 //! use nlp::{Ipm, IterationView, Problem, Status};
 //!
 //! let mut pb = Problem::new();
-//! let x = pb.variable("x", 2);
+//! let x = pb.variable("x", 2).unwrap();
 //! pb.minimize((x[0] - 1.0).sq() + (x[1] - 2.0).sq());
 //! let mut compiled = pb.compile().unwrap();
 //! let mut objectives = Vec::new();

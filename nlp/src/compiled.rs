@@ -1,14 +1,19 @@
 //! [`Compiled`]: a problem differentiated and compiled once; the numeric NLP solvers consume.
 use crate::numeric::{AffineCone, NumericNlp};
-use crate::problem::{row_name, Block, BuildError, Problem};
+use crate::parameter::{ParameterIndex, ParameterKey};
+use crate::problem::{row_name, Block, BuildError, ProblemParts};
+use std::sync::Arc;
 use symx::{Expr, Function, Matrix, Sparsity};
 
 /// A compiled problem: evaluators for f, ∇f, g, the sparse Jacobian of g and the sparse
 /// lower-triangular Lagrangian Hessian, with fixed sparsity and their own work space.
 ///
 /// It holds no symbolic expressions, so it is `Send` and can be solved on another thread.
-/// Parameter values can change between solves ([`Compiled::set_parameter`]) without
-/// recompiling.
+/// Parameter values can change between solves ([`Compiled::set_value`]) without
+/// recompiling. A clone shares the compiled evaluators (behind `Arc`) and owns its
+/// bounds, initial point, parameter values and work space: clones solve independently,
+/// e.g. one per thread, without compiling again.
+#[derive(Clone)]
 pub struct Compiled {
     n: usize,
     m: usize,
@@ -18,34 +23,33 @@ pub struct Compiled {
     g_u: Vec<f64>,
     x0: Vec<f64>,
     params: Vec<f64>,
-    f_fn: Function,
-    grad_fn: Function,
-    g_fn: Function,
-    jac_fn: Function,
-    hess_fn: Function,
+    parameter_index: ParameterIndex,
+    f_fn: Arc<Function>,
+    grad_fn: Arc<Function>,
+    g_fn: Arc<Function>,
+    jac_fn: Arc<Function>,
+    hess_fn: Arc<Function>,
     jac_sparsity: Sparsity,
     hess_sparsity: Sparsity,
     work: Vec<f64>,
     variable_names: Vec<String>,
     variable_blocks: Vec<Block>,
-    parameter_blocks: Vec<Block>,
     constraint_blocks: Vec<Block>,
     /// Affine second-order cones, with evaluators of their stacked entries `[t; v]` and
     /// of the entries' Jacobian (`None` without affine cones).
     affine_cones: Vec<AffineCone>,
-    cone_fns: Option<(Function, Function, Sparsity)>,
+    cone_fns: Option<Arc<(Function, Function, Sparsity)>>,
 }
 
 impl Compiled {
     pub(crate) fn new(
-        problem: &Problem,
+        parts: ProblemParts<'_>,
         f: Expr,
-        g: &[Expr],
         params: Vec<f64>,
     ) -> Result<Compiled, BuildError> {
-        let parts = problem.parts();
         let x = parts.variables;
         let p = parts.parameters;
+        let g: &[Expr] = &parts.rows.iter().map(|r| r.expr).collect::<Vec<_>>();
         let grad = symx::gradient(f, x)?;
         let jac = symx::jacobian(g, x)?;
         let sigma = Expr::sym("obj_factor");
@@ -58,9 +62,9 @@ impl Compiled {
         let hess_fn = Function::new(&[x, p, &[sigma], &lambda], &[hess.values()])?;
         let mut affine_cones = Vec::new();
         let mut entries = Vec::new();
-        for c in parts.cones.iter().filter(|c| c.affine) {
+        for &(row, c) in parts.cones.iter().filter(|(_, c)| c.affine) {
             affine_cones.push(AffineCone {
-                row: c.row,
+                row,
                 offset: entries.len(),
                 dim: 1 + c.v.len(),
             });
@@ -71,32 +75,33 @@ impl Compiled {
             None
         } else {
             let cj = symx::jacobian(&entries, x)?;
-            Some((
+            Some(Arc::new((
                 Function::new(&[x, p], &[&entries])?,
                 Function::new(&[x, p], &[cj.values()])?,
                 cj.sparsity().clone(),
-            ))
+            )))
         };
         let work_size = [&f_fn, &grad_fn, &g_fn, &jac_fn, &hess_fn]
             .into_iter()
-            .chain(cone_fns.iter().flat_map(|(a, b, _)| [a, b]))
+            .chain(cone_fns.iter().flat_map(|c| [&c.0, &c.1]))
             .map(|f| f.work_size())
             .max()
             .unwrap_or(0);
         Ok(Compiled {
             n: x.len(),
             m: g.len(),
-            x_l: parts.lower.to_vec(),
-            x_u: parts.upper.to_vec(),
+            x_l: parts.lower,
+            x_u: parts.upper,
             g_l: parts.rows.iter().map(|r| r.lower).collect(),
             g_u: parts.rows.iter().map(|r| r.upper).collect(),
             x0: parts.initial.to_vec(),
             params,
-            f_fn,
-            grad_fn,
-            g_fn,
-            jac_fn,
-            hess_fn,
+            parameter_index: parts.parameter_index.clone(),
+            f_fn: Arc::new(f_fn),
+            grad_fn: Arc::new(grad_fn),
+            g_fn: Arc::new(g_fn),
+            jac_fn: Arc::new(jac_fn),
+            hess_fn: Arc::new(hess_fn),
             jac_sparsity: jac.sparsity().clone(),
             hess_sparsity: hess.sparsity().clone(),
             work: vec![0.0; work_size],
@@ -106,39 +111,31 @@ impl Compiled {
                 .map(|(i, e)| e.name().unwrap_or_else(|| format!("x[{i}]")))
                 .collect(),
             variable_blocks: parts.variable_blocks.to_vec(),
-            parameter_blocks: parts.parameter_blocks.to_vec(),
-            constraint_blocks: parts.constraint_blocks.to_vec(),
+            constraint_blocks: parts.constraint_blocks,
             affine_cones,
             cone_fns,
         })
     }
 
-    /// Sets the values of the parameter declared as `name` (finite numbers, one per entry).
-    pub fn set_parameter(&mut self, name: &str, values: &[f64]) -> Result<(), BuildError> {
-        let block = self
-            .parameter_blocks
-            .iter()
-            .find(|b| b.name == name)
-            .ok_or_else(|| BuildError::NotDeclared {
-                what: format!("set_parameter('{name}')"),
-                index: 0,
-                kind: "parameter",
-            })?;
-        if values.len() != block.len {
-            return Err(BuildError::Size {
-                what: format!("parameter '{name}'"),
-                expected: block.len,
-                got: values.len(),
-            });
+    /// Sets parameter values (finite numbers), by handle or by name: the same call as
+    /// [`Problem::set_value`](crate::Problem::set_value). Handles only work on the thread
+    /// that built the problem ([`BuildError::ForeignThread`] elsewhere); names work on
+    /// any thread.
+    pub fn set_value<'a>(
+        &mut self,
+        p: impl Into<ParameterKey<'a>>,
+        values: &[f64],
+    ) -> Result<(), BuildError> {
+        let idx = self.parameter_index.resolve(p.into(), values)?;
+        for (i, &v) in idx.into_iter().zip(values) {
+            self.params[i] = v;
         }
-        if let Some(&v) = values.iter().find(|v| !v.is_finite()) {
-            return Err(BuildError::NotFinite {
-                what: format!("value of parameter '{name}'"),
-                value: v,
-            });
-        }
-        self.params[block.range()].copy_from_slice(values);
         Ok(())
+    }
+
+    /// The values of all parameter entries, in declaration order.
+    pub fn parameter_values(&self) -> &[f64] {
+        &self.params
     }
 
     /// Replaces the initial guess (e.g. for a new solve after changing parameters).
@@ -172,7 +169,7 @@ impl Compiled {
 
     /// The entries of the variable declared as `name` in a primal vector `x`.
     pub fn variable_values<'a>(&self, name: &str, x: &'a [f64]) -> Option<&'a [f64]> {
-        let b = self.variable_blocks.iter().find(|b| b.name == name)?;
+        let b = self.variable_blocks.iter().find(|b| b.name == name)?; // names are unique
         x.get(b.range())
     }
 
@@ -182,6 +179,24 @@ impl Compiled {
         if let Err(e) = f.eval(inputs, &mut [out], work) {
             panic!("compiled problem evaluated with wrong sizes: {e}");
         }
+    }
+}
+
+impl std::fmt::Debug for Compiled {
+    /// Sizes, sparsity and names; not the evaluators' instruction lists.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names = |b: &[Block]| b.iter().map(|b| b.name.clone()).collect::<Vec<_>>();
+        f.debug_struct("Compiled")
+            .field("n", &self.n)
+            .field("m", &self.m)
+            .field("jacobian_nnz", &self.jac_sparsity.compute_nnz())
+            .field("hessian_nnz", &self.hess_sparsity.compute_nnz())
+            .field("variables", &names(&self.variable_blocks))
+            .field("parameters", &names(self.parameter_index.blocks()))
+            .field("parameter_values", &self.params)
+            .field("constraints", &names(&self.constraint_blocks))
+            .field("affine_cones", &self.affine_cones.len())
+            .finish_non_exhaustive()
     }
 }
 
@@ -242,16 +257,16 @@ impl NumericNlp for Compiled {
         &self.affine_cones
     }
     fn cone_jac_sparsity(&self) -> Option<&Sparsity> {
-        self.cone_fns.as_ref().map(|(_, _, s)| s)
+        self.cone_fns.as_ref().map(|c| &c.2)
     }
     fn eval_cone_entries(&mut self, x: &[f64], out: &mut [f64]) {
-        if let Some((f, _, _)) = &self.cone_fns {
-            Compiled::eval(f, &[x, &self.params], out, &mut self.work);
+        if let Some(c) = &self.cone_fns {
+            Compiled::eval(&c.0, &[x, &self.params], out, &mut self.work);
         }
     }
     fn eval_cone_jac(&mut self, x: &[f64], values: &mut [f64]) {
-        if let Some((_, f, _)) = &self.cone_fns {
-            Compiled::eval(f, &[x, &self.params], values, &mut self.work);
+        if let Some(c) = &self.cone_fns {
+            Compiled::eval(&c.1, &[x, &self.params], values, &mut self.work);
         }
     }
 }

@@ -11,6 +11,7 @@ pub mod mpcc;
 pub mod numeric;
 pub mod option_names;
 pub mod options;
+pub mod parameter;
 pub mod problem;
 pub mod scaling;
 pub mod solution;
@@ -21,7 +22,8 @@ pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
 pub use error::SolveError;
 pub use ipm::Ipm;
-pub use problem::{Block, BuildError, ComplementarityReport, Problem};
+pub use parameter::ParameterKey;
+pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};
 
 pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
 pub use mpcc::{

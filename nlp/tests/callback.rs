@@ -19,7 +19,7 @@ const INF: f64 = f64::INFINITY;
 /// no bounds (dropped by the interior point).
 fn scaled_with_fixed() -> Compiled {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 4);
+    let x = pb.variable("x", 4).unwrap();
     pb.set_initial(&x, &[1.0, 1.5, 0.2, 2.0]).unwrap();
     pb.set_bounds(&[x[3]], 2.0, 2.0).unwrap();
     pb.set_bounds(&[x[2]], 0.0, INF).unwrap();
@@ -240,7 +240,7 @@ fn restoration_iterations_are_reported_and_can_be_stopped() {
 /// phase, exact final phase), labelled in the view.
 fn mpcc_problem() -> Problem {
     let mut pb = Problem::new();
-    let v = pb.variable("v", 2);
+    let v = pb.variable("v", 2).unwrap();
     pb.set_initial(&v, &[0.5, 0.4]).unwrap();
     pb.minimize((v[0] - 1.0).sq() + (v[1] - 1.0).sq());
     pb.complementarity("xy", v[0], v[1]).unwrap();

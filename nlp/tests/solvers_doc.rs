@@ -6,7 +6,7 @@ mod example {
     // Keep in sync with the first code block of docs/solvers.md (checked below).
     pub fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut pb = Problem::new();
-        let x = pb.variable("x", 2);
+        let x = pb.variable("x", 2)?;
         pb.set_initial(&x, &[-1.2, 1.0])?;
         // Rosenbrock on the disc x₀² + x₁² ≤ 1.5.
         pb.minimize(100.0 * (x[1] - x[0].sq()).sq() + (1.0 - x[0]).sq());
@@ -31,7 +31,7 @@ mod callback_example {
 
     pub fn watch() -> Result<(), Box<dyn std::error::Error>> {
         let mut pb = Problem::new();
-        let x = pb.variable("x", 2);
+        let x = pb.variable("x", 2)?;
         pb.set_initial(&x, &[-1.2, 1.0])?;
         pb.minimize(100.0 * (x[1] - x[0].sq()).sq() + (1.0 - x[0]).sq());
         pb.subject_to((x[0].sq() + x[1].sq()).le(1.5))?;

@@ -52,7 +52,7 @@ fn case(problem: Problem, f_star: f64) -> Built {
 
 /// Declares `x` (N entries) with its starting point; returns the vector and its entries.
 fn vars<const N: usize>(pb: &mut Problem, x0: [f64; N]) -> Result<(Matrix, [Expr; N]), BuildError> {
-    let x = pb.variable("x", N);
+    let x = pb.variable("x", N)?;
     pb.set_initial(&x, &x0)?;
     let entries = std::array::from_fn(|i| x[i]);
     Ok((x, entries))
@@ -60,11 +60,7 @@ fn vars<const N: usize>(pb: &mut Problem, x0: [f64; N]) -> Result<(Matrix, [Expr
 
 /// Per-entry bounds `lo[i] ≤ x[i] ≤ hi[i]`.
 fn bounds(pb: &mut Problem, x: &[Expr], lo: &[f64], hi: &[f64]) -> Result<(), BuildError> {
-    assert_eq!((x.len(), x.len()), (lo.len(), hi.len()));
-    for i in 0..x.len() {
-        pb.set_bounds(&x[i..i + 1], lo[i], hi[i])?;
-    }
-    Ok(())
+    pb.set_bounds(x, lo, hi)
 }
 
 fn rosenbrock(x1: Expr, x2: Expr) -> Expr {

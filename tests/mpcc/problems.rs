@@ -16,7 +16,10 @@ pub struct Case {
 }
 
 fn scalars(pb: &mut Problem, names: &[&str]) -> Vec<symx::Expr> {
-    names.iter().map(|n| pb.scalar_variable(n)).collect()
+    names
+        .iter()
+        .map(|n| pb.scalar_variable(n).unwrap())
+        .collect()
 }
 
 /// min (x−1)² + (y−1)²  s.t. 0 ≤ x ⊥ y ≥ 0, from (1, 0.5): f* = 1 at (1, 0) (by hand: on
@@ -293,8 +296,8 @@ pub fn nash1() -> Case {
 pub fn lcp_chain() -> Case {
     fn build() -> Problem {
         let mut pb = Problem::new();
-        let x = pb.variable("x", 10);
-        let y = pb.variable("y", 10);
+        let x = pb.variable("x", 10).unwrap();
+        let y = pb.variable("y", 10).unwrap();
         let xs: Vec<_> = x.iter().copied().collect();
         let ys: Vec<_> = y.iter().copied().collect();
         pb.set_initial(&xs, &[1.0; 10]).unwrap();
@@ -418,8 +421,8 @@ pub fn gauvin() -> Case {
 pub fn qpec2() -> Case {
     fn build() -> Problem {
         let mut pb = Problem::new();
-        let x: Vec<_> = pb.variable("x", 10).iter().copied().collect();
-        let y: Vec<_> = pb.variable("y", 20).iter().copied().collect();
+        let x: Vec<_> = pb.variable("x", 10).unwrap().iter().copied().collect();
+        let y: Vec<_> = pb.variable("y", 20).unwrap().iter().copied().collect();
         pb.set_bounds(&y, 0.0, f64::INFINITY).unwrap();
         pb.set_initial(&x, &[1.0; 10]).unwrap();
         pb.set_initial(&y, &[1.0; 20]).unwrap();

@@ -133,7 +133,7 @@ pub fn build(
             moved.push([false; 4]);
         } else {
             let c = Biped::ALL.map(|j| {
-                let v = pb.variable(&format!("r_{}^{label}", j.name()), 3);
+                let v = pb.variable(&format!("r_{}^{label}", j.name()), 3)?;
                 let off = k * STANCE_LEN + if j == Biped::B { 0 } else { 3 };
                 pb.set_initial(&v, at(off)).map(|_| v)
             });
@@ -151,7 +151,7 @@ pub fn build(
                     continue;
                 }
                 mk[i.index()] = true;
-                let r = pb.variable(&format!("r_{}^{label}", i.name()), 3);
+                let r = pb.variable(&format!("r_{}^{label}", i.name()), 3)?;
                 let g = at(foot_offset(k, i));
                 pb.set_initial(&r, g)?;
                 for &(lo, hi) in &keep_out {
@@ -177,7 +177,7 @@ pub fn build(
             moved.push(mk);
         }
         let f = Foot::ALL.map(|i| {
-            let v = pb.variable(&format!("F_{}^{label}", i.name()), 3);
+            let v = pb.variable(&format!("F_{}^{label}", i.name()), 3)?;
             pb.set_initial(&v, at(k * STANCE_LEN + 18 + 3 * i.index()))
                 .map(|_| v)
         });
@@ -239,7 +239,7 @@ pub fn build(
     if *formulation == Formulation::Complementarity {
         for k in 1..n {
             let label = k + 1;
-            let sk = pb.variable(&format!("s^{label}"), 4);
+            let sk = pb.variable(&format!("s^{label}"), 4)?;
             pb.set_bounds(&sk, 0.0, s.step_radius_sq)?;
             let mut init = [0.0; 4];
             for i in Foot::ALL {
@@ -271,8 +271,8 @@ pub fn build(
     let mut cost: Expr = terms.into_iter().sum();
     let has_penalty = !complementarity.is_empty();
     if has_penalty {
-        let penalty = pb.scalar_parameter(PENALTY);
-        pb.set_value(&[penalty], &[1.0])?;
+        let penalty = pb.scalar_parameter(PENALTY)?;
+        pb.set_value(penalty, &[1.0])?;
         cost += penalty * complementarity.into_iter().sum::<Expr>();
     }
     pb.minimize(cost);
@@ -398,11 +398,13 @@ pub const STANCE_FEET: &str = "stance feet";
 pub fn build_stance(s: &Scenario, terrain: &dyn Terrain) -> Result<Problem, BuildError> {
     let mut pb = Problem::new();
     let label = 0;
-    let p = pb.parameter(STANCE_FEET, 12);
+    let p = pb.parameter(STANCE_FEET, 12)?;
     pb.set_value(&p, &[0.0; 12])?;
     let feet: [Matrix; 4] = std::array::from_fn(|c| vec3(&p[3 * c..3 * c + 3]));
-    let coms = Biped::ALL.map(|j| pb.variable(&format!("r_{}", j.name()), 3));
-    let forces = Foot::ALL.map(|i| pb.variable(&format!("F_{}", i.name()), 3));
+    let [rb, rf] = Biped::ALL.map(|j| pb.variable(&format!("r_{}", j.name()), 3));
+    let coms = [rb?, rf?];
+    let [f0, f1, f2, f3] = Foot::ALL.map(|i| pb.variable(&format!("F_{}", i.name()), 3));
+    let forces = [f0?, f1?, f2?, f3?];
     force_balance(&mut pb, s, label, &coms, &feet, &forces)?;
     for i in Foot::ALL {
         friction_cone(

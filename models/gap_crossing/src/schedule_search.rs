@@ -65,7 +65,7 @@ impl StanceSolver {
     /// forces, with that cost; `None` when the solver does not succeed.
     pub fn solve(&mut self, s: &Scenario, feet: &Feet, start: &Stance) -> Option<(Stance, f64)> {
         let p: Vec<f64> = feet.to_array().iter().flatten().copied().collect();
-        self.compiled.set_parameter(STANCE_FEET, &p).ok()?;
+        self.compiled.set_value(STANCE_FEET, &p).ok()?;
         let mut x0 = Vec::with_capacity(18);
         x0.extend_from_slice(&start.com.b);
         x0.extend_from_slice(&start.com.f);
