@@ -38,7 +38,14 @@ pub struct Compiled {
     /// Affine second-order cones, with evaluators of their stacked entries `[t; v]` and
     /// of the entries' Jacobian (`None` without affine cones).
     affine_cones: Vec<AffineCone>,
-    cone_fns: Option<Arc<(Function, Function, Sparsity)>>,
+    cone_fns: Option<Arc<ConeEvaluators>>,
+}
+
+/// Evaluators of the affine cones' stacked entries `[t; v]` and of their Jacobian.
+struct ConeEvaluators {
+    entries: Function,
+    jacobian: Function,
+    jacobian_sparsity: Sparsity,
 }
 
 impl Compiled {
@@ -75,15 +82,15 @@ impl Compiled {
             None
         } else {
             let cj = symx::jacobian(&entries, x)?;
-            Some(Arc::new((
-                Function::new(&[x, p], &[&entries])?,
-                Function::new(&[x, p], &[cj.values()])?,
-                cj.sparsity().clone(),
-            )))
+            Some(Arc::new(ConeEvaluators {
+                entries: Function::new(&[x, p], &[&entries])?,
+                jacobian: Function::new(&[x, p], &[cj.values()])?,
+                jacobian_sparsity: cj.sparsity().clone(),
+            }))
         };
         let work_size = [&f_fn, &grad_fn, &g_fn, &jac_fn, &hess_fn]
             .into_iter()
-            .chain(cone_fns.iter().flat_map(|c| [&c.0, &c.1]))
+            .chain(cone_fns.iter().flat_map(|c| [&c.entries, &c.jacobian]))
             .map(|f| f.work_size())
             .max()
             .unwrap_or(0);
@@ -257,16 +264,16 @@ impl NumericNlp for Compiled {
         &self.affine_cones
     }
     fn cone_jac_sparsity(&self) -> Option<&Sparsity> {
-        self.cone_fns.as_ref().map(|c| &c.2)
+        self.cone_fns.as_ref().map(|c| &c.jacobian_sparsity)
     }
     fn eval_cone_entries(&mut self, x: &[f64], out: &mut [f64]) {
         if let Some(c) = &self.cone_fns {
-            Compiled::eval(&c.0, &[x, &self.params], out, &mut self.work);
+            Compiled::eval(&c.entries, &[x, &self.params], out, &mut self.work);
         }
     }
     fn eval_cone_jac(&mut self, x: &[f64], values: &mut [f64]) {
         if let Some(c) = &self.cone_fns {
-            Compiled::eval(&c.1, &[x, &self.params], values, &mut self.work);
+            Compiled::eval(&c.jacobian, &[x, &self.params], values, &mut self.work);
         }
     }
 }
