@@ -9,6 +9,7 @@ pub mod kkt;
 pub mod log;
 pub mod mpcc;
 pub mod numeric;
+pub mod ocp;
 pub mod option_names;
 pub mod options;
 pub mod problem;
@@ -29,6 +30,7 @@ pub use mpcc::{
     MpccSolution,
 };
 pub use numeric::{AffineCone, NumericNlp};
+pub use ocp::{Horizon, Method, Ocp, OcpError, Trajectory};
 pub use option_names::{NamedOptions, OptionError};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
 pub use solution::{IterationRecord, Solution, Stats, Status};
