@@ -1,4 +1,5 @@
 //! Butcher tableaus and collocation points/coefficients (nlp::ocp) against published
+#![allow(clippy::needless_range_loop)] // index loops mirror the C[j][r] formulas
 //! values, CasADi's own coefficients and convergence orders.
 use nlp::ocp::{ButcherTableau, Collocation, CollocationPoints, OcpError};
 use symx::{Expr, Function, Matrix};

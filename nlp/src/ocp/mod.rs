@@ -198,8 +198,8 @@ impl Ocp {
         self.dynamics = Some(Dynamics::new(f));
     }
 
-    /// Sets the final time (fixed `T > 0`, or free within `0 < lower ≤ guess ≤ upper`…
-    /// `lower` may be 0).
+    /// Sets the final time: fixed `T > 0`, or free with `0 ≤ lower ≤ guess ≤ upper` and a
+    /// finite guess `> 0`.
     pub fn set_horizon(&mut self, horizon: Horizon) -> Result<(), OcpError> {
         let bad = |why: &str| {
             Err(OcpError::Invalid {
@@ -213,8 +213,11 @@ impl Ocp {
                 lower,
                 upper,
                 guess,
-            } if !(lower >= 0.0 && lower <= guess && guess <= upper && guess > 0.0)
-                || !guess.is_finite() =>
+            } if !(lower >= 0.0
+                && lower <= guess
+                && guess <= upper
+                && guess > 0.0
+                && guess.is_finite()) =>
             {
                 bad("need 0 ≤ lower ≤ guess ≤ upper and a finite guess > 0")
             }
