@@ -390,8 +390,10 @@ impl Transcription {
         } else {
             Vec::new()
         };
+        let mut time: Vec<f64> = (0..=n).map(|k| grid(k, 0.0)).collect();
+        time[n] = t_f; // exactly T, not (N·T)/N
         Ok(Trajectory {
-            time: (0..=n).map(|k| grid(k, 0.0)).collect(),
+            time,
             state_names: self.state_names.clone(),
             states: values(&self.states)?,
             control_names: self.control_names.clone(),

@@ -1,0 +1,123 @@
+//! The optimal-control examples (examples/*.rs built on nlp::ocp) against IPOPT on the
+//! identical transcriptions: CasADi 3.8.2 + IPOPT 3.14.19 (MUMPS), tol 1e-8, values printed
+//! by `python3 benches/reference/ocp_examples.py` (run 2026-11-25 on this machine; the
+//! script mirrors nlp/src/ocp/transcription.rs variable by variable).
+//!
+//! Tolerance: both solvers stop at a scaled KKT error ≤ 1e-8, so the objectives of two
+//! converged runs agree to O(1e-8) relative; 1e-7 relative tells "the same optimum" from
+//! a different local minimum or a different formulation (which move the objective by far
+//! more, e.g. RK4 M = 4 vs M = 1 changes the Van der Pol cost in the 5th digit).
+#![allow(dead_code)] // the examples' `main`s are not called here
+
+#[path = "../examples/vdp_multiple_shooting.rs"]
+mod vdp_multiple_shooting;
+
+#[path = "../examples/vdp_collocation.rs"]
+mod vdp_collocation;
+
+#[path = "../examples/race_car_ocp.rs"]
+mod race_car_ocp;
+
+#[path = "../examples/cart_pole.rs"]
+mod cart_pole;
+
+#[path = "../examples/quadrotor.rs"]
+mod quadrotor;
+
+#[path = "../examples/two_link_arm.rs"]
+mod two_link_arm;
+
+use symnlp::nlp::ocp::{Trajectory, Transcription};
+use symnlp::nlp::{Ipm, IpmOptions, Sqp, SqpOptions};
+
+fn assert_matches_ipopt(name: &str, value: f64, ipopt: f64) {
+    let rel = ((value - ipopt) / ipopt).abs();
+    assert!(
+        rel < 1e-7,
+        "{name}: {value} vs IPOPT {ipopt} (relative {rel:.1e})"
+    );
+}
+
+fn solve_ipm(tr: &Transcription) -> Trajectory {
+    let mut compiled = tr.compile().expect("compiles");
+    let sol = Ipm::default().solve(&mut compiled).expect("solves");
+    assert!(sol.status.is_success(), "{:?}", sol.status);
+    tr.trajectory(&sol).expect("reads back")
+}
+
+#[test]
+fn vdp_multiple_shooting_matches_ipopt() {
+    // {"objective": 3.732969410715394, "iterations": 9}
+    let t = vdp_multiple_shooting::solve(20, IpmOptions::default()).unwrap();
+    assert!(t.status.is_success());
+    assert_matches_ipopt("vdp ms", t.objective, 3.732969410715394);
+    assert_eq!((t.time.len(), t.controls[0].len()), (21, 20));
+    assert_eq!(t.state("x1").unwrap()[0], 0.0);
+    assert!(t.state("x1").unwrap().iter().all(|&v| v >= -0.25 - 1e-8));
+}
+
+#[test]
+fn vdp_multiple_shooting_with_sqp_reaches_the_same_optimum() {
+    let ocp = vdp_multiple_shooting::van_der_pol().unwrap();
+    let method = symnlp::nlp::Method::multiple_shooting(symnlp::nlp::ocp::ButcherTableau::rk4(), 4);
+    let tr = ocp.transcribe(&method, 20).unwrap();
+    let mut compiled = tr.compile().unwrap();
+    let sol = Sqp::new(SqpOptions::default())
+        .solve(&mut compiled)
+        .unwrap();
+    assert!(sol.status.is_success(), "{:?}", sol.status);
+    let t = tr.trajectory(&sol).unwrap();
+    assert_matches_ipopt("vdp ms (sqp)", t.objective, 3.732969410715394);
+}
+
+#[test]
+fn vdp_collocation_matches_ipopt() {
+    // {"objective": 3.7774566843106947, "iterations": 16}
+    let t = vdp_collocation::solve(20, 3, IpmOptions::default()).unwrap();
+    assert!(t.status.is_success());
+    assert_matches_ipopt("vdp collocation", t.objective, 3.7774566843106947);
+    let c = t.collocation.as_ref().expect("collocation states");
+    assert_eq!((c.time.len(), c.states[0].len()), (60, 60));
+    // The trajectory serialises (plot-ready JSON) and reads back identical.
+    let json = serde_json::to_string(&t).unwrap();
+    assert_eq!(serde_json::from_str::<Trajectory>(&json).unwrap(), t);
+}
+
+#[test]
+fn race_car_with_ocp_matches_ipopt_and_the_hand_written_example() {
+    // ocp_examples.py: T = 1.904634273502346 (42 iterations); race_car.py (CasADi's own
+    // Opti formulation): 1.9046342722764305, the value tests/race_car.rs checks.
+    let t = solve_ipm(&race_car_ocp::transcription(100).unwrap());
+    assert_matches_ipopt("race car", t.final_time, 1.904634273502346);
+    assert_matches_ipopt("race car vs race_car.py", t.final_time, 1.9046342722764305);
+    assert_eq!(t.time.last().copied(), Some(t.final_time));
+    assert!((t.state("position").unwrap()[100] - 1.0).abs() < 1e-8);
+}
+
+#[test]
+fn cart_pole_swing_up_matches_ipopt() {
+    // {"objective": 60.80995090111304, "iterations": 13}
+    let t = solve_ipm(&cart_pole::transcription(20).unwrap());
+    assert_matches_ipopt("cart-pole", t.objective, 60.80995090111304);
+    assert!((t.state("q2").unwrap()[20] - std::f64::consts::PI).abs() < 1e-8);
+}
+
+#[test]
+fn quadrotor_point_to_point_matches_ipopt() {
+    // {"objective": 0.08009187934345072, "iterations": 7}
+    let t = solve_ipm(&quadrotor::transcription(20).unwrap());
+    assert_matches_ipopt("quadrotor", t.objective, 0.08009187934345072);
+    assert!(t
+        .controls
+        .iter()
+        .flatten()
+        .all(|&f| (-1e-8..=2.5 + 1e-8).contains(&f)));
+}
+
+#[test]
+fn two_link_arm_minimum_time_matches_ipopt() {
+    // {"objective": 2.303220583549893, "T": 2.260260652913143, "iterations": 11}
+    let t = solve_ipm(&two_link_arm::transcription(20).unwrap());
+    assert_matches_ipopt("arm objective", t.objective, 2.303220583549893);
+    assert_matches_ipopt("arm T", t.final_time, 2.260260652913143);
+}
