@@ -14,6 +14,7 @@ pub mod option_names;
 pub mod options;
 pub mod problem;
 pub mod scaling;
+pub mod sensitivity;
 pub mod solution;
 pub mod sqp;
 
@@ -33,5 +34,6 @@ pub use numeric::{AffineCone, NumericNlp};
 pub use ocp::{Horizon, Method, Ocp, OcpError, Trajectory};
 pub use option_names::{NamedOptions, OptionError};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
+pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};
