@@ -1,7 +1,7 @@
-//! Optimal control on top of [`Problem`]: an [`Ocp`] states a continuous-time problem once
+//! Optimal control on top of [`Problem`](crate::Problem): an [`Ocp`] states a continuous-time problem once
 //! — dynamics `ẋ = f(x, u, p)`, Lagrange and Mayer costs, path and boundary constraints,
 //! bounds, a fixed or free final time — and [`Ocp::transcribe`] turns it into a
-//! [`Problem`] by direct multiple shooting (any explicit Runge–Kutta tableau, `M` steps per
+//! [`Problem`](crate::Problem) by direct multiple shooting (any explicit Runge–Kutta tableau, `M` steps per
 //! interval) or direct collocation (Legendre or Radau points of any degree). The
 //! [`Transcription`] compiles like any problem, is solved by either solver with the same
 //! options, and reads a [`Solution`](crate::Solution) back as a [`Trajectory`]
@@ -20,6 +20,11 @@ pub use butcher::ButcherTableau;
 pub use collocation::{Collocation, CollocationPoints};
 pub use trajectory::{CollocationStates, Trajectory};
 pub use transcription::{Method, Transcription};
+
+/// The tutorial `docs/ocp.md`, compiled and run as doc tests so that its examples stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/ocp.md")]
+pub struct OcpGuide;
 
 use crate::constraint::Constraint;
 use crate::problem::BuildError;
@@ -178,7 +183,7 @@ impl Ocp {
 
     /// Declares a parameter vector `name` with its values; the closures receive all
     /// parameters stacked in declaration order as `p`. In the transcription it is a
-    /// [`Problem`] parameter of the same name.
+    /// [`Problem`](crate::Problem) parameter of the same name.
     pub fn add_parameter(&mut self, name: &str, values: &[f64]) -> Result<(), OcpError> {
         if self.parameters.iter().any(|(n, _)| n == name) {
             return Err(BuildError::DuplicateName { name: name.into() }.into());
