@@ -15,8 +15,8 @@ const M_POLE: f64 = 0.3;
 const LENGTH: f64 = 0.5;
 const GRAVITY: f64 = 9.81;
 
-/// The swing-up on `n` intervals (`x = [cart position, angle, cart speed, angular rate]`).
-pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+/// The optimal control problem (no transcription yet).
+pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
     let mut ocp = Ocp::new(&["q1", "q2", "dq1", "dq2"], &["force"]);
     ocp.set_dynamics(|x, u, _p| {
         let (s, c) = (x[1].sin(), x[1].cos());
@@ -35,6 +35,12 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     let goal = [1.0, PI, 0.0, 0.0];
     ocp.set_final_state(&goal)?;
     ocp.set_state_guess_linear(&[0.0; 4], &goal)?;
+    Ok(ocp)
+}
+
+/// The swing-up on `n` intervals (`x = [cart position, angle, cart speed, angular rate]`).
+pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+    let ocp = problem()?;
     Ok(ocp.transcribe(&Method::collocation(CollocationPoints::Radau, 3)?, n)?)
 }
 

@@ -42,8 +42,8 @@ fn dynamics(x: &Matrix, u: &Matrix) -> Matrix {
     ])
 }
 
-/// The manoeuvre on `n` RK4 intervals.
-pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+/// The optimal control problem (no transcription yet).
+pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
     let states = [
         "x", "y", "z", "vx", "vy", "vz", "roll", "pitch", "yaw", "wx", "wy", "wz",
     ];
@@ -63,6 +63,12 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     ocp.set_final_state(&goal)?;
     ocp.set_state_guess_linear(&[0.0; 12], &goal)?;
     ocp.set_control_guess(|_t| vec![HOVER; 4]);
+    Ok(ocp)
+}
+
+/// The manoeuvre on `n` RK4 intervals.
+pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+    let ocp = problem()?;
     Ok(ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), n)?)
 }
 

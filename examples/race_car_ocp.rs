@@ -10,8 +10,8 @@ use symnlp::nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Transcription};
 use symnlp::nlp::Relation;
 use symnlp::symx::Matrix;
 
-/// The race car as an optimal control problem, transcribed on `n` RK4 intervals.
-pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+/// The optimal control problem (no transcription yet).
+pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
     let mut ocp = Ocp::new(&["position", "speed"], &["throttle"]);
     ocp.set_dynamics(|x, u, _p| Matrix::from_vec(vec![x[1], u[0] - x[1]]));
     ocp.set_terminal_cost(|_x, _p, t| t); // minimum time
@@ -27,6 +27,12 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     ocp.set_initial_state(&[0.0, 0.0])?;
     ocp.add_boundary_constraint("finish line", |_x0, x_t, _p, _t| x_t[0].eq(1.0));
     ocp.set_state_guess(|_t| vec![0.0, 1.0]);
+    Ok(ocp)
+}
+
+/// The race car as an optimal control problem, transcribed on `n` RK4 intervals.
+pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+    let ocp = problem()?;
     Ok(ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), n)?)
 }
 

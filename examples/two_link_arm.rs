@@ -35,8 +35,8 @@ fn dynamics(x: &Matrix, u: &Matrix) -> Matrix {
     ])
 }
 
-/// The manoeuvre on `n` collocation intervals.
-pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+/// The optimal control problem (no transcription yet).
+pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
     let mut ocp = Ocp::new(&["q1", "q2", "dq1", "dq2"], &["tau1", "tau2"]);
     ocp.set_dynamics(|x, u, _p| dynamics(x, u));
     ocp.set_stage_cost(|_x, u, _p| 0.01 * (u[0].sq() + u[1].sq()));
@@ -51,6 +51,12 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     ocp.set_initial_state(&[0.0; 4])?;
     ocp.set_final_state(&goal)?;
     ocp.set_state_guess_linear(&[0.0; 4], &goal)?;
+    Ok(ocp)
+}
+
+/// The manoeuvre on `n` collocation intervals.
+pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+    let ocp = problem()?;
     Ok(ocp.transcribe(&Method::collocation(CollocationPoints::Legendre, 3)?, n)?)
 }
 

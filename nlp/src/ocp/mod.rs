@@ -198,6 +198,24 @@ impl Ocp {
         Ok(())
     }
 
+    /// The dynamics compiled as a numeric function `(x, u, p) ↦ ẋ` (three inputs, one
+    /// output), e.g. to simulate a solution's controls or to plot the vector field.
+    pub fn dynamics_function(&self) -> Result<symx::Function, OcpError> {
+        let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
+        let x = Matrix::sym_vec("x", self.nx());
+        let u = Matrix::sym_vec("u", self.nu());
+        let p = Matrix::sym_vec("p", self.np());
+        let f = dynamics.eval(&x, &u, &p);
+        if f.len() != self.nx() {
+            return Err(OcpError::Size {
+                what: "dynamics output".into(),
+                expected: self.nx(),
+                got: f.len(),
+            });
+        }
+        Ok(symx::Function::new(&[&x, &u, &p], &[&f])?)
+    }
+
     /// Sets the dynamics `ẋ = f(x, u, p)`.
     pub fn set_dynamics(&mut self, f: impl Fn(&Matrix, &Matrix, &Matrix) -> Matrix + 'static) {
         self.dynamics = Some(Dynamics::new(f));
