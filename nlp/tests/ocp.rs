@@ -268,3 +268,31 @@ fn mistakes_are_reported() {
     sol.x.pop();
     assert!(matches!(tr.trajectory(&sol), Err(OcpError::Size { .. })));
 }
+
+#[test]
+fn free_final_time_without_controls() {
+    // ẋ = −x, x(0) = 1, min (x(T) − 1/2)²: T* = ln 2 up to the RK4 error of the grid.
+    let mut ocp = Ocp::new(&["x"], &[]);
+    ocp.set_dynamics(|x, _u, _p| Matrix::from_vec(vec![-x[0]]));
+    ocp.set_terminal_cost(|x, _p, _t| (x[0] - 0.5).sq());
+    ocp.set_horizon(Horizon::Free {
+        lower: 0.1,
+        upper: 5.0,
+        guess: 1.0,
+    })
+    .unwrap();
+    ocp.set_initial_state(&[1.0]).unwrap();
+    ocp.set_state_guess(|t| vec![(-t).exp()]);
+    let t = solve(
+        &ocp,
+        &Method::multiple_shooting(ButcherTableau::rk4(), 1),
+        10,
+    );
+    // RK4 with h ≈ 0.07: relative error of e^{−h} per step ~h⁵/120 ≈ 1.4e-8, times 10.
+    assert!(
+        (t.final_time - 2f64.ln()).abs() < 1e-6,
+        "T = {}",
+        t.final_time
+    );
+    assert!(t.controls.is_empty() && t.control_names.is_empty());
+}

@@ -248,3 +248,39 @@ fn bad_inputs_are_errors() {
     );
     assert_eq!(sens.compute(&sol, &[2.0]).unwrap().dx_dp, vec![vec![1.0]]);
 }
+
+#[test]
+fn sensitivities_at_an_sqp_solution() {
+    // The SQP's multipliers of inactive constraints are exactly zero; the same
+    // sensitivities follow (compared with the interior point's at the same optimum).
+    let mut pb = Problem::new();
+    let x = pb.variable("x", 2);
+    let p = pb.scalar_parameter("p");
+    pb.set_value(&[p], &[1.0]).unwrap();
+    pb.minimize((x[0] - 2.0 * p).sq() + (x[1] - p).sq() + x[0] * x[1]);
+    pb.subject_to((x[0] + 2.0 * x[1]).le(1.0)).unwrap();
+    pb.subject_to((x[0] - x[1]).le(10.0)).unwrap();
+    let mut compiled = pb.compile().unwrap();
+    let a = nlp::Sqp::new(nlp::SqpOptions::default())
+        .solve(&mut compiled)
+        .unwrap();
+    let b = tight().solve(&mut compiled).unwrap();
+    let mut sens = ParametricSensitivity::new(&pb).unwrap();
+    let (sa, sb) = (
+        sens.compute(&a, &[1.0]).unwrap(),
+        sens.compute(&b, &[1.0]).unwrap(),
+    );
+    assert_eq!(sa.active_rows, vec![0]);
+    assert_eq!(sa.active_rows, sb.active_rows);
+    assert!(rel_err(&sa.dx_dp[0], &sb.dx_dp[0]) < 1e-6);
+    let fd = finite_differences(&mut compiled, "p", &[1.0], &b);
+    assert_matches(&sa, &fd, 1e-6);
+    assert!(sa.weakly_active.is_empty() && sb.weakly_active.is_empty());
+
+    // At p = 1/2 the unconstrained minimiser (1, 0) lies exactly on x₀ + 2x₁ = 1 with a
+    // zero multiplier: weakly active, and reported as such.
+    compiled.set_parameter("p", &[0.5]).unwrap();
+    let c = tight().solve(&mut compiled).unwrap();
+    let sc = sens.compute(&c, &[0.5]).unwrap();
+    assert_eq!(sc.weakly_active, vec!["g[0] upper".to_string()]);
+}
