@@ -7,6 +7,8 @@
 //! converged runs agree to O(1e-8) relative; 1e-7 relative tells "the same optimum" from
 //! a different local minimum or a different formulation (which move the objective by far
 //! more, e.g. RK4 M = 4 vs M = 1 changes the Van der Pol cost in the 5th digit).
+//! Measured (2026-11-25): 1e-16…4e-13 relative with the interior point, 2e-8 with the SQP
+//! (its own stopping tolerance), 6e-10 between the race car's two IPOPT formulations.
 #![allow(dead_code)] // the examples' `main`s are not called here
 
 #[path = "../examples/vdp_multiple_shooting.rs"]
