@@ -132,6 +132,21 @@ fn guesses_reach_the_initial_point() {
     let tau = 0.5 - (1.0f64 / 12.0).sqrt(); // first Legendre point of degree 2
     assert!((xc[0] - (1.0 - tau / 4.0)).abs() < 1e-15);
 
+    // A linear guess follows a horizon set afterwards.
+    let mut late = lqr();
+    late.set_state_guess_linear(&[1.0], &[0.0]).unwrap();
+    late.set_horizon(Horizon::Fixed(3.0)).unwrap();
+    let tr = late
+        .transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 4)
+        .unwrap();
+    let compiled = tr.compile().unwrap();
+    let mut x0 = vec![0.0; compiled.n()];
+    compiled.initial_point(&mut x0);
+    assert_eq!(
+        compiled.variable_values("X", &x0).unwrap(),
+        &[1.0, 0.75, 0.5, 0.25, 0.0]
+    );
+
     // A coarse solution as the guess of a finer grid.
     let coarse = solve(
         &lqr(),

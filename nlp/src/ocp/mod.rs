@@ -74,8 +74,9 @@ type PathFn = Box<dyn Fn(&Matrix, &Matrix, &Matrix) -> Constraint>;
 type BoundaryFn = Box<dyn Fn(&Matrix, &Matrix, &Matrix, Expr) -> Constraint>;
 /// The Mayer term `φ(x(T), p, T)`.
 type TerminalFn = Box<dyn Fn(&Matrix, &Matrix, Expr) -> Expr>;
-/// A guess as a function of time.
-type GuessFn = Box<dyn Fn(f64) -> Vec<f64>>;
+/// A guess as a function of time `t` and of the horizon's guess `T` (so that guesses in
+/// normalised time follow a later `set_horizon`).
+type GuessFn = Box<dyn Fn(f64, f64) -> Vec<f64>>;
 
 /// The dynamics `ẋ = f(x, u, p)`, given once.
 pub struct Dynamics {
@@ -307,23 +308,22 @@ impl Ocp {
     /// Guesses the states as a function of time `t ∈ [0, T]` (`T` the fixed value or the
     /// horizon's guess); it must return `nx` finite values.
     pub fn set_state_guess(&mut self, x: impl Fn(f64) -> Vec<f64> + 'static) {
-        self.state_guess = Some(Box::new(x));
+        self.state_guess = Some(Box::new(move |t, _| x(t)));
     }
 
     /// Guesses the controls as a function of time (`nu` finite values).
     pub fn set_control_guess(&mut self, u: impl Fn(f64) -> Vec<f64> + 'static) {
-        self.control_guess = Some(Box::new(u));
+        self.control_guess = Some(Box::new(move |t, _| u(t)));
     }
 
     /// Guesses the states on the straight line from `start` (t = 0) to `end` (t = T).
     pub fn set_state_guess_linear(&mut self, start: &[f64], end: &[f64]) -> Result<(), OcpError> {
         let a = check_values("state guess start", self.nx(), start)?;
         let b = check_values("state guess end", self.nx(), end)?;
-        let t_f = self.horizon.guess();
-        self.set_state_guess(move |t| {
+        self.state_guess = Some(Box::new(move |t, t_f| {
             let s = (t / t_f).clamp(0.0, 1.0);
             a.iter().zip(&b).map(|(a, b)| a + s * (b - a)).collect()
-        });
+        }));
         Ok(())
     }
 
@@ -331,9 +331,12 @@ impl Ocp {
     /// interpolated linearly in normalised time `t / T`.
     pub fn set_guess_from(&mut self, previous: &Trajectory) {
         let (p1, p2) = (previous.clone(), previous.clone());
-        let t_new = self.horizon.guess();
-        self.set_state_guess(move |t| p1.states_at(t / t_new * p1.final_time));
-        self.set_control_guess(move |t| p2.controls_at(t / t_new * p2.final_time));
+        self.state_guess = Some(Box::new(move |t, t_f| {
+            p1.states_at(t / t_f * p1.final_time)
+        }));
+        self.control_guess = Some(Box::new(move |t, t_f| {
+            p2.controls_at(t / t_f * p2.final_time)
+        }));
     }
 }
 

@@ -181,7 +181,7 @@ impl Ocp {
         let times = |k: usize, tau: f64| (k as f64 + tau) * t_f / n as f64;
         if let Some(g) = &self.state_guess {
             let mut set = |m: &Matrix, col: usize, t: f64| -> Result<(), OcpError> {
-                let v = g(t);
+                let v = g(t, t_f);
                 tr.problem
                     .set_initial(&m.column(col)?, &v)
                     .map_err(|e| match e {
@@ -208,7 +208,7 @@ impl Ocp {
         if let (Some(g), true) = (&self.control_guess, self.nu() > 0) {
             for k in 0..n {
                 let t = times(k, 0.0);
-                let v = g(t);
+                let v = g(t, t_f);
                 if v.len() != self.nu() {
                     return Err(OcpError::Size {
                         what: format!("control guess at t = {t}"),
