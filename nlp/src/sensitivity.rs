@@ -47,17 +47,35 @@ pub enum SensitivityError {
     NotConverged(Status),
     /// The KKT matrix has the wrong inertia: the second-order sufficient conditions or
     /// the linear independence of the active constraints fail at the solution.
-    #[error("KKT inertia {got:?}, expected {expected:?} (SOSC or LICQ fails at the solution)")]
-    Inertia { expected: Inertia, got: Inertia },
+    #[error(
+        "KKT inertia ({positive}, {negative}, {zero}) (positive, negative, zero), expected \
+         ({n}, {m}, 0): SOSC or LICQ fails at the solution"
+    )]
+    Inertia {
+        positive: usize,
+        negative: usize,
+        zero: usize,
+        n: usize,
+        m: usize,
+    },
     /// A parameter value is not finite.
     #[error("parameter value {index} is {value}")]
     NotFinite { index: usize, value: f64 },
-    /// The linear solver failed.
-    #[error(transparent)]
-    Kkt(#[from] KktError),
+    /// The linear solver failed (its message).
+    #[error("KKT linear solver: {0}")]
+    LinearSolver(String),
+    /// Iterative refinement did not reach an accurate solution of the KKT system.
+    #[error("KKT solve residual {0:.1e} exceeds 1e-8")]
+    Inaccurate(f64),
     /// Differentiating or compiling failed.
     #[error(transparent)]
     Build(#[from] BuildError),
+}
+
+impl From<KktError> for SensitivityError {
+    fn from(e: KktError) -> Self {
+        SensitivityError::LinearSolver(e.to_string())
+    }
 }
 
 impl From<symx::SymxError> for SensitivityError {
@@ -212,8 +230,11 @@ impl ParametricSensitivity {
         };
         if inertia != expected {
             return Err(SensitivityError::Inertia {
-                expected,
-                got: inertia,
+                positive: inertia.positive,
+                negative: inertia.negative,
+                zero: inertia.zero,
+                n,
+                m,
             });
         }
         // The factor is of K + diag(δ_x on F, −δ_c on active rows); refinement solves the
@@ -254,6 +275,9 @@ impl ParametricSensitivity {
                 }
             }
             let residual = self.kkt.solve_shifted(&mut rhs, Some(&shift))?;
+            if residual.is_nan() || residual > 1e-8 {
+                return Err(SensitivityError::Inaccurate(residual));
+            }
             out.residual = out.residual.max(residual);
             let (dxj, dlj) = rhs.split_at(n);
             // Bound multipliers from the stationarity rows of the active bounds.
