@@ -94,7 +94,9 @@ pub struct Sensitivity {
     pub dlambda_dp: Vec<Vec<f64>>,
     /// `∂z_Lᵢ/∂pⱼ` (non-zero only at active lower bounds).
     pub dz_l_dp: Vec<Vec<f64>>,
-    /// `∂z_Uᵢ/∂pⱼ` (non-zero only at active upper bounds).
+    /// `∂z_Uᵢ/∂pⱼ` (non-zero only at active upper bounds). For a fixed variable only
+    /// `z_U − z_L` is determined; its derivative goes to the side whose multiplier is
+    /// larger at the solution (`z_L` on a tie).
     pub dz_u_dp: Vec<Vec<f64>>,
     /// Rows of g held active (equalities included).
     pub active_rows: Vec<usize>,
