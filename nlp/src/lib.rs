@@ -9,11 +9,13 @@ pub mod kkt;
 pub mod log;
 pub mod mpcc;
 pub mod numeric;
+pub mod ocp;
 pub mod option_names;
 pub mod options;
 pub mod parameter;
 pub mod problem;
 pub mod scaling;
+pub mod sensitivity;
 pub mod solution;
 pub mod sqp;
 
@@ -31,7 +33,9 @@ pub use mpcc::{
     MpccSolution,
 };
 pub use numeric::{AffineCone, NumericNlp};
+pub use ocp::{Horizon, Method, Ocp, OcpError, Trajectory};
 pub use option_names::{NamedOptions, OptionError};
 pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
+pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};

@@ -1,0 +1,384 @@
+//! Optimal control on top of [`Problem`](crate::Problem): an [`Ocp`] states a continuous-time problem once
+//! — dynamics `ẋ = f(x, u, p)`, Lagrange and Mayer costs, path and boundary constraints,
+//! bounds, a fixed or free final time — and [`Ocp::transcribe`] turns it into a
+//! [`Problem`](crate::Problem) by direct multiple shooting (any explicit Runge–Kutta tableau, `M` steps per
+//! interval) or direct collocation (Legendre or Radau points of any degree). The
+//! [`Transcription`] compiles like any problem, is solved by either solver with the same
+//! options, and reads a [`Solution`](crate::Solution) back as a [`Trajectory`]
+//! (time grid, states, controls; serde-serialisable). See `docs/ocp.md`.
+//!
+//! Functions of the model are Rust closures of expressions given once. Each transcription
+//! calls them through one place per kind ([`Dynamics::eval`] for the dynamics), so the
+//! inlined expressions can later become calls of one compiled function without changing
+//! this API.
+mod butcher;
+mod collocation;
+mod trajectory;
+mod transcription;
+
+pub use butcher::ButcherTableau;
+pub use collocation::{Collocation, CollocationPoints};
+pub use trajectory::{CollocationStates, Trajectory};
+pub use transcription::{Method, Transcription};
+
+/// The tutorial `docs/ocp.md`, compiled and run as doc tests so that its examples stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/ocp.md")]
+pub struct OcpGuide;
+
+use crate::constraint::Constraint;
+use crate::problem::BuildError;
+use symx::{Expr, Matrix};
+use thiserror::Error;
+
+/// A mistake in an optimal control problem or its transcription, naming the culprit.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum OcpError {
+    /// A Butcher tableau that is not an explicit Runge–Kutta method.
+    #[error("Butcher tableau '{name}': {why}")]
+    Tableau { name: String, why: String },
+    /// A collocation degree outside the supported range.
+    #[error("collocation degree {0} is outside 1..=60")]
+    Degree(usize),
+    /// A numerical routine failed (e.g. the eigensolver of the collocation points).
+    #[error("{0}")]
+    Numerical(String),
+    /// Two lengths that must agree.
+    #[error("{what}: expected {expected} values, got {got}")]
+    Size {
+        what: String,
+        expected: usize,
+        got: usize,
+    },
+    /// An invalid setting.
+    #[error("{what}: {why}")]
+    Invalid { what: String, why: String },
+    /// No dynamics was given.
+    #[error("the problem has no dynamics: call Ocp::set_dynamics")]
+    NoDynamics,
+    /// An error of the underlying problem.
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    /// An error from symx.
+    #[error(transparent)]
+    Symx(#[from] symx::SymxError),
+}
+
+/// A function of `(x, u, p)` returning a vector (the dynamics, path constraints).
+type StageVector = Box<dyn Fn(&Matrix, &Matrix, &Matrix) -> Matrix>;
+/// A function of `(x, u, p)` returning a scalar (the Lagrange integrand).
+type StageScalar = Box<dyn Fn(&Matrix, &Matrix, &Matrix) -> Expr>;
+/// A path constraint `c(x, u, p)` in relation form.
+type PathFn = Box<dyn Fn(&Matrix, &Matrix, &Matrix) -> Constraint>;
+/// A boundary constraint `c(x(0), x(T), p, T)` in relation form.
+type BoundaryFn = Box<dyn Fn(&Matrix, &Matrix, &Matrix, Expr) -> Constraint>;
+/// The Mayer term `φ(x(T), p, T)`.
+type TerminalFn = Box<dyn Fn(&Matrix, &Matrix, Expr) -> Expr>;
+/// A guess as a function of time `t` and of the horizon's guess `T` (so that guesses in
+/// normalised time follow a later `set_horizon`).
+type GuessFn = Box<dyn Fn(f64, f64) -> Vec<f64>>;
+
+/// The dynamics `ẋ = f(x, u, p)`, given once.
+pub struct Dynamics {
+    f: StageVector,
+}
+
+impl Dynamics {
+    /// Dynamics from a closure of expressions: `f(x, u, p)` with `x`, `u`, `p` column
+    /// vectors of the sizes the [`Ocp`] declares, returning `ẋ` (as many entries as `x`).
+    pub fn new(f: impl Fn(&Matrix, &Matrix, &Matrix) -> Matrix + 'static) -> Self {
+        Dynamics { f: Box::new(f) }
+    }
+
+    /// `ẋ` at `(x, u, p)`; every transcription evaluates the dynamics through this call.
+    pub fn eval(&self, x: &Matrix, u: &Matrix, p: &Matrix) -> Matrix {
+        (self.f)(x, u, p)
+    }
+}
+
+/// The final time.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Horizon {
+    /// A given final time `T > 0`.
+    Fixed(f64),
+    /// A decision variable `T` with `lower ≤ T ≤ upper` and an initial guess.
+    Free { lower: f64, upper: f64, guess: f64 },
+}
+
+impl Horizon {
+    /// The fixed value or the guess.
+    pub fn guess(&self) -> f64 {
+        match *self {
+            Horizon::Fixed(t) => t,
+            Horizon::Free { guess, .. } => guess,
+        }
+    }
+}
+
+/// A continuous-time optimal control problem
+///
+/// ```text
+/// min  ∫₀ᵀ l(x, u, p) dt + φ(x(T), p, T)
+/// s.t. ẋ = f(x, u, p),  c(x, u, p) within bounds on the grid,  b(x(0), x(T), p, T) within bounds,
+///      x_l ≤ x ≤ x_u,  u_l ≤ u ≤ u_u,  T fixed or free
+/// ```
+///
+/// with `p` parameters (values fixed in a solve, changeable afterwards, and the variables
+/// of [`crate::sensitivity`]). Controls are piecewise constant on the transcription grid.
+pub struct Ocp {
+    pub(crate) states: Vec<String>,
+    pub(crate) controls: Vec<String>,
+    pub(crate) parameters: Vec<(String, Vec<f64>)>,
+    pub(crate) dynamics: Option<Dynamics>,
+    pub(crate) horizon: Horizon,
+    pub(crate) stage_cost: Option<StageScalar>,
+    pub(crate) terminal_cost: Option<TerminalFn>,
+    pub(crate) path: Vec<(String, PathFn)>,
+    pub(crate) boundary: Vec<(String, BoundaryFn)>,
+    pub(crate) state_bounds: (Vec<f64>, Vec<f64>),
+    pub(crate) control_bounds: (Vec<f64>, Vec<f64>),
+    pub(crate) initial_state: Option<Vec<f64>>,
+    pub(crate) final_state: Option<Vec<f64>>,
+    pub(crate) state_guess: Option<GuessFn>,
+    pub(crate) control_guess: Option<GuessFn>,
+}
+
+impl Ocp {
+    /// A problem with the named states and controls (their number is the size of `x` and
+    /// `u`), final time fixed at 1 until [`Ocp::set_horizon`], no costs and no bounds.
+    pub fn new(states: &[&str], controls: &[&str]) -> Ocp {
+        let (nx, nu) = (states.len(), controls.len());
+        Ocp {
+            states: states.iter().map(|s| s.to_string()).collect(),
+            controls: controls.iter().map(|s| s.to_string()).collect(),
+            parameters: Vec::new(),
+            dynamics: None,
+            horizon: Horizon::Fixed(1.0),
+            stage_cost: None,
+            terminal_cost: None,
+            path: Vec::new(),
+            boundary: Vec::new(),
+            state_bounds: (vec![f64::NEG_INFINITY; nx], vec![f64::INFINITY; nx]),
+            control_bounds: (vec![f64::NEG_INFINITY; nu], vec![f64::INFINITY; nu]),
+            initial_state: None,
+            final_state: None,
+            state_guess: None,
+            control_guess: None,
+        }
+    }
+
+    /// Number of states.
+    pub fn nx(&self) -> usize {
+        self.states.len()
+    }
+
+    /// Number of controls.
+    pub fn nu(&self) -> usize {
+        self.controls.len()
+    }
+
+    /// Number of parameter entries (all parameters stacked in declaration order).
+    pub fn np(&self) -> usize {
+        self.parameters.iter().map(|(_, v)| v.len()).sum()
+    }
+
+    /// Declares a parameter vector `name` with its values; the closures receive all
+    /// parameters stacked in declaration order as `p`. In the transcription it is a
+    /// [`Problem`](crate::Problem) parameter of the same name.
+    pub fn add_parameter(&mut self, name: &str, values: &[f64]) -> Result<(), OcpError> {
+        if self.parameters.iter().any(|(n, _)| n == name) {
+            return Err(BuildError::DuplicateName { name: name.into() }.into());
+        }
+        if let Some(&v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(OcpError::Invalid {
+                what: format!("value of parameter '{name}'"),
+                why: format!("{v} is not finite"),
+            });
+        }
+        self.parameters.push((name.to_string(), values.to_vec()));
+        Ok(())
+    }
+
+    /// The dynamics compiled as a numeric function `(x, u, p) ↦ ẋ` (three inputs, one
+    /// output), e.g. to simulate a solution's controls or to plot the vector field.
+    pub fn dynamics_function(&self) -> Result<symx::Function, OcpError> {
+        let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
+        let x = Matrix::sym_vec("x", self.nx());
+        let u = Matrix::sym_vec("u", self.nu());
+        let p = Matrix::sym_vec("p", self.np());
+        let f = dynamics.eval(&x, &u, &p);
+        if f.len() != self.nx() {
+            return Err(OcpError::Size {
+                what: "dynamics output".into(),
+                expected: self.nx(),
+                got: f.len(),
+            });
+        }
+        Ok(symx::Function::new(&[&x, &u, &p], &[&f])?)
+    }
+
+    /// Sets the dynamics `ẋ = f(x, u, p)`.
+    pub fn set_dynamics(&mut self, f: impl Fn(&Matrix, &Matrix, &Matrix) -> Matrix + 'static) {
+        self.dynamics = Some(Dynamics::new(f));
+    }
+
+    /// Sets the final time: fixed `T > 0`, or free with `0 ≤ lower ≤ guess ≤ upper` and a
+    /// finite guess `> 0`.
+    pub fn set_horizon(&mut self, horizon: Horizon) -> Result<(), OcpError> {
+        let bad = |why: &str| {
+            Err(OcpError::Invalid {
+                what: "horizon".into(),
+                why: why.into(),
+            })
+        };
+        match horizon {
+            Horizon::Fixed(t) if !(t.is_finite() && t > 0.0) => bad("T must be finite and > 0"),
+            Horizon::Free {
+                lower,
+                upper,
+                guess,
+            } if !(lower >= 0.0
+                && lower <= guess
+                && guess <= upper
+                && guess > 0.0
+                && guess.is_finite()) =>
+            {
+                bad("need 0 ≤ lower ≤ guess ≤ upper and a finite guess > 0")
+            }
+            _ => {
+                self.horizon = horizon;
+                Ok(())
+            }
+        }
+    }
+
+    /// Sets the Lagrange integrand `l(x, u, p)` of the cost `∫₀ᵀ l dt`.
+    pub fn set_stage_cost(&mut self, l: impl Fn(&Matrix, &Matrix, &Matrix) -> Expr + 'static) {
+        self.stage_cost = Some(Box::new(l));
+    }
+
+    /// Sets the Mayer term `φ(x(T), p, T)` (e.g. `|_, _, t| t` for minimum time).
+    pub fn set_terminal_cost(&mut self, phi: impl Fn(&Matrix, &Matrix, Expr) -> Expr + 'static) {
+        self.terminal_cost = Some(Box::new(phi));
+    }
+
+    /// Adds a path constraint `c(x, u, p)` imposed at every grid point `t₀ … t_N` (at
+    /// `t_N` with the last interval's control).
+    pub fn add_path_constraint(
+        &mut self,
+        name: &str,
+        c: impl Fn(&Matrix, &Matrix, &Matrix) -> Constraint + 'static,
+    ) {
+        self.path.push((name.to_string(), Box::new(c)));
+    }
+
+    /// Adds a boundary constraint `b(x(0), x(T), p, T)`.
+    pub fn add_boundary_constraint(
+        &mut self,
+        name: &str,
+        b: impl Fn(&Matrix, &Matrix, &Matrix, Expr) -> Constraint + 'static,
+    ) {
+        self.boundary.push((name.to_string(), Box::new(b)));
+    }
+
+    /// Bounds of the states, imposed at every grid and collocation point (±∞ for none).
+    pub fn set_state_bounds(&mut self, lower: &[f64], upper: &[f64]) -> Result<(), OcpError> {
+        self.state_bounds = check_bounds("state bounds", self.nx(), lower, upper)?;
+        Ok(())
+    }
+
+    /// Bounds of the controls (±∞ for none).
+    pub fn set_control_bounds(&mut self, lower: &[f64], upper: &[f64]) -> Result<(), OcpError> {
+        self.control_bounds = check_bounds("control bounds", self.nu(), lower, upper)?;
+        Ok(())
+    }
+
+    /// Fixes `x(0)`.
+    pub fn set_initial_state(&mut self, x0: &[f64]) -> Result<(), OcpError> {
+        self.initial_state = Some(check_values("initial state", self.nx(), x0)?);
+        Ok(())
+    }
+
+    /// Fixes `x(T)`.
+    pub fn set_final_state(&mut self, xf: &[f64]) -> Result<(), OcpError> {
+        self.final_state = Some(check_values("final state", self.nx(), xf)?);
+        Ok(())
+    }
+
+    /// Guesses the states as a function of time `t ∈ [0, T]` (`T` the fixed value or the
+    /// horizon's guess); it must return `nx` finite values.
+    pub fn set_state_guess(&mut self, x: impl Fn(f64) -> Vec<f64> + 'static) {
+        self.state_guess = Some(Box::new(move |t, _| x(t)));
+    }
+
+    /// Guesses the controls as a function of time (`nu` finite values).
+    pub fn set_control_guess(&mut self, u: impl Fn(f64) -> Vec<f64> + 'static) {
+        self.control_guess = Some(Box::new(move |t, _| u(t)));
+    }
+
+    /// Guesses the states on the straight line from `start` (t = 0) to `end` (t = T).
+    pub fn set_state_guess_linear(&mut self, start: &[f64], end: &[f64]) -> Result<(), OcpError> {
+        let a = check_values("state guess start", self.nx(), start)?;
+        let b = check_values("state guess end", self.nx(), end)?;
+        self.state_guess = Some(Box::new(move |t, t_f| {
+            let s = (t / t_f).clamp(0.0, 1.0);
+            a.iter().zip(&b).map(|(a, b)| a + s * (b - a)).collect()
+        }));
+        Ok(())
+    }
+
+    /// Guesses the states and controls from a previous solution (e.g. on a coarser grid),
+    /// interpolated linearly in normalised time `t / T`.
+    pub fn set_guess_from(&mut self, previous: &Trajectory) {
+        let (p1, p2) = (previous.clone(), previous.clone());
+        self.state_guess = Some(Box::new(move |t, t_f| {
+            p1.states_at(t / t_f * p1.final_time)
+        }));
+        self.control_guess = Some(Box::new(move |t, t_f| {
+            p2.controls_at(t / t_f * p2.final_time)
+        }));
+    }
+}
+
+fn check_values(what: &str, n: usize, v: &[f64]) -> Result<Vec<f64>, OcpError> {
+    if v.len() != n {
+        return Err(OcpError::Size {
+            what: what.into(),
+            expected: n,
+            got: v.len(),
+        });
+    }
+    if let Some(i) = v.iter().position(|v| !v.is_finite()) {
+        return Err(OcpError::Invalid {
+            what: format!("{what}[{i}]"),
+            why: format!("{} is not finite", v[i]),
+        });
+    }
+    Ok(v.to_vec())
+}
+
+fn check_bounds(
+    what: &str,
+    n: usize,
+    lower: &[f64],
+    upper: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), OcpError> {
+    for (side, v) in [("lower", lower), ("upper", upper)] {
+        if v.len() != n {
+            return Err(OcpError::Size {
+                what: format!("{what} ({side})"),
+                expected: n,
+                got: v.len(),
+            });
+        }
+    }
+    for (i, (&l, &u)) in lower.iter().zip(upper).enumerate() {
+        if l.is_nan() || u.is_nan() || l > u {
+            return Err(OcpError::Invalid {
+                what: format!("{what}[{i}]"),
+                why: format!("[{l}, {u}] is not an interval"),
+            });
+        }
+    }
+    Ok((lower.to_vec(), upper.to_vec()))
+}
