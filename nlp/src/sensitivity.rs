@@ -155,7 +155,7 @@ impl ParametricSensitivity {
     /// Differentiates `problem` with respect to its parameters and compiles `∇²ₓₓL`,
     /// `∂g/∂x`, `∇²ₓₚL` and `∂g/∂p` as functions of `(x, p, λ)`.
     pub fn new(problem: &Problem) -> Result<Self, SensitivityError> {
-        let parts = problem.parts();
+        let parts = problem.parts()?;
         let (x, p) = (parts.variables, parts.parameters);
         if p.is_empty() {
             return Err(SensitivityError::NoParameters);
@@ -183,8 +183,8 @@ impl ParametricSensitivity {
             n: x.len(),
             m: g.len(),
             np: p.len(),
-            x_l: parts.lower.to_vec(),
-            x_u: parts.upper.to_vec(),
+            x_l: parts.lower.clone(),
+            x_u: parts.upper.clone(),
             g_l: parts.rows.iter().map(|r| r.lower).collect(),
             g_u: parts.rows.iter().map(|r| r.upper).collect(),
             hess: compile(&hess)?,

@@ -104,7 +104,7 @@ fn parameters_change_the_solution_without_recompiling() {
     let tr = ocp.transcribe(&method, 10).unwrap();
     let mut compiled = tr.compile().unwrap();
     let a = Ipm::default().solve(&mut compiled).unwrap();
-    compiled.set_parameter("weight", &[4.0]).unwrap();
+    compiled.set_value("weight", &[4.0]).unwrap();
     let b = Ipm::default().solve(&mut compiled).unwrap();
     let (ta, tb) = (tr.trajectory(&a).unwrap(), tr.trajectory(&b).unwrap());
     // A heavier state weight drives x to zero faster.
@@ -260,8 +260,11 @@ fn mistakes_are_reported() {
 
     let mut outside = lqr();
     outside.set_state_bounds(&[2.0], &[3.0]).unwrap(); // x(0) = 1 is outside
+                                                       // The fixed initial state is a single-variable row; it meets the bounds (and is
+                                                       // found disjoint from them) when simple bounds are detected, at compile time.
+    let outside = outside.transcribe(&m, 4).unwrap();
     assert!(matches!(
-        outside.transcribe(&m, 4),
+        outside.compile(),
         Err(OcpError::Build(BuildError::InvertedBounds { .. }))
     ));
     let mut guess = lqr();

@@ -31,7 +31,7 @@ fn finite_differences(
             let mut side = |s: f64| {
                 let mut q = p.to_vec();
                 q[j] += s * h;
-                compiled.set_parameter(name, &q).unwrap();
+                compiled.set_value(name, &q).unwrap();
                 let r = tight().solve_warm(compiled, sol).unwrap();
                 assert!(r.status.is_success(), "{:?}", r.status);
                 r
@@ -89,8 +89,8 @@ fn equality_constrained_example_of_sipopt() {
     // parametric_cpp): min ‖x‖² s.t. 6x₁ + 3x₂ + 2x₃ = p₁, p₂x₁ + x₂ − x₃ = 1, x ≥ 0, at
     // p = (5, 1), where x* = (62, 38, 2)/98 (bounds inactive).
     let mut pb = Problem::new();
-    let x = pb.variable("x", 3);
-    let p = pb.parameter("p", 2);
+    let x = pb.variable("x", 3).unwrap();
+    let p = pb.parameter("p", 2).unwrap();
     pb.set_value(&p, &[5.0, 1.0]).unwrap();
     pb.set_bounds(&x, 0.0, f64::INFINITY).unwrap();
     pb.minimize(x.sumsqr());
@@ -121,8 +121,8 @@ fn equality_constrained_example_of_sipopt() {
 #[test]
 fn active_inequality_and_bound_are_held_fixed() {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 4);
-    let p = pb.parameter("p", 2);
+    let x = pb.variable("x", 4).unwrap();
+    let p = pb.parameter("p", 2).unwrap();
     let pv = [1.0, 1.0];
     pb.set_value(&p, &pv).unwrap();
     pb.minimize(
@@ -156,7 +156,7 @@ fn active_inequality_and_bound_are_held_fixed() {
     // The first-order prediction is second-order accurate.
     let dp = [1e-3, -2e-3];
     compiled
-        .set_parameter("p", &[pv[0] + dp[0], pv[1] + dp[1]])
+        .set_value("p", &[pv[0] + dp[0], pv[1] + dp[1]])
         .unwrap();
     let moved = tight().solve_warm(&mut compiled, &sol).unwrap();
     let predicted = s.predict_x(&sol.x, &dp);
@@ -199,13 +199,13 @@ fn optimal_control_sensitivity_to_a_model_parameter() {
 #[test]
 fn bad_inputs_are_errors() {
     let mut pb = Problem::new();
-    let x = pb.variable("x", 1);
+    let x = pb.variable("x", 1).unwrap();
     pb.minimize(x[0].sq());
     assert!(matches!(
         ParametricSensitivity::new(&pb),
         Err(SensitivityError::NoParameters)
     ));
-    let p = pb.scalar_parameter("p");
+    let p = pb.scalar_parameter("p").unwrap();
     pb.set_value(&[p], &[2.0]).unwrap();
     pb.minimize((x[0] - p).sq());
     let mut compiled = pb.compile().unwrap();
@@ -227,8 +227,8 @@ fn bad_inputs_are_errors() {
     ));
     // A maximum (negative curvature) is not a KKT point of a minimisation: wrong inertia.
     let mut pb2 = Problem::new();
-    let y = pb2.variable("y", 2);
-    let q = pb2.scalar_parameter("q");
+    let y = pb2.variable("y", 2).unwrap();
+    let q = pb2.scalar_parameter("q").unwrap();
     pb2.set_value(&[q], &[0.0]).unwrap();
     pb2.minimize(-(y[0].sq()) + y[1].sq() + q * y[0]);
     let fake = Solution {
@@ -254,8 +254,8 @@ fn sensitivities_at_an_sqp_solution() {
     // The SQP's multipliers of inactive constraints are exactly zero; the same
     // sensitivities follow (compared with the interior point's at the same optimum).
     let mut pb = Problem::new();
-    let x = pb.variable("x", 2);
-    let p = pb.scalar_parameter("p");
+    let x = pb.variable("x", 2).unwrap();
+    let p = pb.scalar_parameter("p").unwrap();
     pb.set_value(&[p], &[1.0]).unwrap();
     pb.minimize((x[0] - 2.0 * p).sq() + (x[1] - p).sq() + x[0] * x[1]);
     pb.subject_to((x[0] + 2.0 * x[1]).le(1.0)).unwrap();
@@ -279,7 +279,7 @@ fn sensitivities_at_an_sqp_solution() {
 
     // At p = 1/2 the unconstrained minimiser (1, 0) lies exactly on x₀ + 2x₁ = 1 with a
     // zero multiplier: weakly active, and reported as such.
-    compiled.set_parameter("p", &[0.5]).unwrap();
+    compiled.set_value("p", &[0.5]).unwrap();
     let c = tight().solve(&mut compiled).unwrap();
     let sc = sens.compute(&c, &[0.5]).unwrap();
     assert_eq!(sc.weakly_active, vec!["g[0] upper".to_string()]);

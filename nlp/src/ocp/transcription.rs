@@ -75,9 +75,9 @@ impl Ocp {
             });
         }
         let mut pb = Problem::new();
-        let x = pb.variable_matrix("X", nx, n + 1);
+        let x = pb.variable_matrix("X", nx, n + 1)?;
         let u = if nu > 0 {
-            pb.variable_matrix("U", nu, n)
+            pb.variable_matrix("U", nu, n)?
         } else {
             Matrix::zeros(0, n)
         };
@@ -88,7 +88,7 @@ impl Ocp {
                 upper,
                 guess,
             } => {
-                let t = pb.scalar_variable("T");
+                let t = pb.scalar_variable("T")?;
                 pb.set_bounds(&[t], lower, upper)?;
                 pb.set_initial(&[t], &[guess])?;
                 t
@@ -102,7 +102,7 @@ impl Ocp {
                     why: format!("the names {RESERVED:?} are used by the transcription"),
                 });
             }
-            let p = pb.parameter(name, values.len());
+            let p = pb.parameter(name, values.len())?;
             pb.set_value(&p, values)?;
             p_all.extend_from_slice(&p);
         }
@@ -277,7 +277,7 @@ impl Stage<'_> {
     /// and the collocation-state variables.
     fn collocation(&self, pb: &mut Problem, c: &Collocation) -> Result<(Expr, Matrix), OcpError> {
         let (nx, n, d) = (self.ocp.nx(), self.u.ncols(), c.degree());
-        let xc = pb.variable_matrix("Xc", nx, n * d);
+        let xc = pb.variable_matrix("Xc", nx, n * d)?;
         for i in 0..nx {
             let (lo, hi) = (self.ocp.state_bounds.0[i], self.ocp.state_bounds.1[i]);
             pb.set_bounds(&xc.row(i)?, lo, hi)?;

@@ -522,7 +522,7 @@ impl Problem {
     }
 
     /// The pieces [`Compiled::new`] needs, after simple bound detection.
-    fn parts(&self) -> Result<ProblemParts<'_>, BuildError> {
+    pub(crate) fn parts(&self) -> Result<ProblemParts<'_>, BuildError> {
         let layout = self.layout()?;
         Ok(ProblemParts {
             variables: &self.variables,
