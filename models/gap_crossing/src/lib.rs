@@ -21,10 +21,11 @@ pub mod export;
 pub mod gait;
 pub mod model;
 pub mod plan;
+pub mod reach;
 pub mod render;
 pub mod scenario;
 pub mod schedule_search;
 pub mod solve;
+pub mod status;
 pub mod sweep;
-
 pub mod terrain;

@@ -14,13 +14,16 @@
 //!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
 //!
 //!   With the SQP back end, 2 and 3 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
+use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::convergence::ResidualProbe;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
-use crate::scenario::{Foot, Gait, Scenario};
+use crate::reach::{self, Unreachable};
+use crate::scenario::{dist2, Biped, Foot, Gait, Scenario};
 use crate::schedule_search::{self, StanceSolver};
-use crate::terrain::{GapTerrain, Terrain};
+use crate::status::{GoalShortfall, PlanStatus};
+use crate::terrain::{self, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
     BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError, Sqp,
@@ -146,7 +149,10 @@ pub struct Phase {
 /// The result of planning.
 #[derive(Clone, Debug)]
 pub struct Outcome {
-    /// The solution file (the spec's schema).
+    /// The verdict: solved, or why not ([`decide`]).
+    pub status: PlanStatus,
+    /// The solution file (the spec's schema); its `solver.status` is the word of
+    /// `status` ([`crate::status::StatusKind::word`]). When not solved, the best plan found.
     pub file: SolutionFile,
     /// The solver runs, in order.
     pub phases: Vec<Phase>,
@@ -292,9 +298,10 @@ fn run(
     Ok(record(solved, settings, phases))
 }
 
-/// Plans scenario `s` (its `gait` field chooses the formulation) on the spec's gap terrain.
+/// Plans scenario `s` (its `gait` field chooses the formulation) on its terrain
+/// ([`terrain::of`]).
 pub fn plan(s: &Scenario, settings: &Settings) -> Result<Outcome, PlanningError> {
-    plan_on(s, &GapTerrain { gap: s.gap }, settings)
+    plan_on(s, &*terrain::of(s), settings)
 }
 
 /// Plans scenario `s` on any terrain.
@@ -326,17 +333,70 @@ pub fn plan_on(
             Backend::Sqp => "sqp",
         }
         .into(),
-        status: status_name(last.solution.status).into(),
+        status: String::new(),
         iterations: phases.iter().map(|p| p.iterations).sum(),
         objective: plan.cost(s),
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
     };
+    let mut file = SolutionFile::new(s.clone(), solver, plan);
+    let status = decide(s, last.solution.status, &file);
+    file.solver.status = status.kind().word().into();
     Ok(Outcome {
-        file: SolutionFile::new(s.clone(), solver, plan),
+        status,
+        file,
         phases,
         chosen: last.phase,
     })
+}
+
+/// The verdict on a plan of scenario `s` returned by a solver with `solver_status`, in
+/// this order: a geometric proof that the goal is unreachable ([`reach::uncrossable`]:
+/// gap not crossable; n_step below [`reach::stances_needed`]: goal not reached); the
+/// solver's failure; the independent checker's violations of (2)–(11), the keep-out and
+/// the start; a final CoM farther than [`GOAL_TOL`] (0.05 m) from its goal; else solved.
+pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanStatus {
+    if let Some(c) = reach::uncrossable(s) {
+        return PlanStatus::GapNotCrossable(c);
+    }
+    let bound = reach::stances_needed(s);
+    let distance = file.stances.last().map_or(f64::INFINITY, |last| {
+        Biped::ALL
+            .iter()
+            .map(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt())
+            .fold(0.0, f64::max)
+    });
+    let shortfall = |bound: Unreachable| {
+        PlanStatus::GoalNotReached(GoalShortfall {
+            n_step: s.n_step,
+            distance,
+            guess_needs: gait::crawl_stances_to_goal(s, GOAL_TOL, 4 * bound.needed + 100),
+            bound,
+        })
+    };
+    if s.n_step < bound.needed {
+        return shortfall(bound);
+    }
+    if !solver_status.is_success() {
+        return PlanStatus::SolverFailed(solver_status);
+    }
+    let report = check::check_with(
+        file,
+        &check::Options {
+            goal: GoalCheck::Skip,
+            ..check::Options::default()
+        },
+    );
+    if !report.ok() {
+        return PlanStatus::CheckFailed {
+            violations: report.violations.len(),
+            labels: report.equations(),
+        };
+    }
+    if distance.is_nan() || distance > GOAL_TOL {
+        return shortfall(bound);
+    }
+    PlanStatus::Solved
 }
 
 /// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
@@ -416,7 +476,8 @@ fn free_gait(
     Ok(best)
 }
 
-/// The status word written to the solution file (`solved` for success).
+/// The solver's own status as a word (for logs and examples; the solution file holds
+/// the plan's `status::StatusKind` word).
 pub fn status_name(status: Status) -> &'static str {
     match status {
         Status::SolveSucceeded => "solved",
