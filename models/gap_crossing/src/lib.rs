@@ -17,6 +17,7 @@
 
 pub mod check;
 pub mod convergence;
+pub mod crossing;
 pub mod export;
 pub mod gait;
 pub mod model;

@@ -199,10 +199,11 @@ mod tests {
         assert!(c.to_string().contains("0.3100"), "{c}");
         s.gap.max = 2.5 + 0.299 - 0.06;
         assert_eq!(uncrossable(&s), None);
-        s.gap.max = 2.5 + 0.3 - 0.06;
-        assert!(
-            uncrossable(&s).is_some(),
-            "keep-out = reach counts as not crossable"
-        );
+        // Keep-out exactly as wide as the reach (numbers exact in binary: 2.75 − 2.5 =
+        // 0.25 = √0.0625): not crossable, as the spec says.
+        s.gap.max = 2.75;
+        s.gap.margin = 0.0;
+        s.step_radius_sq = 0.0625;
+        assert!(uncrossable(&s).is_some(), "keep-out = reach counts as not crossable");
     }
 }

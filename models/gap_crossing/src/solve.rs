@@ -16,6 +16,7 @@
 //!   With the SQP back end, 2 and 3 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::convergence::ResidualProbe;
+use crate::crossing;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
@@ -35,6 +36,9 @@ use std::time::Instant;
 /// Largest number of schedule-search rounds (each: evaluate every adjacent swap, then
 /// one solve of the improved schedule) of the free gait.
 pub const SEARCH_ROUNDS: usize = 4;
+
+/// Largest number of crossing-search rounds ([`crate::crossing`]).
+pub const CROSSING_ROUNDS: usize = 4;
 
 /// Initial barrier parameter of the schedule search's re-solves (default 0.1): on the
 /// lateral-goal test scenario, 161 iterations over its rounds instead of 238, same plans.
@@ -315,15 +319,18 @@ pub fn plan_on(
     let crawl = gait::crawl_schedule(s.n_step);
     let guess = gait::crawl(s);
     let last = match s.gait {
-        Gait::Crawl => run(
-            s,
-            terrain,
-            &crawl,
-            &guess,
-            settings,
-            &mut phases,
-            "crawl gait",
-        )?,
+        Gait::Crawl => {
+            let first = run(
+                s,
+                terrain,
+                &crawl,
+                &guess,
+                settings,
+                &mut phases,
+                "crawl gait",
+            )?;
+            crossing_search(s, terrain, settings, first, &mut phases)?
+        }
         Gait::Free => free_gait(s, terrain, settings, &mut phases)?,
     };
     let plan = Plan::from_flat(s, &last.flat)?;
@@ -444,6 +451,7 @@ fn free_gait(
     if !best.solution.status.is_success() {
         return Ok(best);
     }
+    best = crossing_search(s, terrain, &candidate, best, phases)?;
     // Schedule search from the better plan: each round's proposal satisfies every
     // equation of its schedule with a lower cost; the re-solve frees every variable.
     let search_settings = candidate.warm();
@@ -472,6 +480,71 @@ fn free_gait(
             break;
         }
         best = next;
+    }
+    Ok(best)
+}
+
+/// Whether the final CoMs of a flat plan are within [`GOAL_TOL`] of their goals.
+fn reaches_goal(s: &Scenario, flat: &[f64]) -> bool {
+    Plan::from_flat(s, flat).is_ok_and(|p| {
+        p.stances.last().is_some_and(|last| {
+            Biped::ALL
+                .iter()
+                .all(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt() <= GOAL_TOL)
+        })
+    })
+}
+
+/// The crossing search ([`crate::crossing`]) from a solved run: each round solves, in
+/// parallel, every candidate in which one foot crosses a keep-out zone one move earlier,
+/// and keeps the best that succeeds with a lower objective (and reaches the goal when
+/// `best` does), for up to [`CROSSING_ROUNDS`] rounds.
+fn crossing_search(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    settings: &Settings,
+    mut best: Run,
+    phases: &mut Vec<Phase>,
+) -> Result<Run, PlanningError> {
+    use rayon::prelude::*;
+    for round in 1..=CROSSING_ROUNDS {
+        if !best.solution.status.is_success() {
+            break;
+        }
+        let plan = Plan::from_flat(s, &best.flat)?;
+        let candidates = crossing::earlier_crossings(s, terrain, &plan, &best.schedule);
+        if candidates.is_empty() {
+            break;
+        }
+        let solved: Vec<Result<Solved, PlanningError>> = candidates
+            .par_iter()
+            .map(|c| {
+                solve_scheduled(
+                    s,
+                    terrain,
+                    &best.schedule,
+                    &c.plan.to_flat(),
+                    settings,
+                    &format!(
+                        "crossing search {round}: {} crosses at transition {}",
+                        c.foot,
+                        c.transition + 1
+                    ),
+                )
+            })
+            .collect();
+        let needs_goal = reaches_goal(s, &best.flat);
+        let mut improved = false;
+        for r in solved {
+            let next = record(r?, settings, phases);
+            if next.beats(&best) && (!needs_goal || reaches_goal(s, &next.flat)) {
+                best = next;
+                improved = true;
+            }
+        }
+        if !improved {
+            break;
+        }
     }
     Ok(best)
 }
