@@ -204,6 +204,9 @@ mod tests {
         s.gap.max = 2.75;
         s.gap.margin = 0.0;
         s.step_radius_sq = 0.0625;
-        assert!(uncrossable(&s).is_some(), "keep-out = reach counts as not crossable");
+        assert!(
+            uncrossable(&s).is_some(),
+            "keep-out = reach counts as not crossable"
+        );
     }
 }
