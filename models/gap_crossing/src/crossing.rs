@@ -80,9 +80,7 @@ pub fn earlier_crossings(
                 continue;
             }
             let mut new_holds = holds.clone();
-            for k in m - 1..holds.len() - 1 {
-                new_holds[k] = holds[k + 1];
-            }
+            new_holds[m - 1..holds.len() - 1].copy_from_slice(&holds[m..]);
             let mut candidate = plan.clone();
             let first = moves[m - 2] + 1; // the stance after the earlier crossing move
             for (k, st) in candidate.stances.iter_mut().enumerate().skip(first) {

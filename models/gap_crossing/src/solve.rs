@@ -1,4 +1,5 @@
-//! From a scenario to a checked-ready plan: guess, build, compile, solve, read back.
+//! From a scenario to a checked-ready plan: guess, build, compile, solve, read back,
+//! and the verdict ([`decide`]: solved, or why not, as a [`PlanStatus`]).
 //!
 //! - `crawl` gait: one solve of the scheduled problem (order BR, FR, BL, FL), from the
 //!   crawl-gait heuristic.
@@ -8,12 +9,14 @@
 //!   1. the crawl schedule, solved as above (so the free gait is never worse than it);
 //!   2. the biped-pair schedule FR, FL, BR, BL ([`gait::PAIR_ORDER`]), solved from the
 //!      same heuristic with that order, on a second thread alongside 1;
-//!   3. the schedule search ([`crate::schedule_search`]) from the better of 1 and 2:
+//!   3. the crossing search ([`crate::crossing`], [`CROSSING_ROUNDS`] rounds) from the
+//!      better of 1 and 2, which the crawl gait also runs after its solve; then
+//!   4. the schedule search ([`crate::schedule_search`]) from its result:
 //!      adjacent swaps of the schedule whose exact per-stance evaluation lowers the
 //!      cost, each round re-solved with every variable free from the improved plan,
 //!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
 //!
-//!   With the SQP back end, 2 and 3 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
+//!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::convergence::ResidualProbe;
 use crate::crossing;

@@ -420,12 +420,12 @@ impl HeightMap {
             let (mut row, mut drow) = (Expr::zero(), Expr::zero());
             for (i, k, d) in &kx {
                 let z = self.node(*i, j);
-                row = row + z * *k;
-                drow = drow + z * *d;
+                row += z * *k;
+                drow += z * *d;
             }
-            h = h + row * ky;
-            hx = hx + drow * ky;
-            hy = hy + row * dky;
+            h += row * ky;
+            hx += drow * ky;
+            hy += row * dky;
         }
         (h, [hx, hy])
     }

@@ -169,7 +169,7 @@ fn start_violating_the_equations_is_rejected() {
     // A foot in the widened gap (the gap moved under the front feet).
     let e = rejected("[gap]\nmin = 1.98\nmax = 2.1\ndepth = 0.0");
     assert!(
-        e.contains("widened gap") && e.contains("start.feet.FR") && e.contains("FL"),
+        e.contains("keep-out") && e.contains("start.feet.FR") && e.contains("FL"),
         "{e}"
     );
 }
