@@ -250,3 +250,101 @@ fn auto_goal_check_rejects_a_plan_stopping_before_a_crossable_gap() {
         }
     }
 }
+
+/// `sweep` counts each outcome separately: goals 0.5 m (B) and 1.2 m (F) ahead, gap
+/// keep-out 0.16 m (crossable) or 0.41 m (not), 3 or 15 stances (the lower bound is 9).
+#[test]
+fn sweep_counts_each_outcome() {
+    let dir = tmp("sweep");
+    let grid = dir.join("grid.toml");
+    std::fs::write(
+        &grid,
+        "[base]\ngait = \"crawl\"\ngoal = { B = [0.5, 0.5, 0.5], F = [3.2, 0.5, 0.5] }\n\
+         [axes]\ngap.max = [2.35, 2.6]\nn_step = [3, 15]\n",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = run(&[
+        "sweep",
+        "--grid",
+        grid.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("outcomes: solved 1, gap_not_crossable 2, goal_not_reached 1"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("sweep.json")).unwrap())
+            .unwrap();
+    let by = &json["summary"]["by_status"];
+    assert_eq!(
+        (by["solved"].as_u64(), by["gap_not_crossable"].as_u64()),
+        (Some(1), Some(2))
+    );
+    assert_eq!(by["goal_not_reached"].as_u64(), Some(1));
+    let csv = std::fs::read_to_string(out_dir.join("sweep.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .nth(3)
+            .unwrap()
+            .starts_with("2,2.6,3,gap_not_crossable,"),
+        "{csv}"
+    );
+}
+
+/// Each terrain kind is drawn in plan.svg: the plan of every example is rendered and
+/// its kind's marks are present (stones: one sand-coloured box per stone; gaps: one
+/// dark band per gap; the step's edge label; the height map's shading (cells outside
+/// the figure are clipped: 960 of its 60 × 24 cells are drawn for hills.toml) and caption).
+#[test]
+fn every_terrain_kind_is_drawn() {
+    use gap_crossing::plan::SolverInfo;
+    for (file, marks) in [
+        (
+            "default.toml",
+            vec![
+                ("gap x ∈ (2.25, 2.35)", 1),
+                ("#7f1d1d\" fill-opacity=\"0.45\"", 1),
+            ],
+        ),
+        (
+            "gaps.toml",
+            vec![("2 gaps", 1), ("#7f1d1d\" fill-opacity=\"0.45\"", 2)],
+        ),
+        ("step.toml", vec![("step +0.1 m", 2)]),
+        (
+            "stones.toml",
+            vec![("8 stepping stones", 1), ("fill=\"#e8dcc0\"", 8)],
+        ),
+        (
+            "hills.toml",
+            vec![
+                ("height map hills.csv (16 × 5 nodes", 1),
+                ("fill=\"#8c6d3f\"", 500),
+            ],
+        ),
+    ] {
+        let s = Scenario::load(&examples().join(file)).unwrap();
+        let plan = gap_crossing::gait::crawl_plan(&s);
+        let info = SolverInfo {
+            name: "guess".into(),
+            status: "guess".into(),
+            iterations: 0,
+            objective: 0.0,
+            max_constraint_violation: 0.0,
+            solve_seconds: 0.0,
+        };
+        let svg = gap_crossing::render::plan_svg(&SolutionFile::new(s, info, plan));
+        for (mark, n) in marks {
+            let got = svg.matches(mark).count();
+            assert!(
+                got >= n,
+                "{file}: `{mark}` {got} times, expected at least {n}"
+            );
+        }
+    }
+}
