@@ -17,6 +17,11 @@ fn solve(solver: &str, dir: &Path) -> SolutionFile {
             "crawl",
             "--set",
             "n_step=12",
+            // Goals 0.5 m ahead (the front feet cross the gap): reachable in 12 stances.
+            "--set",
+            "goal.B=[0.5, 0.5, 0.5]",
+            "--set",
+            "goal.F=[2.5, 0.5, 0.5]",
             "--out",
             dir.to_str().unwrap(),
         ])
