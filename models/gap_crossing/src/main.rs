@@ -200,6 +200,8 @@ fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
         None => Scenario::default(),
     };
     s.apply_overrides(&a.set)?;
+    // A height map's CSV named by `--set` is read relative to the working directory.
+    s.load_terrain_files(Path::new("."))?;
     if let Some(g) = a.gait {
         s.gait = match g {
             GaitArg::Free => Gait::Free,

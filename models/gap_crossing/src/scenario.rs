@@ -684,6 +684,10 @@ fn merge_terrain(base: &mut Value, patch: Value) -> Result<(), ScenarioError> {
     let same_kind = p.get("kind").is_none_or(|k| base.get("kind") == Some(k));
     match base {
         Value::Object(b) if same_kind => {
+            // A new CSV file: its heights are read again.
+            if p.contains_key("file") && !p.contains_key("heights") {
+                b.remove("heights");
+            }
             for (k, v) in p {
                 b.insert(k, v);
             }
@@ -711,14 +715,13 @@ impl Scenario {
     pub fn from_value(v: Value) -> Result<Scenario, ScenarioError> {
         let mut base = serde_json::to_value(Scenario::default()).expect("defaults serialise");
         merge(&mut base, v, "")?;
-        serde_json::from_value(base).map_err(|e| {
-            let m = e.to_string();
-            ScenarioError::Value(if m.contains("kind") || m.contains("variant") {
-                format!("terrain: {m}")
-            } else {
-                m
-            })
-        })
+        // The terrain table is replaced, not merged, so serde checks it: its errors are
+        // prefixed with its name.
+        if let Some(t) = base.get("terrain") {
+            serde_json::from_value::<TerrainSpec>(t.clone())
+                .map_err(|e| ScenarioError::Value(format!("terrain: {e}")))?;
+        }
+        serde_json::from_value(base).map_err(|e| ScenarioError::Value(e.to_string()))
     }
 
     /// Parses scenario text in the given format (`"toml"` or `"json"`); missing fields take
