@@ -39,9 +39,10 @@ pub enum GoalCheck {
     Auto,
     /// Always required.
     Required,
-    /// Never checked: for inspecting the other equations of a partial plan (a guess, a
-    /// plan of a too-short horizon). The summary says "goal NOT checked", and the
-    /// planner never calls a plan solved on this basis (it always requires the goal).
+    /// The goal distance is not checked (for inspecting the other equations of a partial
+    /// plan: a guess, a plan of a too-short horizon; the summary says "goal NOT
+    /// checked"), but a plan that stops before a crossable keep-out zone is still
+    /// rejected (label `cross`, [`reach::stopped_before_crossable`]).
     Skip,
 }
 
@@ -422,6 +423,20 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
                         amount: d - GOAL_TOL,
                     });
                 }
+            }
+        }
+    }
+    if opts.goal == GoalCheck::Skip {
+        // Skipping the goal never forgives a plan that stops before a crossable gap.
+        if let Some(last) = st.last() {
+            for (i, d) in reach::stopped_before_crossable(s, &last.feet) {
+                out.push(Violation {
+                    equation: "cross".into(),
+                    name: "foot stops before a crossable keep-out zone its goal lies beyond; distance from the goal's region (m)".into(),
+                    stance: st.len(),
+                    foot: Some(i.name().to_string()),
+                    amount: d,
+                });
             }
         }
     }

@@ -171,6 +171,38 @@ pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
     None
 }
 
+/// Feet of a plan's last stance `last` that stop before a crossable keep-out zone: the
+/// allowed region nearest the foot's goal (its start moved with its biped's CoM
+/// displacement) is reachable from its start by steps shorter than the reach, n_step is
+/// not below [`stances_needed`], and the foot stands in another allowed region. Each with
+/// its horizontal distance from that region (m).
+pub fn stopped_before_crossable(s: &Scenario, last: &crate::scenario::Feet) -> Vec<(Foot, f64)> {
+    if s.n_step < stances_needed(s).needed {
+        return Vec::new();
+    }
+    let regions = terrain::of(s).regions();
+    let reach = s.step_radius_sq.sqrt();
+    let goals = crate::gait::foot_goals(s);
+    let mut out = Vec::new();
+    for i in Foot::ALL {
+        let (p, g, f) = (s.start.feet.get(i), goals.get(i), last.get(i));
+        let Some(target) = (0..regions.len()).min_by(|&a, &b| {
+            regions[a]
+                .distance_to(g[0], g[1])
+                .total_cmp(&regions[b].distance_to(g[0], g[1]))
+        }) else {
+            continue;
+        };
+        let d = regions[target].distance_to(f[0], f[1]);
+        // A foot in the keep-out itself is the checker's `gap` finding, not this one.
+        let standing = regions.iter().any(|r| r.contains(f[0], f[1], 1e-6));
+        if standing && d > 1e-6 && reachable(&regions, p[0], p[1], reach).contains(&target) {
+            out.push((i, d));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -348,3 +348,36 @@ fn every_terrain_kind_is_drawn() {
         }
     }
 }
+
+/// `check --goal skip` does not check the goal distance but still rejects a plan that
+/// stops before a crossable gap (label `cross`), and accepts the same plan when the gap
+/// is not crossable or the horizon too short.
+#[test]
+fn skip_goal_check_still_rejects_stopping_before_a_crossable_gap() {
+    let dir = tmp("skip");
+    for (name, sets, code) in [
+        ("crossable", vec!["gap.max=2.489"], Some(1)),
+        ("wide", vec!["gap.max=2.75"], Some(0)),
+        ("short", vec!["n_step=20"], Some(0)),
+    ] {
+        let d = dir.join(name);
+        let mut args = vec!["guess", "--kind", "standing", "--out", d.to_str().unwrap()];
+        for s in &sets {
+            args.extend(["--set", s]);
+        }
+        assert!(run(&args).status.success());
+        let out = run(&[
+            "check",
+            d.join("guess.json").to_str().unwrap(),
+            "--goal",
+            "skip",
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), code, "{name}: {stdout}");
+        assert_eq!(
+            stdout.contains("cross"),
+            code == Some(1),
+            "{name}: {stdout}"
+        );
+    }
+}
