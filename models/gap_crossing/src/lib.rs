@@ -30,3 +30,4 @@ pub mod solve;
 pub mod status;
 pub mod sweep;
 pub mod terrain;
+pub mod terrain_spec;

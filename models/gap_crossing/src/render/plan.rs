@@ -259,6 +259,43 @@ fn terrain_top(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain) {
     }
 }
 
+/// Side view of the keep-out: pale red where no allowed region holds (x, y) along the
+/// profile's line (stones: each stone as a block at z = 0 instead).
+fn terrain_side(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain, tx: &[f64]) {
+    let band = |svg: &mut String, a: f64, b: f64| {
+        let _ = writeln!(
+            svg,
+            r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#d62728" fill-opacity="0.12"/>"##,
+            p.px(a),
+            p.y0,
+            (p.px(b) - p.px(a)).max(0.5),
+            p.h()
+        );
+    };
+    if let TerrainSpec::Stones { stones } = &s.terrain {
+        for b in stones {
+            rect(svg, p, [b[0], b[1]], [-0.03, 0.0], r##"fill="#8c7a55""##);
+        }
+        return;
+    }
+    let (y, regions) = (side_y(s), t.regions());
+    let mut out_from: Option<f64> = None;
+    for &x in tx {
+        let out = !regions.iter().any(|r| r.contains(x, y, 0.0));
+        match (out, out_from) {
+            (true, None) => out_from = Some(x),
+            (false, Some(a)) => {
+                band(svg, a, x);
+                out_from = None;
+            }
+            _ => {}
+        }
+    }
+    if let (Some(a), Some(&b)) = (out_from, tx.last()) {
+        band(svg, a, b);
+    }
+}
+
 /// Lowest and highest terrain height along the side view's line (m), for height maps
 /// sampled over the grid.
 fn terrain_range(s: &Scenario, t: &dyn Terrain) -> (f64, f64) {
@@ -395,16 +432,6 @@ pub fn plan_svg(file: &SolutionFile) -> String {
     // ---- Top view.
     top.axes(&mut svg, "x (m)", "y (m)", "Top view (x–y)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-top)">"##);
-    let band = |svg: &mut String, p: &Panel, a: f64, b: f64, fill: &str, op: f64| {
-        let _ = writeln!(
-            svg,
-            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{fill}" fill-opacity="{op}"/>"#,
-            p.px(a),
-            p.y0,
-            (p.px(b) - p.px(a)).max(0.5),
-            p.h()
-        );
-    };
     terrain_top(&mut svg, &top, s, &*terrain);
     // Foot trails (thin grey) and CoM paths.
     for i in Foot::ALL {
@@ -479,39 +506,9 @@ pub fn plan_svg(file: &SolutionFile) -> String {
     // ---- Side view.
     side.axes(&mut svg, "x (m)", "z (m)", "Side view (x–z)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-side)">"##);
-    // Keep-out along the profile's line: x where no allowed region holds (x, y).
     let y_side = side_y(s);
-    let regions = terrain.regions();
     let tx = terrain_xs(s, xr.0, xr.1);
-    let mut out_from: Option<f64> = None;
-    for (k, &x) in tx.iter().enumerate() {
-        let out = !regions.iter().any(|r| r.contains(x, y_side, 0.0))
-            && !matches!(s.terrain, TerrainSpec::Stones { .. });
-        match (out, out_from) {
-            (true, None) => out_from = Some(x),
-            (false, Some(a)) => {
-                band(&mut svg, &side, a, x, "#d62728", 0.12);
-                out_from = None;
-            }
-            _ => {}
-        }
-        if k + 1 == tx.len() {
-            if let Some(a) = out_from {
-                band(&mut svg, &side, a, x, "#d62728", 0.12);
-            }
-        }
-    }
-    if let TerrainSpec::Stones { stones } = &s.terrain {
-        for b in stones {
-            rect(
-                &mut svg,
-                &side,
-                [b[0], b[1]],
-                [-0.03, 0.0],
-                r##"fill="#8c7a55""##,
-            );
-        }
-    }
+    terrain_side(&mut svg, &side, s, &*terrain, &tx);
     let mut d = format!("M{:.1},{:.1}", side.px(xr.0), side.py(zr.0));
     for &x in &tx {
         let _ = write!(
