@@ -381,3 +381,22 @@ fn skip_goal_check_still_rejects_stopping_before_a_crossable_gap() {
         );
     }
 }
+
+/// The spec's start tolerance: a 3 m deep gap at the default position lowers the ground
+/// under the front start feet by 1.1e-6 m (> 1e-6, ≤ 1e-5): the scenario is accepted,
+/// solved, and the checker accepts the start feet; 2e-5 m off is rejected.
+#[test]
+fn start_feet_may_sit_1e5_off_the_terrain() {
+    let mut s = Scenario::default();
+    s.gap.depth = 3.0;
+    s.gait = Gait::Crawl;
+    let h = s.gap.height(2.0);
+    assert!(h.abs() > 1e-6 && h.abs() < 1e-5, "{h}");
+    s.validate().unwrap();
+    let o = solve::plan(&s, &Settings::default()).unwrap();
+    assert!(o.status.is_solved(), "{}", o.status);
+    let mut off = Scenario::default();
+    off.start.feet.br[2] = 2e-5;
+    let e = off.validate().unwrap_err().to_string();
+    assert!(e.contains("(3)") && e.contains("start.feet.BR"), "{e}");
+}
