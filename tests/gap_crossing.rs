@@ -3,7 +3,8 @@
 //! independent checker (`check::check`), which must report zero violations.
 //!
 //! Every scenario asserts, in each gait mode:
-//! - solver status `solved`;
+//! - status `solved` (every equation holds and the goal is reached), or, for a horizon
+//!   too short to reach the goal, `goal_not_reached`;
 //! - the checker's report has no violation (equations (2)–(11), the widened gap, the
 //!   start, the goals when n_step allows them);
 //! - whether the goals were required (the checker's "when n_step allows it") is what the
@@ -19,7 +20,8 @@ use gap_crossing::check::{self, Report};
 use gap_crossing::plan::SolutionFile;
 use gap_crossing::scenario::{Foot, Gait, Scenario};
 use gap_crossing::solve::{self, Settings};
-use gap_crossing::terrain::{StepTerrain, Terrain};
+use gap_crossing::status::StatusKind;
+use gap_crossing::terrain;
 use std::time::Instant;
 
 /// The default scenario with `--set`-style overrides.
@@ -31,6 +33,7 @@ fn scenario(overrides: &[&str]) -> Scenario {
 }
 
 struct Solved {
+    status: StatusKind,
     file: SolutionFile,
     report: Report,
     seconds: f64,
@@ -44,6 +47,7 @@ fn solve_in(s: &Scenario, gait: Gait) -> Solved {
     let seconds = started.elapsed().as_secs_f64();
     let report = check::check(&outcome.file);
     Solved {
+        status: outcome.status.kind(),
         file: outcome.file,
         report,
         seconds,
@@ -66,10 +70,12 @@ fn both_gaits(name: &str, s: Scenario, goal_required: bool) {
         );
     }
     for (gait, r) in [("crawl", &crawl), ("free", &free)] {
-        assert_eq!(
-            r.file.solver.status, "solved",
-            "{name}, {gait} gait: solver status"
-        );
+        let expected = if goal_required {
+            StatusKind::Solved
+        } else {
+            StatusKind::GoalNotReached
+        };
+        assert_eq!(r.status, expected, "{name}, {gait} gait: status");
         assert!(
             r.report.ok(),
             "{name}, {gait} gait: checker found violations:\n{}",
@@ -206,15 +212,14 @@ fn long_horizon_120() {
     both_gaits("n_step 120", scenario(&["n_step=120"]), true);
 }
 
-/// A widened gap longer than the step radius cannot be crossed: the planner keeps every
-/// foot on the near side (its crawl guess stops before the gap), and since the crawl
-/// heuristic cannot reach the goals, the checker does not require them. This documents
-/// that such a "solved" plan is a robot that stops at the gap.
+/// A widened gap at least as long as the step reach cannot be crossed: the status is
+/// `gap_not_crossable` (a geometric certificate), the checker's `auto` mode does not
+/// require the goals (the same certificate), and no foot crosses.
 #[test]
 fn uncrossable_gap_is_not_crossed() {
     let s = scenario(&["gap.min=2.5", "gap.max=2.75", "gait=crawl"]);
     let r = solve_in(&s, Gait::Crawl);
-    assert_eq!(r.file.solver.status, "solved");
+    assert_eq!(r.status, StatusKind::GapNotCrossable);
     assert!(r.report.ok(), "{}", r.report);
     assert!(!r.report.goal_checked);
     let (lo, hi) = s.gap.keep_out();
@@ -226,78 +231,32 @@ fn uncrossable_gap_is_not_crossed() {
     }
 }
 
-/// The model is written against the `Terrain` abstraction: a 0.1 m step up at x = 2.3,
-/// solved with `solve::plan_on`. The checker knows only the scenario's gap terrain, so
-/// the terrain equations are checked here: every foot on the step terrain, outside its
-/// keep-out zone, and the feet end up on the step.
+/// A 0.1 m step up at x = 2.3 chosen in the scenario (`terrain.kind = "step"`): solved
+/// in both gaits; the checker (which evaluates the scenario's terrain) accepts the plan,
+/// and every foot ends on the step, 0.1 m up.
 #[test]
-fn step_terrain_through_plan_on() {
-    let step = StepTerrain {
-        edge: 2.3,
-        rise: 0.1,
-        steepness: 1e6,
-        margin: 0.04,
-    };
-    // The scenario's gap (flat, depth 0) has the step's keep-out zone, so the crawl guess
-    // steps over the edge; the goal CoMs are 0.1 m higher, on the step.
-    let mut s = scenario(&[
-        "gap.depth=0",
-        "gap.min=2.29",
-        "gap.max=2.31",
-        "gap.margin=0.03",
+fn step_terrain_from_the_scenario() {
+    let s = scenario(&[
+        "terrain={kind=\"step\", edge=2.3, rise=0.1, steepness=1e6, margin=0.04}",
         "goal.B=[3.0, 0.5, 0.6]",
         "goal.F=[5.0, 0.5, 0.6]",
     ]);
-    let (a, b) = (s.gap.keep_out(), step.keep_out()[0]);
-    assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12);
+    let step = terrain::of(&s);
     for gait in [Gait::Crawl, Gait::Free] {
-        s.gait = gait;
-        let started = Instant::now();
-        let outcome = solve::plan_on(&s, &step, &Settings::default()).expect("plans");
-        let file = &outcome.file;
+        let r = solve_in(&s, gait);
         println!(
             "step terrain {gait:<5}: {} objective {:.6e}, {} iterations, {:.2} s",
-            file.solver.status,
-            file.solver.objective,
-            file.solver.iterations,
-            started.elapsed().as_secs_f64()
+            r.status, r.file.solver.objective, r.file.solver.iterations, r.seconds
         );
-        assert_eq!(file.solver.status, "solved", "{gait} gait");
-        let (lo, hi) = step.keep_out()[0];
-        for (k, st) in file.stances.iter().enumerate() {
-            for i in Foot::ALL {
-                let p = st.feet.get(i);
-                let h = step.height_at(p[0], p[1]);
-                assert!(
-                    (p[2] - h).abs() <= 1e-6,
-                    "{gait}: stance {}, foot {i} at z = {} but the step is at {h}",
-                    k + 1,
-                    p[2]
-                );
-                // 1e-6: the checker's tolerance for the gap's keep-out.
-                assert!(
-                    p[0] <= lo + 1e-6 || p[0] >= hi - 1e-6,
-                    "{gait}: stance {}, foot {i} at x = {} is on the edge",
-                    k + 1,
-                    p[0]
-                );
-            }
-        }
-        let last = file.stances.last().unwrap();
-        for i in Foot::ALL {
+        assert_eq!(r.status, StatusKind::Solved, "{gait} gait");
+        assert!(r.report.ok() && r.report.goal_checked, "{}", r.report);
+        for p in r.file.stances.last().unwrap().feet.to_array() {
+            assert!(p[0] >= 2.34 && (p[2] - step.height_at(p[0], p[1])).abs() < 1e-6);
             assert!(
-                last.feet.get(i)[0] >= hi,
-                "{gait}: foot {i} not on the step"
+                (p[2] - 0.1).abs() < 1e-5,
+                "foot at z = {} not on the step",
+                p[2]
             );
         }
-        // Everything the checker verifies that does not depend on the terrain holds: its
-        // only complaints are (3) (feet at the step's height, not the flat gap terrain's).
-        let report = check::check(file);
-        let others: Vec<_> = report
-            .violations
-            .iter()
-            .filter(|v| v.equation != "(3)")
-            .collect();
-        assert!(others.is_empty(), "{gait}: {others:#?}");
     }
 }

@@ -5,14 +5,16 @@
 //! symbolic expressions and no solver code are involved, so a bug in the model or the
 //! solver cannot hide itself here.
 //!
-//! Labels: `(2)`…`(11)` are the source's equations; `gap` is the keep-out of the widened
-//! gap; `start` is stance 1 = the scenario's start; `goal` is the final CoMs within 0.05 m
+//! Labels: `(2)`…`(11)` are the source's equations; `gap` is the terrain's keep-out (the
+//! widened gap; for other terrains, outside every allowed region); `start` is stance 1 = the scenario's start; `goal` is the final CoMs within 0.05 m
 //! of their goals; `crawl` (crawl gait mode only) is a foot moving out of its turn;
 //! `n_step` is a stance count that differs from the scenario's.
 
 use crate::gait;
 use crate::plan::{SolutionFile, Stance};
-use crate::scenario::{dist2, Biped, Foot, Gait, Scenario, Vec3};
+use crate::reach;
+use crate::scenario::{dist2, Biped, Foot, Gait, Scenario, Vec3, START_TERRAIN_TOL};
+use crate::terrain::{self, Terrain};
 use nalgebra::Vector3;
 use serde::Serialize;
 use std::fmt;
@@ -29,14 +31,18 @@ pub const GOAL_TOL: f64 = 0.05;
 /// Whether the goal requirement applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum GoalCheck {
-    /// Required "when n_step allows it": when the spec's crawl heuristic (each foot
-    /// ≤ 0.28 m per move, one foot per transition) reaches both goals within n_step
-    /// stances, which proves the goal reachable. True for the default scenario.
+    /// Required unless the geometry proves the goal unreachable ([`crate::reach`]): a
+    /// keep-out zone on the way at least as wide as the step reach, or n_step below the
+    /// lower bound on the stances any plan needs. A plan that stops before a crossable
+    /// gap with enough stances is therefore rejected.
     #[default]
     Auto,
     /// Always required.
     Required,
-    /// Never checked.
+    /// The goal distance is not checked (for inspecting the other equations of a partial
+    /// plan: a guess, a plan of a too-short horizon; the summary says "goal NOT
+    /// checked"), but a plan that stops before a crossable keep-out zone is still
+    /// rejected (label `cross`, [`reach::stopped_before_crossable`]).
     Skip,
 }
 
@@ -122,7 +128,7 @@ impl Report {
         let goal = if self.goal_checked {
             "goals reached"
         } else {
-            "goal not required"
+            "goal NOT checked"
         };
         if self.ok() {
             format!(
@@ -162,6 +168,7 @@ fn inf_norm(v: Vector3<f64>) -> f64 {
 
 struct Checker<'a> {
     s: &'a Scenario,
+    terrain: Box<dyn Terrain>,
     tol: f64,
     out: Vec<Violation>,
     max_residual: f64,
@@ -172,10 +179,23 @@ impl Checker<'_> {
     /// Records `amount` (how far past its bound a residual is); a violation when it
     /// exceeds the tolerance or is NaN.
     fn test(&mut self, eq: &str, name: &str, stance: usize, foot: Option<String>, amount: f64) {
+        self.test_with(self.tol, eq, name, stance, foot, amount);
+    }
+
+    /// [`Checker::test`] with tolerance `tol`.
+    fn test_with(
+        &mut self,
+        tol: f64,
+        eq: &str,
+        name: &str,
+        stance: usize,
+        foot: Option<String>,
+        amount: f64,
+    ) {
         if amount.is_nan() || amount > self.max_residual {
             self.max_residual = amount;
         }
-        if amount.is_nan() || amount > self.tol {
+        if amount.is_nan() || amount > tol {
             self.out.push(Violation {
                 equation: eq.to_string(),
                 name: name.to_string(),
@@ -204,8 +224,16 @@ impl Checker<'_> {
             let p = st.feet.get(i);
             let name = Some(i.name().to_string());
             // (3) on the terrain: f_env = h(x) − z = 0.
-            let f_env = s.gap.height(p[0]) - p[2];
-            self.test(
+            let f_env = self.terrain.height_at(p[0], p[1]) - p[2];
+            // A foot still at its start may sit up to START_TERRAIN_TOL off the terrain
+            // (the spec: a deep gap's atan tail lowers the ground near its edges).
+            let tol = if p == s.start.feet.get(i) {
+                START_TERRAIN_TOL.max(self.tol)
+            } else {
+                self.tol
+            };
+            self.test_with(
+                tol,
                 "(3)",
                 "foot on terrain |h(x) − z| (m)",
                 k,
@@ -213,7 +241,7 @@ impl Checker<'_> {
                 f_env.abs(),
             );
             // (4) friction cone about the terrain normal.
-            let n = v3(s.gap.normal(p[0]));
+            let n = v3(self.terrain.normal_at(p[0], p[1]));
             let f = v3(st.forces.get(i));
             let fn_ = f.dot(&n);
             let ft = (f - n * fn_).norm();
@@ -241,11 +269,16 @@ impl Checker<'_> {
                 name.clone(),
                 (l2 - s.leg_length_sq).abs(),
             );
-            // Keep-out of the widened gap (distance inside it).
-            let (lo, hi) = s.gap.keep_out();
-            let inside = (p[0] - lo).min(hi - p[0]);
-            if p[0].is_nan() || inside > 0.0 {
-                self.test("gap", "foot inside the widened gap by (m)", k, name, inside);
+            // Keep-out: distance from the nearest region where feet may stand.
+            let inside = self.terrain.keep_out_depth(p[0], p[1]);
+            if p[0].is_nan() || p[1].is_nan() || inside > 0.0 {
+                self.test(
+                    "gap",
+                    "foot in the keep-out, distance from the nearest allowed region (m)",
+                    k,
+                    name,
+                    inside,
+                );
             }
         }
         // (6)–(9) foot distances.
@@ -340,6 +373,7 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
     let st = &file.stances;
     let mut c = Checker {
         s,
+        terrain: terrain::of(s),
         tol: opts.tol,
         out: Vec::new(),
         max_residual: 0.0,
@@ -393,7 +427,9 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
     let goal_checked = match opts.goal {
         GoalCheck::Required => true,
         GoalCheck::Skip => false,
-        GoalCheck::Auto => gait::crawl_stances_to_goal(s, GOAL_TOL, s.n_step).is_some(),
+        GoalCheck::Auto => {
+            reach::uncrossable(s).is_none() && s.n_step >= reach::stances_needed(s).needed
+        }
     };
     if goal_checked {
         if let Some(last) = st.last() {
@@ -408,6 +444,20 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
                         amount: d - GOAL_TOL,
                     });
                 }
+            }
+        }
+    }
+    if opts.goal == GoalCheck::Skip {
+        // Skipping the goal never forgives a plan that stops before a crossable gap.
+        if let Some(last) = st.last() {
+            for (i, d) in reach::stopped_before_crossable(s, &last.feet) {
+                out.push(Violation {
+                    equation: "cross".into(),
+                    name: "foot stops before a crossable keep-out zone its goal lies beyond; distance from the goal's region (m)".into(),
+                    stance: st.len(),
+                    foot: Some(i.name().to_string()),
+                    amount: d,
+                });
             }
         }
     }

@@ -15,7 +15,7 @@
 use crate::gait;
 use crate::model::{self, Formulation, Model};
 use crate::scenario::Scenario;
-use crate::terrain::GapTerrain;
+use crate::terrain;
 use nlp::{Compiled, NumericNlp};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -74,12 +74,12 @@ fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
-/// The crawl-gait model of `s` (crawl schedule, crawl guess, the spec's gap terrain),
+/// The crawl-gait model of `s` (crawl schedule, crawl guess, the scenario's terrain),
 /// built and compiled.
 pub fn crawl_model(s: &Scenario) -> Result<(Model, Compiled), crate::solve::PlanningError> {
     let guess = gait::crawl(s);
     let formulation = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
-    let model = model::build(s, &GapTerrain { gap: s.gap }, &formulation, &guess)?;
+    let model = model::build(s, &*terrain::of(s), &formulation, &guess)?;
     let compiled = model.problem.compile()?;
     Ok((model, compiled))
 }

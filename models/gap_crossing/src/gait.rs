@@ -2,16 +2,19 @@
 //!
 //! Guesses are flat vectors in the layout of [`crate::plan`] (30 numbers per stance).
 //! - [`standing`]: every stance equals the start; forces balance gravity.
-//! - [`crawl`]: the spec's crawl-gait heuristic (BR, FR, BL, FL, repeated; each move
-//!   ≤ 0.28 m toward that foot's goal; a landing that would fall in the widened gap goes
-//!   just beyond it when that is within 0.27 m, else just before it), with CoMs that
-//!   satisfy the leg-length equation (11) exactly and forces balancing gravity (2).
+//! - [`crawl`]: the crawl-gait heuristic (BR, FR, BL, FL, repeated; each move ≤ 0.28 m
+//!   toward that foot's goal; a landing that would fall in the keep-out goes to the
+//!   point of an allowed region within one jump closest to the goal, see
+//!   [`footholds_for_schedule`]), with CoMs that satisfy the leg-length equation (11)
+//!   exactly and forces balancing gravity (2). On the spec's default gap it gives the
+//!   spec's crawl footholds (its 0.27 m jump limit is never reached there).
 //!
 //! Feet are always placed on the numeric terrain, z = h(x), so equation (3) holds to
 //! rounding even at the steep gap edges (where h is not exactly 0).
 
 use crate::plan::{Plan, Stance};
 use crate::scenario::{dist2, Biped, Coms, Feet, Foot, Scenario, Vec3};
+use crate::terrain::{self, Region, Terrain};
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The crawl order: transition k (from stance k+1 to k+2, 1-based) moves
@@ -20,9 +23,6 @@ pub const CRAWL_ORDER: [Foot; 4] = [Foot::BR, Foot::FR, Foot::BL, Foot::FL];
 
 /// Longest move of one foot in the crawl heuristic (m); below the 0.3 m step radius.
 pub const CRAWL_MAX_MOVE: f64 = 0.28;
-
-/// Longest jump across the widened gap the heuristic attempts (m).
-pub const CRAWL_MAX_JUMP: f64 = 0.27;
 
 /// How far outside the widened gap a foot lands when it is placed "just" before or
 /// beyond it (m): small against the 0.03 m margin, large against the 1e-6 tolerance.
@@ -62,41 +62,127 @@ pub fn foot_goals(s: &Scenario) -> Feet {
     g
 }
 
-/// Where the crawl heuristic puts foot at `cur` when it moves toward `goal` (xy
-/// direction; z on the terrain).
-fn crawl_landing(s: &Scenario, cur: Vec3, goal: Vec3) -> Vec3 {
-    let (dx, dy) = (goal[0] - cur[0], goal[1] - cur[1]);
-    let dist = dx.hypot(dy);
-    if dist < 1e-12 {
-        return cur;
+/// How far below the step reach the guess's longest jump stays (m): a jump of
+/// `reach − JUMP_SLACK` leaves the solver a little room on (5).
+pub const JUMP_SLACK: f64 = 1e-4;
+
+/// The landing rule's view of the terrain: its allowed regions, the jump length and the
+/// clearance kept from region edges.
+struct Ground {
+    terrain: Box<dyn Terrain>,
+    regions: Vec<Region>,
+    jump: f64,
+    clearance: f64,
+}
+
+impl Ground {
+    fn of(s: &Scenario) -> Ground {
+        let terrain = terrain::of(s);
+        let regions = terrain.regions();
+        let jump = s.step_radius_sq.sqrt() - JUMP_SLACK;
+        // The widest distance between two regions that a jump can span: landings keep
+        // [`GAP_CLEARANCE`] from region edges, less when that jump would not fit.
+        let widest = regions
+            .iter()
+            .enumerate()
+            .flat_map(|(a, ra)| regions[a + 1..].iter().map(move |rb| ra.distance(rb)))
+            .filter(|&d| d > 0.0 && d < jump)
+            .fold(0.0, f64::max);
+        let clearance = GAP_CLEARANCE.min(((jump - widest) / 4.0).max(1e-7));
+        Ground {
+            terrain,
+            regions,
+            jump,
+            clearance,
+        }
     }
-    let (ux, uy) = (dx / dist, dy / dist);
-    let at = |t: f64| -> Vec3 {
-        let x = cur[0] + ux * t;
-        [x, cur[1] + uy * t, s.gap.height(x)]
+
+    fn on(&self, x: f64, y: f64) -> Vec3 {
+        [x, y, self.terrain.height_at(x, y)]
+    }
+
+    /// Where a foot at `cur` heading for `goal` lands (see [`footholds_for_schedule`]).
+    fn landing(&self, cur: Vec3, goal: Vec3) -> Vec3 {
+        let (dx, dy) = (goal[0] - cur[0], goal[1] - cur[1]);
+        let dist = dx.hypot(dy);
+        if dist < 1e-12 {
+            return cur;
+        }
+        let t = dist.min(CRAWL_MAX_MOVE);
+        let (px, py) = (cur[0] + dx / dist * t, cur[1] + dy / dist * t);
+        if self.regions.iter().any(|r| r.contains(px, py, 0.0)) {
+            return self.on(px, py);
+        }
+        // The straight move ends in the keep-out: among the points of every region
+        // within one jump, the one closest to the goal (this region's edge when no other
+        // region is within reach: the foot walks up to the gap and jumps next time).
+        let mut best: Option<(f64, Vec3)> = None;
+        for r in &self.regions {
+            if let Some(q) = self.jump_into(r, cur, goal) {
+                let d = (q[0] - goal[0]).hypot(q[1] - goal[1]);
+                if best.is_none_or(|(b, _)| d < b) {
+                    best = Some((d, q));
+                }
+            }
+        }
+        best.map_or(cur, |(_, q)| q)
+    }
+
+    /// The point of region `r` (shrunk by the clearance) within one jump of `cur`
+    /// (3-D distance) closest to `goal` horizontally, if any.
+    fn jump_into(&self, r: &Region, cur: Vec3, goal: Vec3) -> Option<Vec3> {
+        let mut radius = self.jump;
+        let mut q = None;
+        // The disc's radius in x–y depends on the height difference at the landing.
+        for _ in 0..3 {
+            let p = project_box_disc(
+                r,
+                self.clearance,
+                [cur[0], cur[1]],
+                radius,
+                [goal[0], goal[1]],
+            )?;
+            let landing = self.on(p[0], p[1]);
+            let dz = landing[2] - cur[2];
+            q = Some(landing);
+            if dz.abs() >= self.jump {
+                return None;
+            }
+            radius = (self.jump * self.jump - dz * dz).sqrt();
+        }
+        q.filter(|q| dist2(*q, cur).sqrt() <= self.jump + 1e-9)
+    }
+}
+
+/// The projection of `g` onto the box `r` (shrunk by `inset`) intersected with the disc
+/// of `radius` about `c`, by Dykstra's alternating projections (which converge to the
+/// projection onto an intersection of convex sets); `None` when they do not meet.
+fn project_box_disc(
+    r: &Region,
+    inset: f64,
+    c: [f64; 2],
+    radius: f64,
+    g: [f64; 2],
+) -> Option<[f64; 2]> {
+    let disc = |p: [f64; 2]| {
+        let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
+        let d = dx.hypot(dy);
+        if d <= radius {
+            p
+        } else {
+            [c[0] + dx * radius / d, c[1] + dy * radius / d]
+        }
     };
-    let land = at(dist.min(CRAWL_MAX_MOVE));
-    if !s.gap.in_keep_out(land[0]) {
-        return land;
+    let (mut x, mut p, mut q) = (g, [0.0; 2], [0.0; 2]);
+    for _ in 0..400 {
+        let y = r.clamp(x[0] + p[0], x[1] + p[1], inset);
+        p = [x[0] + p[0] - y[0], x[1] + p[1] - y[1]];
+        let nx = disc([y[0] + q[0], y[1] + q[1]]);
+        q = [y[0] + q[0] - nx[0], y[1] + q[1] - nx[1]];
+        x = nx;
     }
-    // The landing falls in the widened gap; the foot moves along x (ux ≠ 0, since the
-    // foot itself is outside the gap).
-    let (lo, hi) = s.gap.keep_out();
-    let (far, near) = if ux > 0.0 {
-        (hi + GAP_CLEARANCE, lo - GAP_CLEARANCE)
-    } else {
-        (lo - GAP_CLEARANCE, hi + GAP_CLEARANCE)
-    };
-    let beyond = at((far - cur[0]) / ux);
-    if dist2(beyond, cur).sqrt() <= CRAWL_MAX_JUMP {
-        return beyond;
-    }
-    let t = (near - cur[0]) / ux;
-    if t > 0.0 {
-        at(t)
-    } else {
-        cur
-    }
+    let y = r.clamp(x[0], x[1], inset);
+    ((y[0] - c[0]).hypot(y[1] - c[1]) <= radius + 1e-12).then_some(y)
 }
 
 /// The crawl heuristic's footholds: `n_step` foot configurations, the first the start;
@@ -105,16 +191,23 @@ pub fn crawl_footholds(s: &Scenario) -> Vec<Feet> {
     footholds_for_schedule(s, &crawl_schedule(s.n_step))
 }
 
-/// The crawl heuristic's landing rule with any schedule: at transition k only
-/// `schedule[k]` moves, ≤ [`CRAWL_MAX_MOVE`] toward its goal, jumping the widened gap as
-/// in [`crawl_footholds`]. `schedule.len() + 1` foot configurations, the first the start.
+/// The landing rule with any schedule: at transition k only `schedule[k]` moves,
+/// ≤ [`CRAWL_MAX_MOVE`] straight toward its goal when that lands in an allowed region of
+/// the terrain; otherwise it lands on the point, among all regions' points within one
+/// jump (`reach − JUMP_SLACK`, 3-D, kept [`GAP_CLEARANCE`] or less inside the region),
+/// closest to its goal: beyond the keep-out when it can get there, else on the near
+/// edge, from where it jumps at its next move, in any direction (a lateral goal makes a
+/// diagonal approach). This is the crossing decision: the first move from which another
+/// region is reachable crosses (the earliest crossing stance of each foot).
+/// `schedule.len() + 1` foot configurations, the first the start.
 pub fn footholds_for_schedule(s: &Scenario, schedule: &[Foot]) -> Vec<Feet> {
+    let ground = Ground::of(s);
     let goals = foot_goals(s);
     let mut out = Vec::with_capacity(schedule.len() + 1);
     let mut feet = s.start.feet;
     out.push(feet);
     for &foot in schedule {
-        let p = crawl_landing(s, feet.get(foot), goals.get(foot));
+        let p = ground.landing(feet.get(foot), goals.get(foot));
         *feet.get_mut(foot) = p;
         out.push(feet);
     }

@@ -9,6 +9,12 @@
 //! - [`plan`]: the solution file (JSON) and the flat variable layout, 30 numbers per stance;
 //! - [`gait`]: initial guesses (standing still, the crawl-gait heuristic) and the crawl
 //!   schedule;
+//! - [`terrain`], [`terrain_spec`]: the ground (gap, step, several gaps, stepping stones,
+//!   height map) as expressions and numbers, its allowed regions, and its scenario table;
+//! - [`crossing`]: the crossing search (which move of each foot first lands beyond a gap);
+//! - [`reach`]: geometric certificates that a goal is unreachable;
+//! - [`status`]: the typed outcome of planning (solved, gap not crossable, goal not
+//!   reached, solver failed, check failed) and its exit code;
 //! - [`check`]: the independent checker, recomputing every residual from a solution file
 //!   with plain `f64` arithmetic (no symbolic or solver code);
 //! - [`convergence`]: the per-iteration history of the solver runs (objective,
@@ -17,14 +23,17 @@
 
 pub mod check;
 pub mod convergence;
+pub mod crossing;
 pub mod export;
 pub mod gait;
 pub mod model;
 pub mod plan;
+pub mod reach;
 pub mod render;
 pub mod scenario;
 pub mod schedule_search;
 pub mod solve;
+pub mod status;
 pub mod sweep;
-
 pub mod terrain;
+pub mod terrain_spec;

@@ -1,8 +1,10 @@
 //! `gap-crossing`: the quadruped gap-crossing planner's command line.
 //!
-//! Exit codes: 0 success; 1 `solve` found no valid plan, `check` found violations, or
-//! some `sweep` point was not solved and checked; 2 any error (bad arguments, bad files,
-//! invalid scenario or grid). Errors go to stderr.
+//! Exit codes (docs/gap-crossing.md, "Exit codes"; `status::StatusKind::exit_code`):
+//! 0 success; 1 `solve`: solver failure or checker rejection, `check`: violations,
+//! `sweep`: some point not solved; 2 any error (bad arguments, bad files, invalid
+//! scenario or grid); 3 `solve`: gap not crossable; 4 `solve`: goal not reached.
+//! Errors go to stderr.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use gap_crossing::check::{self, GoalCheck, Options};
@@ -198,6 +200,8 @@ fn scenario(a: &ScenarioArgs) -> Result<Scenario, CliError> {
         None => Scenario::default(),
     };
     s.apply_overrides(&a.set)?;
+    // A height map's CSV named by `--set` is read relative to the working directory.
+    s.load_terrain_files(Path::new("."))?;
     if let Some(g) = a.gait {
         s.gait = match g {
             GaitArg::Free => Gait::Free,
@@ -236,18 +240,18 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     // Convergence history of all solver runs, numbered on, with the residual of (10) at
     // every iterate (recorded by the solvers' iteration callback).
     let history = Convergence::from_phases(&outcome.phases);
-    let solved = file.solver.status == "solved" && report.ok();
-    if !solved {
+    if !outcome.status.is_solved() {
         // Nothing partial is left as if it were a result.
+        let kind = outcome.status.kind();
         eprintln!(
-            "error: no valid plan: solver status {}, checker: {}",
-            file.solver.status,
-            report.summary()
+            "error: no valid plan: status {kind} (exit code {}): {}",
+            kind.exit_code(),
+            outcome.status
         );
         if !report.ok() {
-            eprintln!("{report}");
+            eprintln!("checker: {report}");
         }
-        return Ok(ExitCode::from(1));
+        return Ok(ExitCode::from(kind.exit_code()));
     }
     std::fs::create_dir_all(&a.out).map_err(io(&a.out))?;
     let json = a.out.join("solution.json");
@@ -387,7 +391,7 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         for ((_, v), w) in r.overrides.iter().zip(&widths) {
             line += &format!("  {:>w$}", sweep::label(v));
         }
-        let check = if r.status == "solved" || r.objective.is_some() {
+        let check = if r.status.is_solved() || r.objective.is_some() {
             if r.check_ok {
                 "ok".to_string()
             } else {
@@ -412,6 +416,11 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         results.len(),
         wall
     );
+    let by_status: Vec<String> = sweep::counts(&results)
+        .into_iter()
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect();
+    println!("outcomes: {}", by_status.join(", "));
     println!(
         "wrote {}",
         files

@@ -6,9 +6,11 @@
 //! and feet are constants, its forces are variables).
 //!
 //! Two design choices make the problem well posed for a Newton-type solver:
-//! - **Keep-out as bounds.** The disjunction "no foot in the widened gap" is resolved by
-//!   a side assignment: foot `i` at stance `k` stays on the side of each keep-out interval
-//!   where the initial guess has it, as a simple bound on its x. Interior-point iterates
+//! - **Keep-out as bounds.** The disjunction "no foot in the keep-out" is resolved by a
+//!   region assignment: foot `i` at stance `k` stays in the allowed region of the terrain
+//!   (a box, [`crate::terrain::Region`]) where the initial guess has it, as simple bounds
+//!   on its x and y. Which stance first lands beyond a gap is decided before the solve,
+//!   by the guess's crossing search ([`crate::gait`]). Interior-point iterates
 //!   never leave their bounds, so they never see the steep edges of the terrain (`k = 1e6`),
 //!   which is where off-the-shelf IPOPT walks feet into the gap.
 //! - **Shared foot variables** ([`Formulation::Scheduled`]). When only a scheduled foot may
@@ -70,14 +72,16 @@ pub enum ModelError {
     /// A schedule of the wrong length.
     #[error("schedule has {got} entries, expected n_step − 1 = {expected}")]
     ScheduleLength { expected: usize, got: usize },
-    /// The guess puts a foot inside a keep-out interval, so no side can be assigned.
-    #[error("initial guess puts foot {foot} at stance {stance} inside the keep-out zone ({lo}, {hi}) at x = {x}")]
+    /// The guess puts a foot in the keep-out (outside every allowed region of the
+    /// terrain), so no region can be assigned.
+    #[error(
+        "initial guess puts foot {foot} at stance {stance} in the keep-out, at (x, y) = ({x}, {y})"
+    )]
     GuessInKeepOut {
         foot: &'static str,
         stance: usize,
         x: f64,
-        lo: f64,
-        hi: f64,
+        y: f64,
     },
     /// A problem-definition error from nlp.
     #[error(transparent)]
@@ -116,7 +120,7 @@ pub fn build(
         }
     }
     let mut pb = Problem::new();
-    let keep_out = terrain.keep_out();
+    let regions = terrain.regions();
 
     // Variables, stance by stance. Stance 1: CoMs and feet are the start (constants).
     let mut coms: Vec<[Matrix; 2]> = Vec::with_capacity(n);
@@ -154,21 +158,23 @@ pub fn build(
                 let r = pb.variable(&format!("r_{}^{label}", i.name()), 3)?;
                 let g = at(foot_offset(k, i));
                 pb.set_initial(&r, g)?;
-                for &(lo, hi) in &keep_out {
-                    // A guess on a keep-out edge (a previous solution at its bound, up to
-                    // the solver's bound relaxation) belongs to that edge's side.
-                    if g[0] <= lo + KEEP_OUT_SNAP {
-                        pb.set_bounds(&r[0..1], f64::NEG_INFINITY, lo)?;
-                    } else if g[0] >= hi - KEEP_OUT_SNAP {
-                        pb.set_bounds(&r[0..1], hi, f64::INFINITY)?;
-                    } else {
-                        return Err(ModelError::GuessInKeepOut {
-                            foot: i.name(),
-                            stance: label,
-                            x: g[0],
-                            lo,
-                            hi,
-                        });
+                // The region holding the guess (a guess on a region's edge, e.g. a
+                // previous solution at its bound up to the solver's bound relaxation,
+                // belongs to it): the foot stays in it, as bounds on its x and y.
+                let Some(region) = regions
+                    .iter()
+                    .find(|q| q.contains(g[0], g[1], KEEP_OUT_SNAP))
+                else {
+                    return Err(ModelError::GuessInKeepOut {
+                        foot: i.name(),
+                        stance: label,
+                        x: g[0],
+                        y: g[1],
+                    });
+                };
+                for (c, [lo, hi]) in [(0, region.x), (1, region.y)] {
+                    if lo.is_finite() || hi.is_finite() {
+                        pb.set_bounds(&r[c..c + 1], lo, hi)?;
                     }
                 }
                 fk.push(r);

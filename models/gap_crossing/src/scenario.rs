@@ -13,12 +13,19 @@ use serde_json::Value;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+pub use crate::terrain_spec::{read_height_csv, TerrainSpec};
+
 /// A point or vector in metres (positions) or newtons (forces): `[x, y, z]`.
 pub type Vec3 = [f64; 3];
 
 /// Absolute tolerance used when checking that the start configuration satisfies the
 /// equations; the same 1e-6 the spec gives the checker (units of each equation).
 pub const START_TOL: f64 = 1e-6;
+
+/// How far a start foot may sit off the terrain, (3) (m): the spec allows 1e-5, since a
+/// deep gap's atan tail lowers the ground near its edges by about 1e-6 m (1.1e-6 m at
+/// x = 2 for a 3 m deep default gap). The checker applies it to feet still at their start.
+pub const START_TERRAIN_TOL: f64 = 1e-5;
 
 /// The two bipeds of the robot: B (back, mass m1) and F (front, mass m2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -353,6 +360,9 @@ pub struct Scenario {
     pub same_biped_sq: Bounds,
     /// Gait mode: `free` (default) or `crawl`.
     pub gait: Gait,
+    /// The ground (default: the `gap` table's gap).
+    #[serde(default)]
+    pub terrain: TerrainSpec,
 }
 
 impl Default for Scenario {
@@ -400,6 +410,7 @@ impl Default for Scenario {
                 max: 2.25,
             },
             gait: Gait::Free,
+            terrain: TerrainSpec::Gap,
         }
     }
 }
@@ -499,6 +510,7 @@ fn merge(base: &mut Value, patch: Value, path: &str) -> Result<(), ScenarioError
             for (key, pv) in p {
                 let here = join(path, &key);
                 match b.get_mut(&key) {
+                    Some(bv) if here == "terrain" => merge_terrain(bv, pv)?,
                     Some(bv) => merge(bv, pv, &here)?,
                     None => {
                         return Err(ScenarioError::UnknownField {
@@ -549,13 +561,56 @@ fn merge(base: &mut Value, patch: Value, path: &str) -> Result<(), ScenarioError
     }
 }
 
+/// Merges a `terrain` table: a different `kind` replaces the table (its fields are the
+/// new kind's, checked by serde); the same kind (or none given) overrides field by field.
+fn merge_terrain(base: &mut Value, patch: Value) -> Result<(), ScenarioError> {
+    let Value::Object(p) = patch else {
+        return Err(ScenarioError::WrongType {
+            field: "terrain".into(),
+            expected: "a table with a `kind`".into(),
+            found: kind(&patch).into(),
+        });
+    };
+    let same_kind = p.get("kind").is_none_or(|k| base.get("kind") == Some(k));
+    match base {
+        Value::Object(b) if same_kind => {
+            // A new CSV file: its heights are read again.
+            if p.contains_key("file") && !p.contains_key("heights") {
+                b.remove("heights");
+            }
+            for (k, v) in p {
+                b.insert(k, v);
+            }
+        }
+        _ => *base = Value::Object(p),
+    }
+    Ok(())
+}
+
 impl Scenario {
+    /// Reads the files a scenario refers to (a height map's CSV), relative to `dir`,
+    /// when their contents are not already in the scenario.
+    pub fn load_terrain_files(&mut self, dir: &Path) -> Result<(), ScenarioError> {
+        if let TerrainSpec::HeightMap { file, heights, .. } = &mut self.terrain {
+            if heights.is_empty() {
+                *heights = read_height_csv(&dir.join(file.as_str()))?;
+            }
+        }
+        Ok(())
+    }
+
     /// Builds a scenario from a (possibly partial) JSON value: given fields override the
     /// defaults, unknown fields and wrongly typed values are rejected with their dotted
     /// path. Does not call [`Scenario::validate`].
     pub fn from_value(v: Value) -> Result<Scenario, ScenarioError> {
         let mut base = serde_json::to_value(Scenario::default()).expect("defaults serialise");
         merge(&mut base, v, "")?;
+        // The terrain table is replaced, not merged, so serde checks it: its errors are
+        // prefixed with its name.
+        if let Some(t) = base.get("terrain") {
+            serde_json::from_value::<TerrainSpec>(t.clone())
+                .map_err(|e| ScenarioError::Value(format!("terrain: {e}")))?;
+        }
         serde_json::from_value(base).map_err(|e| ScenarioError::Value(e.to_string()))
     }
 
@@ -574,7 +629,9 @@ impl Scenario {
             "json" => serde_json::from_str(text).map_err(|e| syntax(e.to_string()))?,
             _ => return Err(ScenarioError::Extension(origin.to_path_buf())),
         };
-        Scenario::from_value(value)
+        let mut s = Scenario::from_value(value)?;
+        s.load_terrain_files(origin.parent().unwrap_or(Path::new(".")))?;
+        Ok(s)
     }
 
     /// Reads a scenario file, TOML or JSON by extension, and validates it.
@@ -774,6 +831,7 @@ impl Scenario {
                 );
             }
         }
+        bad.extend(self.terrain.validate());
         if bad.is_empty() && finite {
             self.validate_start(&mut bad);
         }
@@ -787,11 +845,12 @@ impl Scenario {
     /// The start configuration must satisfy the equations that involve no forces.
     fn validate_start(&self, bad: &mut Vec<Invalid>) {
         let s = &self.start;
+        let terrain = crate::terrain::of(self);
         for i in Foot::ALL {
             let p = s.feet.get(i);
             let field = format!("start.feet.{i}");
-            let h = self.gap.height(p[0]);
-            if (h - p[2]).abs() > START_TOL {
+            let h = terrain.height_at(p[0], p[1]);
+            if (h - p[2]).abs() > START_TERRAIN_TOL {
                 bad.push(Invalid {
                     field: field.clone(),
                     message: format!(
@@ -800,13 +859,13 @@ impl Scenario {
                     ),
                 });
             }
-            if self.gap.in_keep_out(p[0]) {
-                let (lo, hi) = self.gap.keep_out();
+            let depth = terrain.keep_out_depth(p[0], p[1]);
+            if depth > START_TOL {
                 bad.push(Invalid {
                     field: field.clone(),
                     message: format!(
-                        "foot {i} at x = {} is inside the widened gap ({lo}, {hi})",
-                        p[0]
+                        "foot {i} at (x, y) = ({}, {}) is {depth:.3e} m inside the keep-out (outside every region where the {} terrain allows feet)",
+                        p[0], p[1], self.terrain.kind()
                     ),
                 });
             }

@@ -1,4 +1,5 @@
-//! From a scenario to a checked-ready plan: guess, build, compile, solve, read back.
+//! From a scenario to a checked-ready plan: guess, build, compile, solve, read back,
+//! and the verdict ([`decide`]: solved, or why not, as a [`PlanStatus`]).
 //!
 //! - `crawl` gait: one solve of the scheduled problem (order BR, FR, BL, FL), from the
 //!   crawl-gait heuristic.
@@ -8,19 +9,25 @@
 //!   1. the crawl schedule, solved as above (so the free gait is never worse than it);
 //!   2. the biped-pair schedule FR, FL, BR, BL ([`gait::PAIR_ORDER`]), solved from the
 //!      same heuristic with that order, on a second thread alongside 1;
-//!   3. the schedule search ([`crate::schedule_search`]) from the better of 1 and 2:
+//!   3. the crossing search ([`crate::crossing`], [`CROSSING_ROUNDS`] rounds) from the
+//!      better of 1 and 2, which the crawl gait also runs after its solve; then
+//!   4. the schedule search ([`crate::schedule_search`]) from its result:
 //!      adjacent swaps of the schedule whose exact per-stance evaluation lowers the
 //!      cost, each round re-solved with every variable free from the improved plan,
 //!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
 //!
-//!   With the SQP back end, 2 and 3 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
+//!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
+use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::convergence::ResidualProbe;
+use crate::crossing;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
-use crate::scenario::{Foot, Gait, Scenario};
+use crate::reach::{self, Unreachable};
+use crate::scenario::{dist2, Biped, Foot, Gait, Scenario};
 use crate::schedule_search::{self, StanceSolver};
-use crate::terrain::{GapTerrain, Terrain};
+use crate::status::{GoalShortfall, PlanStatus};
+use crate::terrain::{self, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
     BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError, Sqp,
@@ -32,6 +39,9 @@ use std::time::Instant;
 /// Largest number of schedule-search rounds (each: evaluate every adjacent swap, then
 /// one solve of the improved schedule) of the free gait.
 pub const SEARCH_ROUNDS: usize = 4;
+
+/// Largest number of crossing-search rounds ([`crate::crossing`]).
+pub const CROSSING_ROUNDS: usize = 4;
 
 /// Initial barrier parameter of the schedule search's re-solves (default 0.1): on the
 /// lateral-goal test scenario, 161 iterations over its rounds instead of 238, same plans.
@@ -146,7 +156,10 @@ pub struct Phase {
 /// The result of planning.
 #[derive(Clone, Debug)]
 pub struct Outcome {
-    /// The solution file (the spec's schema).
+    /// The verdict: solved, or why not ([`decide`]).
+    pub status: PlanStatus,
+    /// The solution file (the spec's schema); its `solver.status` is the word of
+    /// `status` ([`crate::status::StatusKind::word`]). When not solved, the best plan found.
     pub file: SolutionFile,
     /// The solver runs, in order.
     pub phases: Vec<Phase>,
@@ -292,9 +305,10 @@ fn run(
     Ok(record(solved, settings, phases))
 }
 
-/// Plans scenario `s` (its `gait` field chooses the formulation) on the spec's gap terrain.
+/// Plans scenario `s` (its `gait` field chooses the formulation) on its terrain
+/// ([`terrain::of`]).
 pub fn plan(s: &Scenario, settings: &Settings) -> Result<Outcome, PlanningError> {
-    plan_on(s, &GapTerrain { gap: s.gap }, settings)
+    plan_on(s, &*terrain::of(s), settings)
 }
 
 /// Plans scenario `s` on any terrain.
@@ -308,15 +322,18 @@ pub fn plan_on(
     let crawl = gait::crawl_schedule(s.n_step);
     let guess = gait::crawl(s);
     let last = match s.gait {
-        Gait::Crawl => run(
-            s,
-            terrain,
-            &crawl,
-            &guess,
-            settings,
-            &mut phases,
-            "crawl gait",
-        )?,
+        Gait::Crawl => {
+            let first = run(
+                s,
+                terrain,
+                &crawl,
+                &guess,
+                settings,
+                &mut phases,
+                "crawl gait",
+            )?;
+            crossing_search(s, terrain, settings, first, &mut phases)?
+        }
         Gait::Free => free_gait(s, terrain, settings, &mut phases)?,
     };
     let plan = Plan::from_flat(s, &last.flat)?;
@@ -326,17 +343,77 @@ pub fn plan_on(
             Backend::Sqp => "sqp",
         }
         .into(),
-        status: status_name(last.solution.status).into(),
+        status: String::new(),
         iterations: phases.iter().map(|p| p.iterations).sum(),
         objective: plan.cost(s),
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
     };
+    let mut file = SolutionFile::new(s.clone(), solver, plan);
+    let status = decide(s, last.solution.status, &file);
+    file.solver.status = status.kind().word().into();
     Ok(Outcome {
-        file: SolutionFile::new(s.clone(), solver, plan),
+        status,
+        file,
         phases,
         chosen: last.phase,
     })
+}
+
+/// The verdict on a plan of scenario `s` returned by a solver with `solver_status`, in
+/// this order: a geometric proof that the goal is unreachable ([`reach::uncrossable`]:
+/// gap not crossable; n_step below [`reach::stances_needed`]: goal not reached); the
+/// solver's failure; the independent checker's violations of (2)–(11), the keep-out and
+/// the start; a final CoM farther than [`GOAL_TOL`] (0.05 m) from its goal; else solved.
+pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanStatus {
+    if let Some(c) = reach::uncrossable(s) {
+        return PlanStatus::GapNotCrossable(c);
+    }
+    let bound = reach::stances_needed(s);
+    let distance = file.stances.last().map_or(f64::INFINITY, |last| {
+        Biped::ALL
+            .iter()
+            .map(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt())
+            .fold(0.0, f64::max)
+    });
+    let shortfall = |bound: Unreachable| {
+        PlanStatus::GoalNotReached(GoalShortfall {
+            n_step: s.n_step,
+            distance,
+            guess_needs: gait::crawl_stances_to_goal(s, GOAL_TOL, 4 * bound.needed + 100),
+            bound,
+        })
+    };
+    if s.n_step < bound.needed {
+        return shortfall(bound);
+    }
+    if !solver_status.is_success() {
+        return PlanStatus::SolverFailed(solver_status);
+    }
+    let report = check::check_with(
+        file,
+        &check::Options {
+            goal: GoalCheck::Skip,
+            ..check::Options::default()
+        },
+    );
+    // The goal is judged below, by distance (a `cross` finding is a goal not reached).
+    let mut labels: Vec<String> = report
+        .violations
+        .iter()
+        .filter(|v| v.equation != "cross")
+        .map(|v| v.equation.clone())
+        .collect();
+    if !labels.is_empty() {
+        let violations = labels.len();
+        labels.sort();
+        labels.dedup();
+        return PlanStatus::CheckFailed { violations, labels };
+    }
+    if distance.is_nan() || distance > GOAL_TOL {
+        return shortfall(bound);
+    }
+    PlanStatus::Solved
 }
 
 /// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
@@ -384,6 +461,7 @@ fn free_gait(
     if !best.solution.status.is_success() {
         return Ok(best);
     }
+    best = crossing_search(s, terrain, &candidate, best, phases)?;
     // Schedule search from the better plan: each round's proposal satisfies every
     // equation of its schedule with a lower cost; the re-solve frees every variable.
     let search_settings = candidate.warm();
@@ -416,7 +494,73 @@ fn free_gait(
     Ok(best)
 }
 
-/// The status word written to the solution file (`solved` for success).
+/// Whether the final CoMs of a flat plan are within [`GOAL_TOL`] of their goals.
+fn reaches_goal(s: &Scenario, flat: &[f64]) -> bool {
+    Plan::from_flat(s, flat).is_ok_and(|p| {
+        p.stances.last().is_some_and(|last| {
+            Biped::ALL
+                .iter()
+                .all(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt() <= GOAL_TOL)
+        })
+    })
+}
+
+/// The crossing search ([`crate::crossing`]) from a solved run: each round solves, in
+/// parallel, every candidate in which one foot crosses a keep-out zone one move earlier,
+/// and keeps the best that succeeds with a lower objective (and reaches the goal when
+/// `best` does), for up to [`CROSSING_ROUNDS`] rounds.
+fn crossing_search(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    settings: &Settings,
+    mut best: Run,
+    phases: &mut Vec<Phase>,
+) -> Result<Run, PlanningError> {
+    use rayon::prelude::*;
+    for round in 1..=CROSSING_ROUNDS {
+        if !best.solution.status.is_success() {
+            break;
+        }
+        let plan = Plan::from_flat(s, &best.flat)?;
+        let candidates = crossing::earlier_crossings(s, terrain, &plan, &best.schedule);
+        if candidates.is_empty() {
+            break;
+        }
+        let solved: Vec<Result<Solved, PlanningError>> = candidates
+            .par_iter()
+            .map(|c| {
+                solve_scheduled(
+                    s,
+                    terrain,
+                    &best.schedule,
+                    &c.plan.to_flat(),
+                    settings,
+                    &format!(
+                        "crossing search {round}: {} crosses at transition {}",
+                        c.foot,
+                        c.transition + 1
+                    ),
+                )
+            })
+            .collect();
+        let needs_goal = reaches_goal(s, &best.flat);
+        let mut improved = false;
+        for r in solved {
+            let next = record(r?, settings, phases);
+            if next.beats(&best) && (!needs_goal || reaches_goal(s, &next.flat)) {
+                best = next;
+                improved = true;
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    Ok(best)
+}
+
+/// The solver's own status as a word (for logs and examples; the solution file holds
+/// the plan's `status::StatusKind` word).
 pub fn status_name(status: Status) -> &'static str {
     match status {
         Status::SolveSucceeded => "solved",

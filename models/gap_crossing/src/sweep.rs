@@ -28,6 +28,7 @@ use crate::plan::{write_atomic, SolutionFile};
 use crate::render::ramp;
 use crate::scenario::{Scenario, ScenarioError};
 use crate::solve::{self, Settings};
+use crate::status::StatusKind;
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -71,8 +72,8 @@ pub struct PointResult {
     pub index: usize,
     /// The axis values of this point, `key → value`, in axis order.
     pub overrides: Vec<(String, Value)>,
-    /// The solver's status word (`solved`, ...), or `invalid_scenario`, `error`, `panic`.
-    pub status: String,
+    /// The outcome: the planner's status, or `invalid_scenario`, `error`, `panic`.
+    pub status: StatusKind,
     /// True when the independent checker found no violation.
     pub check_ok: bool,
     /// Number of violations the checker found (0 when not checked).
@@ -92,7 +93,7 @@ pub struct PointResult {
 impl PointResult {
     /// Solved and accepted by the checker.
     pub fn ok(&self) -> bool {
-        self.status == "solved" && self.check_ok
+        self.status.is_solved() && self.check_ok
     }
 }
 
@@ -384,7 +385,7 @@ pub fn run_point(
     let mut r = PointResult {
         index: p.index,
         overrides: p.overrides.clone(),
-        status: String::new(),
+        status: StatusKind::Error,
         check_ok: false,
         violations: 0,
         violated: Vec::new(),
@@ -397,7 +398,7 @@ pub fn run_point(
     let s = match scenario {
         Ok(s) => s,
         Err(e) => {
-            r.status = "invalid_scenario".into();
+            r.status = StatusKind::InvalidScenario;
             r.error = Some(e.to_string());
             r.seconds = started.elapsed().as_secs_f64();
             return (r, None);
@@ -409,7 +410,10 @@ pub fn run_point(
     match outcome {
         Ok(Ok(o)) => {
             let report = check::check(&o.file);
-            r.status = o.file.solver.status.clone();
+            r.status = o.status.kind();
+            if !o.status.is_solved() {
+                r.error = Some(o.status.to_string());
+            }
             r.check_ok = report.ok();
             r.violations = report.violations.len();
             r.violated = report.equations();
@@ -418,11 +422,11 @@ pub fn run_point(
             file = Some(o.file);
         }
         Ok(Err(e)) => {
-            r.status = "error".into();
+            r.status = StatusKind::Error;
             r.error = Some(e.to_string());
         }
         Err(panic) => {
-            r.status = "panic".into();
+            r.status = StatusKind::Panic;
             let msg = panic
                 .downcast_ref::<String>()
                 .cloned()
@@ -474,6 +478,16 @@ fn opt_num(v: Option<f64>) -> String {
     v.map(|x| format!("{x:.10e}")).unwrap_or_default()
 }
 
+/// How many points ended with each status, in [`StatusKind::ALL`] order, zero counts
+/// left out.
+pub fn counts(results: &[PointResult]) -> Vec<(StatusKind, usize)> {
+    StatusKind::ALL
+        .into_iter()
+        .map(|k| (k, results.iter().filter(|r| r.status == k).count()))
+        .filter(|&(_, n)| n > 0)
+        .collect()
+}
+
 /// The CSV summary: one row per point; a column per axis (named by its key), then
 /// `status, check_ok, violations, violated, objective, iterations, seconds, error`.
 pub fn to_csv(grid: &Grid, results: &[PointResult]) -> String {
@@ -504,7 +518,7 @@ pub fn to_csv(grid: &Grid, results: &[PointResult]) -> String {
     for r in results {
         let mut row = vec![r.index.to_string()];
         row.extend(r.overrides.iter().map(|(_, v)| label(v)));
-        row.push(r.status.clone());
+        row.push(r.status.word().to_string());
         row.push(r.check_ok.to_string());
         row.push(r.violations.to_string());
         row.push(r.violated.join(" "));
@@ -546,12 +560,17 @@ pub fn to_json(grid: &Grid, results: &[PointResult], wall_seconds: f64, threads:
         })
         .collect();
     let ok = results.iter().filter(|r| r.ok()).count();
+    let by_status: serde_json::Map<String, Value> = counts(results)
+        .into_iter()
+        .map(|(k, n)| (k.word().to_string(), Value::from(n)))
+        .collect();
     let v = serde_json::json!({
         "grid": grid,
         "summary": {
             "points": results.len(),
             "ok": ok,
             "failed": results.len() - ok,
+            "by_status": by_status,
             "wall_seconds": wall_seconds,
             "threads": threads,
         },
@@ -717,10 +736,10 @@ pub fn to_svg(grid: &Grid, results: &[PointResult]) -> String {
                     )
                 } else if good.is_empty() {
                     let status = &cell[0].status;
-                    let why = if status == "solved" {
+                    let why = if status.is_solved() {
                         "check failed".to_string()
                     } else {
-                        status.replace('_', " ")
+                        status.word().replace('_', " ")
                     };
                     let first = if cell.len() > 1 {
                         format!("0/{} ok", cell.len())
@@ -964,13 +983,13 @@ mod tests {
         let g = grid("[axes]\ngap.min = [2.25, 2.5]\n").unwrap();
         let pts = g.points();
         let (r, file) = run_point(&g, &pts[1], &Settings::default());
-        assert_eq!(r.status, "invalid_scenario");
+        assert_eq!(r.status, StatusKind::InvalidScenario);
         assert!(file.is_none() && !r.ok());
         assert!(r.error.unwrap().contains("gap.min"));
         let results = vec![PointResult {
             index: 1,
             overrides: pts[1].overrides.clone(),
-            status: "invalid_scenario".into(),
+            status: StatusKind::InvalidScenario,
             check_ok: false,
             violations: 0,
             violated: vec![],

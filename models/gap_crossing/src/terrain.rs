@@ -1,24 +1,137 @@
-//! Terrains: ground height and its gradient as symbolic expressions, plus keep-out zones.
+//! Terrains: ground height and its gradient as symbolic expressions, and the regions
+//! where a foot may stand.
 //!
 //! Equation (3) of the model puts each foot on the surface `z = h(x, y)` and equation (4)
 //! takes the contact normal from `∇h`. A [`Terrain`] provides `h` symbolically (for the
-//! model) and numerically (for guesses and plots), and the x-intervals where no foot may
-//! stand. [`GapTerrain`] is the specification's terrain; [`StepTerrain`] (a smoothed step up
-//! or down) shows that the model is written against the abstraction, not the gap.
-use crate::scenario::Gap;
+//! model) and numerically (for guesses, the checker and plots), and its allowed
+//! [`Region`]s: axis-aligned boxes (possibly unbounded) whose union is where feet may
+//! stand; the complement is the keep-out. The kinds, chosen by the scenario's `terrain`
+//! table ([`of`]):
+//! - [`GapTerrain`]: the specification's gap (the default);
+//! - [`StepTerrain`]: a smoothed step up or down, feet `margin` away from its edge;
+//! - [`GapsTerrain`]: several gaps, the sum of their heights;
+//! - [`StonesTerrain`]: flat ground where only the given rectangles (stones) may be stood on;
+//! - [`HeightMap`]: a grid of heights read from a CSV file, interpolated by the
+//!   tensor-product Catmull-Rom spline (C¹), allowed on the grid's rectangle.
+use crate::scenario::{Gap, Scenario, TerrainSpec};
 use std::f64::consts::PI;
-use symx::Expr;
+use symx::{if_else, le, lt, Expr};
+
+/// A closed axis-aligned box `x[0] ≤ x ≤ x[1]`, `y[0] ≤ y ≤ y[1]` (bounds may be infinite).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    /// x range (m).
+    pub x: [f64; 2],
+    /// y range (m).
+    pub y: [f64; 2],
+}
+
+impl Region {
+    /// The strip `lo ≤ x ≤ hi` across the whole width.
+    pub fn strip(lo: f64, hi: f64) -> Region {
+        Region {
+            x: [lo, hi],
+            y: [f64::NEG_INFINITY, f64::INFINITY],
+        }
+    }
+
+    /// Whether `(x, y)` lies in the box widened by `tol`.
+    pub fn contains(&self, x: f64, y: f64, tol: f64) -> bool {
+        x >= self.x[0] - tol && x <= self.x[1] + tol && y >= self.y[0] - tol && y <= self.y[1] + tol
+    }
+
+    /// The point of the box shrunk by `inset` (not past its centre) closest to `(x, y)`.
+    pub fn clamp(&self, x: f64, y: f64, inset: f64) -> [f64; 2] {
+        let c = |v: f64, [a, b]: [f64; 2]| {
+            let (a2, b2) = (a + inset, b - inset);
+            if a2 <= b2 {
+                v.clamp(a2, b2)
+            } else {
+                (a + b) / 2.0
+            }
+        };
+        [c(x, self.x), c(y, self.y)]
+    }
+
+    /// Horizontal (x–y) distance between two boxes: a lower bound on the 3-D distance
+    /// between any two points standing on them.
+    pub fn distance(&self, other: &Region) -> f64 {
+        let gap = |[a0, a1]: [f64; 2], [b0, b1]: [f64; 2]| (b0 - a1).max(a0 - b1).max(0.0);
+        gap(self.x, other.x).hypot(gap(self.y, other.y))
+    }
+
+    /// Horizontal distance from a point to the box.
+    pub fn distance_to(&self, x: f64, y: f64) -> f64 {
+        let [cx, cy] = self.clamp(x, y, 0.0);
+        (x - cx).hypot(y - cy)
+    }
+}
 
 /// Ground geometry as the model sees it.
-pub trait Terrain {
+pub trait Terrain: Send + Sync {
     /// Height `h(x, y)` as an expression of the foot's coordinates.
     fn height(&self, x: Expr, y: Expr) -> Expr;
     /// `(∂h/∂x, ∂h/∂y)` as expressions.
     fn gradient(&self, x: Expr, y: Expr) -> [Expr; 2];
     /// Height at a point, in plain numbers.
     fn height_at(&self, x: f64, y: f64) -> f64;
-    /// Open x-intervals `(lo, hi)` where no foot may stand (edges widened by the safety margin).
-    fn keep_out(&self) -> Vec<(f64, f64)>;
+    /// `(∂h/∂x, ∂h/∂y)` at a point, in plain numbers.
+    fn slope_at(&self, x: f64, y: f64) -> [f64; 2];
+    /// The boxes where a foot may stand (their union; everything else is keep-out).
+    fn regions(&self) -> Vec<Region>;
+
+    /// Unit surface normal `(−h_x, −h_y, 1)/‖·‖` at a point (points up, out of the ground).
+    fn normal_at(&self, x: f64, y: f64) -> [f64; 3] {
+        let [hx, hy] = self.slope_at(x, y);
+        let n = (1.0 + hx * hx + hy * hy).sqrt();
+        [-hx / n, -hy / n, 1.0 / n]
+    }
+
+    /// How far `(x, y)` is from the nearest allowed region (0 when inside one).
+    fn keep_out_depth(&self, x: f64, y: f64) -> f64 {
+        self.regions()
+            .iter()
+            .map(|r| r.distance_to(x, y))
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// The terrain a scenario describes (its `terrain` table; `gap` for the default).
+pub fn of(s: &Scenario) -> Box<dyn Terrain> {
+    match &s.terrain {
+        TerrainSpec::Gap => Box::new(GapTerrain { gap: s.gap }),
+        TerrainSpec::Step {
+            edge,
+            rise,
+            steepness,
+            margin,
+        } => Box::new(StepTerrain {
+            edge: *edge,
+            rise: *rise,
+            steepness: *steepness,
+            margin: *margin,
+        }),
+        TerrainSpec::Gaps { gaps } => Box::new(GapsTerrain { gaps: gaps.clone() }),
+        TerrainSpec::Stones { stones } => Box::new(StonesTerrain {
+            stones: stones
+                .iter()
+                .map(|b| Region {
+                    x: [b[0], b[1]],
+                    y: [b[2], b[3]],
+                })
+                .collect(),
+        }),
+        TerrainSpec::HeightMap {
+            origin,
+            spacing,
+            heights,
+            ..
+        } => Box::new(HeightMap {
+            origin: *origin,
+            spacing: *spacing,
+            heights: heights.clone(),
+        }),
+    }
 }
 
 /// `(D/π)·atan(k·(x − edge))`: a smoothed step of height `D` at `edge` (symbolic).
@@ -59,8 +172,60 @@ impl Terrain for GapTerrain {
     fn height_at(&self, x: f64, _y: f64) -> f64 {
         self.gap.height(x)
     }
-    fn keep_out(&self) -> Vec<(f64, f64)> {
-        vec![self.gap.keep_out()]
+    fn slope_at(&self, x: f64, _y: f64) -> [f64; 2] {
+        [self.gap.slope(x), 0.0]
+    }
+    fn regions(&self) -> Vec<Region> {
+        let (lo, hi) = self.gap.keep_out();
+        vec![
+            Region::strip(f64::NEG_INFINITY, lo),
+            Region::strip(hi, f64::INFINITY),
+        ]
+    }
+}
+
+/// Several gaps across the whole width: the sum of their [`GapTerrain`] heights; feet
+/// stay out of every widened gap.
+#[derive(Clone, Debug)]
+pub struct GapsTerrain {
+    /// The gaps (any order; widened gaps may overlap).
+    pub gaps: Vec<Gap>,
+}
+
+impl Terrain for GapsTerrain {
+    fn height(&self, x: Expr, y: Expr) -> Expr {
+        self.gaps
+            .iter()
+            .map(|&gap| GapTerrain { gap }.height(x, y))
+            .fold(Expr::zero(), |a, b| a + b)
+    }
+    fn gradient(&self, x: Expr, y: Expr) -> [Expr; 2] {
+        let dx = self
+            .gaps
+            .iter()
+            .map(|&gap| GapTerrain { gap }.gradient(x, y)[0])
+            .fold(Expr::zero(), |a, b| a + b);
+        [dx, Expr::zero()]
+    }
+    fn height_at(&self, x: f64, _y: f64) -> f64 {
+        self.gaps.iter().map(|g| g.height(x)).sum()
+    }
+    fn slope_at(&self, x: f64, _y: f64) -> [f64; 2] {
+        [self.gaps.iter().map(|g| g.slope(x)).sum(), 0.0]
+    }
+    fn regions(&self) -> Vec<Region> {
+        let mut outs: Vec<(f64, f64)> = self.gaps.iter().map(Gap::keep_out).collect();
+        outs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut regions = Vec::new();
+        let mut from = f64::NEG_INFINITY;
+        for (lo, hi) in outs {
+            if lo > from {
+                regions.push(Region::strip(from, lo));
+            }
+            from = from.max(hi);
+        }
+        regions.push(Region::strip(from, f64::INFINITY));
+        regions
     }
 }
 
@@ -91,8 +256,202 @@ impl Terrain for StepTerrain {
     fn height_at(&self, x: f64, _y: f64) -> f64 {
         self.rise * (0.5 + (self.steepness * (x - self.edge)).atan() / PI)
     }
-    fn keep_out(&self) -> Vec<(f64, f64)> {
-        vec![(self.edge - self.margin, self.edge + self.margin)]
+    fn slope_at(&self, x: f64, _y: f64) -> [f64; 2] {
+        let a = self.steepness * (x - self.edge);
+        [self.rise / PI * self.steepness / (1.0 + a * a), 0.0]
+    }
+    fn regions(&self) -> Vec<Region> {
+        vec![
+            Region::strip(f64::NEG_INFINITY, self.edge - self.margin),
+            Region::strip(self.edge + self.margin, f64::INFINITY),
+        ]
+    }
+}
+
+/// Stepping stones: flat ground `z = 0` on which only the given rectangles may be stood on.
+#[derive(Clone, Debug)]
+pub struct StonesTerrain {
+    /// The stones.
+    pub stones: Vec<Region>,
+}
+
+impl Terrain for StonesTerrain {
+    fn height(&self, _x: Expr, _y: Expr) -> Expr {
+        Expr::zero()
+    }
+    fn gradient(&self, _x: Expr, _y: Expr) -> [Expr; 2] {
+        [Expr::zero(), Expr::zero()]
+    }
+    fn height_at(&self, _x: f64, _y: f64) -> f64 {
+        0.0
+    }
+    fn slope_at(&self, _x: f64, _y: f64) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn regions(&self) -> Vec<Region> {
+        self.stones.clone()
+    }
+}
+
+/// Catmull-Rom kernel (Keys' cubic convolution kernel with a = −½): piecewise cubic, C¹,
+/// 1 at 0, 0 at the other integers, support (−2, 2).
+pub fn catmull_rom(t: f64) -> f64 {
+    let a = t.abs();
+    if a <= 1.0 {
+        (1.5 * a - 2.5) * a * a + 1.0
+    } else if a < 2.0 {
+        ((-0.5 * a + 2.5) * a - 4.0) * a + 2.0
+    } else {
+        0.0
+    }
+}
+
+/// Derivative of [`catmull_rom`].
+pub fn catmull_rom_slope(t: f64) -> f64 {
+    let a = t.abs();
+    let d = if a <= 1.0 {
+        (4.5 * a - 5.0) * a
+    } else if a < 2.0 {
+        (-1.5 * a + 5.0) * a - 4.0
+    } else {
+        0.0
+    };
+    d * t.signum()
+}
+
+/// [`catmull_rom`] and its derivative as expressions of `t`.
+fn catmull_rom_expr(t: Expr) -> (Expr, Expr) {
+    let a = t.abs();
+    let inner = (1.5 * a - 2.5) * a * a + 1.0;
+    let outer = ((-0.5 * a + 2.5) * a - 4.0) * a + 2.0;
+    let d_inner = (4.5 * a - 5.0) * a;
+    let d_outer = (-1.5 * a + 5.0) * a - 4.0;
+    let k = if_else(le(a, 1.0), inner, if_else(lt(a, 2.0), outer, 0.0));
+    let dk = t.sign() * if_else(le(a, 1.0), d_inner, if_else(lt(a, 2.0), d_outer, 0.0));
+    (k, dk)
+}
+
+/// A height map: `heights[j][i]` is the height at `x = origin[0] + i·spacing[0]`,
+/// `y = origin[1] + j·spacing[1]`, interpolated by the tensor-product Catmull-Rom spline
+/// `h(x, y) = Σ_i Σ_j z_ij K((x − x_i)/Δx) K((y − y_j)/Δy)`, with one ghost node beyond
+/// each edge, linearly extrapolated (`z_{−1} = 2z_0 − z_1`), so that the surface is C¹,
+/// passes through every node and reproduces planes exactly. Feet stay on the grid's
+/// rectangle.
+#[derive(Clone, Debug)]
+pub struct HeightMap {
+    /// `(x, y)` of node `[0][0]` (m).
+    pub origin: [f64; 2],
+    /// Node spacing `(Δx, Δy)` (m), positive.
+    pub spacing: [f64; 2],
+    /// Heights, one row per y, one column per x (m); at least 2 × 2.
+    pub heights: Vec<Vec<f64>>,
+}
+
+impl HeightMap {
+    fn nx(&self) -> usize {
+        self.heights.first().map_or(0, Vec::len)
+    }
+
+    /// Height of node `(i, j)`, ghost nodes (index −1 or n) included.
+    fn node(&self, i: isize, j: isize) -> f64 {
+        let (nx, ny) = (self.nx() as isize, self.heights.len() as isize);
+        let col = |j: usize| -> f64 {
+            let row = &self.heights[j];
+            match i {
+                -1 => 2.0 * row[0] - row[1],
+                i if i == nx => 2.0 * row[(nx - 1) as usize] - row[(nx - 2) as usize],
+                i => row[i as usize],
+            }
+        };
+        match j {
+            -1 => 2.0 * col(0) - col(1),
+            j if j == ny => 2.0 * col((ny - 1) as usize) - col((ny - 2) as usize),
+            j => col(j as usize),
+        }
+    }
+
+    /// Node indices −1 ..= n (ghosts included) along each axis.
+    fn indices(
+        &self,
+    ) -> (
+        std::ops::RangeInclusive<isize>,
+        std::ops::RangeInclusive<isize>,
+    ) {
+        (-1..=self.nx() as isize, -1..=self.heights.len() as isize)
+    }
+
+    /// Height and gradient at a point (plain numbers).
+    fn eval(&self, x: f64, y: f64) -> (f64, [f64; 2]) {
+        let (is, js) = self.indices();
+        let [dx, dy] = self.spacing;
+        let (mut h, mut hx, mut hy) = (0.0, 0.0, 0.0);
+        for j in js {
+            let ty = (y - self.origin[1]) / dy - j as f64;
+            let (ky, dky) = (catmull_rom(ty), catmull_rom_slope(ty) / dy);
+            if ky == 0.0 && dky == 0.0 {
+                continue;
+            }
+            for i in is.clone() {
+                let tx = (x - self.origin[0]) / dx - i as f64;
+                let (kx, dkx) = (catmull_rom(tx), catmull_rom_slope(tx) / dx);
+                let z = self.node(i, j);
+                h += z * kx * ky;
+                hx += z * dkx * ky;
+                hy += z * kx * dky;
+            }
+        }
+        (h, [hx, hy])
+    }
+
+    /// Height and gradient as expressions.
+    fn expr(&self, x: Expr, y: Expr) -> (Expr, [Expr; 2]) {
+        let (is, js) = self.indices();
+        let [dx, dy] = self.spacing;
+        let kx: Vec<(isize, Expr, Expr)> = is
+            .map(|i| {
+                let (k, d) = catmull_rom_expr((x - self.origin[0]) / dx - i as f64);
+                (i, k, d / dx)
+            })
+            .collect();
+        let (mut h, mut hx, mut hy) = (Expr::zero(), Expr::zero(), Expr::zero());
+        for j in js {
+            let (ky, dky) = catmull_rom_expr((y - self.origin[1]) / dy - j as f64);
+            let dky = dky / dy;
+            let (mut row, mut drow) = (Expr::zero(), Expr::zero());
+            for (i, k, d) in &kx {
+                let z = self.node(*i, j);
+                row += z * *k;
+                drow += z * *d;
+            }
+            h += row * ky;
+            hx += drow * ky;
+            hy += row * dky;
+        }
+        (h, [hx, hy])
+    }
+}
+
+impl Terrain for HeightMap {
+    fn height(&self, x: Expr, y: Expr) -> Expr {
+        self.expr(x, y).0
+    }
+    fn gradient(&self, x: Expr, y: Expr) -> [Expr; 2] {
+        self.expr(x, y).1
+    }
+    fn height_at(&self, x: f64, y: f64) -> f64 {
+        self.eval(x, y).0
+    }
+    fn slope_at(&self, x: f64, y: f64) -> [f64; 2] {
+        self.eval(x, y).1
+    }
+    fn regions(&self) -> Vec<Region> {
+        let [x0, y0] = self.origin;
+        let x1 = x0 + (self.nx().max(1) - 1) as f64 * self.spacing[0];
+        let y1 = y0 + (self.heights.len().max(1) - 1) as f64 * self.spacing[1];
+        vec![Region {
+            x: [x0, x1],
+            y: [y0, y1],
+        }]
     }
 }
 
@@ -100,6 +459,20 @@ impl Terrain for StepTerrain {
 mod tests {
     use super::*;
     use symx::Function;
+
+    fn hills() -> HeightMap {
+        HeightMap {
+            origin: [-0.5, -0.5],
+            spacing: [0.5, 0.4],
+            heights: (0..5)
+                .map(|j| {
+                    (0..8)
+                        .map(|i| 0.1 * ((i as f64) * 0.9).sin() * ((j as f64) * 0.7).cos())
+                        .collect()
+                })
+                .collect(),
+        }
+    }
 
     /// The symbolic height and gradient agree with the numeric height and its central
     /// difference (h = 1e-7 on a slope of order k·D/π ≈ 3e5 near the edge is too coarse,
@@ -115,23 +488,95 @@ mod tests {
                 steepness: 50.0,
                 margin: 0.03,
             }),
+            Box::new(GapsTerrain {
+                gaps: vec![
+                    gap,
+                    Gap {
+                        min: 1.0,
+                        max: 1.1,
+                        steepness: 30.0,
+                        ..gap
+                    },
+                ],
+            }),
+            Box::new(hills()),
         ];
         let (x, y) = (Expr::sym("x"), Expr::sym("y"));
         for t in &terrains {
             let [gx, gy] = t.gradient(x, y);
             let f = Function::new(&[&[x, y]], &[&[t.height(x, y), gx, gy]]).unwrap();
-            for &px in &[0.0, 0.9, 1.05, 2.0, 2.2, 2.4, 3.0] {
-                let out = f.call(&[&[px, 0.3]]).unwrap()[0].clone();
-                assert!((out[0] - t.height_at(px, 0.3)).abs() < 1e-12);
-                let d = 1e-6;
-                let fd = (t.height_at(px + d, 0.3) - t.height_at(px - d, 0.3)) / (2.0 * d);
-                assert!(
-                    (out[1] - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
-                    "slope at {px}: {} vs {fd}",
-                    out[1]
-                );
-                assert_eq!(out[2], 0.0);
+            for &px in &[0.0, 0.9, 1.05, 1.3, 2.0, 2.2, 2.4, 3.0] {
+                for &py in &[0.3, 0.77] {
+                    let out = f.call(&[&[px, py]]).unwrap()[0].clone();
+                    assert!((out[0] - t.height_at(px, py)).abs() < 1e-12);
+                    let d = 1e-6;
+                    let fdx = (t.height_at(px + d, py) - t.height_at(px - d, py)) / (2.0 * d);
+                    let fdy = (t.height_at(px, py + d) - t.height_at(px, py - d)) / (2.0 * d);
+                    for (got, fd) in [(out[1], fdx), (out[2], fdy)] {
+                        assert!(
+                            (got - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                            "slope at ({px}, {py}): {got} vs {fd}"
+                        );
+                    }
+                    let [sx, sy] = t.slope_at(px, py);
+                    assert!((sx - out[1]).abs() < 1e-9 && (sy - out[2]).abs() < 1e-9);
+                }
             }
         }
+    }
+
+    /// The height map passes through its nodes, reproduces a plane exactly (ghost nodes
+    /// linearly extrapolated), and is C¹: at the cell boundaries (integer t, where the
+    /// kernel's pieces meet) the one-sided difference quotients of h and of its gradient
+    /// agree to O(step).
+    #[test]
+    fn height_map_interpolates_and_is_c1() {
+        let m = hills();
+        for (j, row) in m.heights.iter().enumerate() {
+            for (i, &z) in row.iter().enumerate() {
+                let (x, y) = (-0.5 + 0.5 * i as f64, -0.5 + 0.4 * j as f64);
+                assert!((m.height_at(x, y) - z).abs() < 1e-12, "node ({i}, {j})");
+            }
+        }
+        let plane = HeightMap {
+            heights: (0..4)
+                .map(|j| (0..5).map(|i| 0.3 * i as f64 - 0.2 * j as f64).collect())
+                .collect(),
+            ..m.clone()
+        };
+        for &(x, y) in &[(-0.4, -0.3), (0.13, 0.61), (1.45, 0.7)] {
+            let want = 0.3 * (x + 0.5) / 0.5 - 0.2 * (y + 0.5) / 0.4;
+            assert!((plane.height_at(x, y) - want).abs() < 1e-12);
+        }
+        // Across x = 0.5 (a node column): gradient continuous from both sides.
+        let e = 1e-7;
+        for y in [0.1, 0.33] {
+            let (l, r) = (m.slope_at(0.5 - e, y), m.slope_at(0.5 + e, y));
+            assert!((l[0] - r[0]).abs() < 1e-5 && (l[1] - r[1]).abs() < 1e-5);
+        }
+        // The kernel itself: value and slope continuous at |t| = 1 and 2.
+        for t in [1.0f64, 2.0] {
+            assert!((catmull_rom(t - e) - catmull_rom(t + e)).abs() < 1e-6);
+            assert!((catmull_rom_slope(t - e) - catmull_rom_slope(t + e)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn regions_of_gaps_and_distances() {
+        let g = |min: f64, max: f64| Gap {
+            min,
+            max,
+            depth: 1.0,
+            steepness: 1e6,
+            margin: 0.03,
+        };
+        let t = GapsTerrain {
+            gaps: vec![g(2.0, 2.1), g(1.0, 1.1)],
+        };
+        let r = t.regions();
+        assert_eq!(r.len(), 3);
+        assert!((r[0].x[1] - 0.97).abs() < 1e-12 && (r[1].x[0] - 1.13).abs() < 1e-12);
+        assert!((r[0].distance(&r[1]) - 0.16).abs() < 1e-12);
+        assert!(t.keep_out_depth(1.05, 0.0) > 0.0 && t.keep_out_depth(1.5, 3.0) == 0.0);
     }
 }

@@ -1,5 +1,6 @@
 //! The binary: exit codes and messages of `check`, `render`, `guess`, `solve`, `sweep`.
 
+use gap_crossing::status::StatusKind;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -148,6 +149,10 @@ fn solve_writes_a_plan_that_check_accepts() {
         "crawl",
         "--set",
         "n_step=12",
+        "--set",
+        "goal.B=[0.5, 0.5, 0.5]",
+        "--set",
+        "goal.F=[2.5, 0.5, 0.5]",
         "--out",
         out_dir.to_str().unwrap(),
     ]);
@@ -165,9 +170,9 @@ fn solve_writes_a_plan_that_check_accepts() {
         "{}",
         text(&out.stdout)
     );
-    // n_step 12 cannot reach the goals: the checker is told to skip that requirement.
+    // Goals 0.5 m ahead (the front feet cross the gap): reached, and required.
     let sol = out_dir.join("solution.json");
-    let out = run(&["check", sol.to_str().unwrap(), "--goal", "skip"]);
+    let out = run(&["check", sol.to_str().unwrap(), "--goal", "required"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
 }
 
@@ -180,7 +185,7 @@ fn sweep_solves_a_grid_and_records_failures() {
     let grid = d.join("grid.toml");
     std::fs::write(
         &grid,
-        "[base]\nn_step = 8\ngait = \"crawl\"\n[axes]\ngap.min = [2.25, 2.4]\n\"gap.depth\" = [0.5, 2]\n",
+        "[base]\nn_step = 9\ngait = \"crawl\"\ngoal = { B = [0.5, 0.5, 0.5], F = [2.5, 0.5, 0.5] }\n[axes]\ngap.min = [2.25, 2.4]\n\"gap.depth\" = [0.5, 2]\n",
     )
     .unwrap();
     let out_dir = d.join("out");
@@ -220,7 +225,10 @@ fn sweep_solves_a_grid_and_records_failures() {
     assert_eq!(json["summary"]["ok"], 2);
     let p1 = &json["points"][1];
     assert_eq!(p1["overrides"]["gap.depth"], 2.0);
-    assert_eq!(p1["status"], "solved");
+    assert_eq!(
+        StatusKind::from_word(p1["status"].as_str().unwrap()),
+        StatusKind::Solved
+    );
     assert_eq!(p1["check_ok"], true);
     assert!(p1["objective"].as_f64().unwrap() > 0.0);
     assert!(p1["iterations"].as_u64().unwrap() > 0);
@@ -235,7 +243,7 @@ fn sweep_solves_a_grid_and_records_failures() {
 
     // --solutions: each solved point's plan, which the checker accepts.
     let p0 = out_dir.join("points").join("0000.json");
-    let out = run(&["check", p0.to_str().unwrap(), "--goal", "skip"]);
+    let out = run(&["check", p0.to_str().unwrap(), "--goal", "required"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
     assert!(!out_dir.join("points").join("0002.json").exists());
 }
@@ -247,8 +255,8 @@ fn sweep_succeeds_with_exit_0_and_rejects_bad_grids_with_2() {
         &d,
         "grid.json",
         &serde_json::json!({
-            "base": { "n_step": 6, "gait": "crawl" },
-            "axes": { "goal.F": [[5.0, 0.5, 0.5], [5.0, 0.6, 0.5]] }
+            "base": { "n_step": 9, "gait": "crawl", "goal": { "B": [0.5, 0.5, 0.5] } },
+            "axes": { "goal.F": [[2.5, 0.5, 0.5], [2.5, 0.6, 0.5]] }
         }),
     );
     let out_dir = d.join("out");
@@ -373,7 +381,11 @@ fn solve_opt_sets_backend_options() {
             "--gait",
             "crawl",
             "--set",
-            "n_step=6",
+            "n_step=9",
+            "--set",
+            "goal.B=[0.5, 0.5, 0.5]",
+            "--set",
+            "goal.F=[2.5, 0.5, 0.5]",
             "--out",
             out_dir.to_str().unwrap(),
         ];
@@ -398,7 +410,8 @@ fn solve_opt_sets_backend_options() {
     let out = solve(&["--opt", "max_iter=1", "--opt", "print_level=0"]);
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
     assert!(
-        text(&out.stderr).contains("maximum_iterations_exceeded"),
+        text(&out.stderr).contains("solver_failed")
+            && text(&out.stderr).contains("MaximumIterationsExceeded"),
         "{}",
         text(&out.stderr)
     );
@@ -453,7 +466,8 @@ fn sweep_takes_solver_options() {
     let grid = write(
         &d,
         "grid.json",
-        &serde_json::json!({ "base": { "n_step": 6, "gait": "crawl" }, "axes": {} }),
+        &serde_json::json!({ "base": { "n_step": 9, "gait": "crawl",
+            "goal": { "B": [0.5, 0.5, 0.5], "F": [2.5, 0.5, 0.5] } }, "axes": {} }),
     );
     let out_dir = d.join("out");
     let sweep = |opts: &[&str]| {
@@ -472,7 +486,8 @@ fn sweep_takes_solver_options() {
     let out = sweep(&["--opt", "max_iter=1"]);
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
     assert!(
-        text(&out.stdout).contains("maximum_iterations_exceeded"),
+        text(&out.stdout).contains("solver_failed")
+            && text(&out.stdout).contains("MaximumIterationsExceeded"),
         "{}",
         text(&out.stdout)
     );

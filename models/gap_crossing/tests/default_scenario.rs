@@ -33,7 +33,10 @@ fn default_scenario_solves_and_checks() {
 
     let file = SolutionFile::read(&path).unwrap();
     let s = Scenario::default();
-    assert_eq!(file.solver.status, "solved");
+    assert_eq!(
+        gap_crossing::status::StatusKind::from_word(&file.solver.status),
+        gap_crossing::status::StatusKind::Solved
+    );
     let last = file.stances.last().unwrap();
     // 0.05 m: the specification's goal tolerance.
     for (com, goal) in [(last.com.b, s.goal.b), (last.com.f, s.goal.f)] {

@@ -169,7 +169,7 @@ fn start_violating_the_equations_is_rejected() {
     // A foot in the widened gap (the gap moved under the front feet).
     let e = rejected("[gap]\nmin = 1.98\nmax = 2.1\ndepth = 0.0");
     assert!(
-        e.contains("widened gap") && e.contains("start.feet.FR") && e.contains("FL"),
+        e.contains("keep-out") && e.contains("start.feet.FR") && e.contains("FL"),
         "{e}"
     );
 }
@@ -379,4 +379,79 @@ fn every_problem_is_reported_at_once() {
         }
         other => panic!("expected Invalid, got {other:?}"),
     }
+}
+
+/// The `terrain` table: each kind parses from TOML and JSON; a bad value is rejected
+/// naming its field; a height map's CSV is read relative to the scenario file, and a
+/// malformed CSV is rejected naming its line.
+#[test]
+fn terrain_kinds_parse_and_bad_ones_are_rejected() {
+    use gap_crossing::scenario::TerrainSpec;
+    let dir = std::env::temp_dir().join(format!("gap_crossing_terrain_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let load = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        Scenario::load(&p)
+    };
+    let s = load(
+        "step.toml",
+        "[terrain]\nkind = \"step\"\nedge = 2.3\nrise = 0.1\nsteepness = 1e6\nmargin = 0.04\n",
+    )
+    .unwrap();
+    assert!(matches!(s.terrain, TerrainSpec::Step { rise, .. } if rise == 0.1));
+    let s = load(
+        "stones.json",
+        r#"{ "terrain": { "kind": "stones", "stones": [[-0.5, 2.15, -0.3, 1.3], [2.3, 2.5, 0, 1]] } }"#,
+    )
+    .unwrap();
+    assert!(matches!(&s.terrain, TerrainSpec::Stones { stones } if stones.len() == 2));
+    let bad = |name: &str, text: &str| load(name, text).unwrap_err().to_string();
+    let e = bad(
+        "a.toml",
+        "[terrain]\nkind = \"step\"\nedge = 2.3\nrise = 0.1\nsteepness = -1.0\nmargin = 0.04\n",
+    );
+    assert!(e.contains("terrain.steepness") && e.contains("-1"), "{e}");
+    let e = bad("b.toml", "[terrain]\nkind = \"step\"\nedge = 2.3\n");
+    assert!(e.contains("terrain") && e.contains("rise"), "{e}");
+    let e = bad("c.toml", "[terrain]\nkind = \"lava\"\n");
+    assert!(e.contains("terrain") && e.contains("lava"), "{e}");
+    let e = bad(
+        "d.toml",
+        "[terrain]\nkind = \"stones\"\nstones = [[1.0, 0.5, 0.0, 1.0]]\n",
+    );
+    assert!(e.contains("terrain.stones[0]"), "{e}");
+    // The start feet are not on any stone.
+    let e = bad(
+        "d2.toml",
+        "[terrain]\nkind = \"stones\"\nstones = [[3.0, 3.5, 0.0, 1.0]]\n",
+    );
+    assert!(e.contains("keep-out") && e.contains("start.feet.BR"), "{e}");
+    let e = bad("e.toml", "[terrain]\nkind = \"gaps\"\ngaps = [{ min = 1.0, max = 0.9, depth = 1.0, steepness = 1e6, margin = 0.03 }]\n");
+    assert!(e.contains("terrain.gaps[0].min"), "{e}");
+    // Height maps: the CSV next to the scenario file.
+    std::fs::write(dir.join("flat.csv"), "# flat\n0, 0, 0\n0, 0, 0\n").unwrap();
+    let hm = "[terrain]\nkind = \"height_map\"\nfile = \"flat.csv\"\norigin = [-1.0, -1.0]\nspacing = [3.0, 3.0]\n";
+    let s = load("hm.toml", hm).unwrap();
+    assert!(
+        matches!(&s.terrain, TerrainSpec::HeightMap { heights, .. } if heights.len() == 2 && heights[0].len() == 3)
+    );
+    std::fs::write(dir.join("flat.csv"), "0, 0, 0\n0, 0\n").unwrap();
+    let e = bad("hm2.toml", hm);
+    assert!(e.contains("line 2") && e.contains("2 columns"), "{e}");
+    std::fs::write(dir.join("flat.csv"), "0, 0, x\n0, 0, 0\n").unwrap();
+    let e = bad("hm3.toml", hm);
+    assert!(e.contains("line 1") && e.contains("`x`"), "{e}");
+    // Overrides: a field of the same kind, or a whole new kind.
+    let mut s = Scenario::default();
+    s.set(
+        "terrain",
+        "{kind=\"step\", edge=2.3, rise=0.1, steepness=1e6, margin=0.04}",
+    )
+    .unwrap();
+    s.set("terrain.rise", "0.2").unwrap();
+    assert!(
+        matches!(s.terrain, TerrainSpec::Step { rise, edge, .. } if rise == 0.2 && edge == 2.3)
+    );
+    s.validate().unwrap();
 }

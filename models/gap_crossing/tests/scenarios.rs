@@ -6,6 +6,7 @@
 use gap_crossing::check;
 use gap_crossing::scenario::{Gait, Scenario};
 use gap_crossing::solve::{self, Settings};
+use gap_crossing::status::StatusKind;
 use gap_crossing::sweep::Grid;
 use std::path::{Path, PathBuf};
 
@@ -74,7 +75,7 @@ fn scenario_files_solve_and_check() {
         })
         .collect();
     // Two at a time (the machine's cores), results in file order.
-    let results: Vec<(String, String, check::Report)> = std::thread::scope(|scope| {
+    let results: Vec<(String, StatusKind, check::Report)> = std::thread::scope(|scope| {
         let chunks: Vec<_> = scenarios
             .chunks(scenarios.len().div_ceil(2))
             .map(|chunk| {
@@ -89,7 +90,7 @@ fn scenario_files_solve_and_check() {
                             let o = solve::plan(&s, &Settings::default())
                                 .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
                             let name = p.file_name().unwrap().to_string_lossy().into_owned();
-                            (name, o.file.solver.status.clone(), check::check(&o.file))
+                            (name, o.status.kind(), check::check(&o.file))
                         })
                         .collect::<Vec<_>>()
                 })
@@ -98,10 +99,10 @@ fn scenario_files_solve_and_check() {
         chunks.into_iter().flat_map(|h| h.join().unwrap()).collect()
     });
     for (name, status, report) in &results {
-        println!("{name:<22} {status:<8} {}", report.summary());
+        println!("{name:<22} {status:<17} {}", report.summary());
     }
     for (name, status, report) in &results {
-        assert_eq!(status, "solved", "{name}");
+        assert_eq!(*status, StatusKind::Solved, "{name}");
         assert!(report.ok(), "{name}: {report}");
     }
 }

@@ -2,6 +2,7 @@
 //! with 12 stances, through the built binary. Status solved, the independent checker
 //! passes, and the objective matches the interior-point method's on the same scenario.
 use gap_crossing::plan::SolutionFile;
+use gap_crossing::status::StatusKind;
 use std::path::Path;
 use std::process::Command;
 
@@ -16,6 +17,11 @@ fn solve(solver: &str, dir: &Path) -> SolutionFile {
             "crawl",
             "--set",
             "n_step=12",
+            // Goals 0.5 m ahead (the front feet cross the gap): reachable in 12 stances.
+            "--set",
+            "goal.B=[0.5, 0.5, 0.5]",
+            "--set",
+            "goal.F=[2.5, 0.5, 0.5]",
             "--out",
             dir.to_str().unwrap(),
         ])
@@ -45,9 +51,15 @@ fn sqp_solves_the_crawl_gait_and_matches_the_ipm() {
     let base = std::env::temp_dir().join(format!("gap_crossing_sqp_{}", std::process::id()));
     let sqp = solve("sqp", &base.join("sqp"));
     assert_eq!(sqp.solver.name, "sqp");
-    assert_eq!(sqp.solver.status, "solved");
+    assert_eq!(
+        StatusKind::from_word(&sqp.solver.status),
+        StatusKind::Solved
+    );
     let ipm = solve("ipm", &base.join("ipm"));
-    assert_eq!(ipm.solver.status, "solved");
+    assert_eq!(
+        StatusKind::from_word(&ipm.solver.status),
+        StatusKind::Solved
+    );
     let rel = (sqp.solver.objective - ipm.solver.objective).abs() / ipm.solver.objective;
     assert!(
         rel <= 1e-4,

@@ -2,7 +2,8 @@
 
 use super::{esc, fmt_tick, nice_step, ramp, ticks, FONT, MARGIN_L, MARGIN_R, WIDTH};
 use crate::plan::SolutionFile;
-use crate::scenario::{Biped, Foot, Scenario, Vec3};
+use crate::scenario::{Biped, Foot, Gap, Scenario, TerrainSpec, Vec3};
+use crate::terrain::{self, Terrain};
 use std::fmt::Write;
 
 /// A linear map from data to pixels for one panel with equal scales on both axes.
@@ -145,14 +146,29 @@ fn goal_marker(svg: &mut String, x: f64, y: f64, label: &str) {
     );
 }
 
-/// Terrain sample points: uniform, plus points hugging each gap edge so the steep atan
+/// Steep edges of the terrain: `(x, width)` with width ≈ the edge's 1/k scale.
+fn edges(s: &Scenario) -> Vec<(f64, f64)> {
+    let gap = |g: &Gap| {
+        let w = 5.0 / g.steepness.max(1e-9);
+        [(g.min, w), (g.max, w)]
+    };
+    match &s.terrain {
+        TerrainSpec::Gap => gap(&s.gap).to_vec(),
+        TerrainSpec::Gaps { gaps } => gaps.iter().flat_map(gap).collect(),
+        TerrainSpec::Step {
+            edge, steepness, ..
+        } => vec![(*edge, 5.0 / steepness.max(1e-9))],
+        _ => Vec::new(),
+    }
+}
+
+/// Terrain sample points: uniform, plus points hugging each steep edge so the atan
 /// edges are drawn as edges.
 fn terrain_xs(s: &Scenario, lo: f64, hi: f64) -> Vec<f64> {
     let mut xs: Vec<f64> = (0..=400)
         .map(|i| lo + (hi - lo) * i as f64 / 400.0)
         .collect();
-    let w = 5.0 / s.gap.steepness.max(1e-9);
-    for e in [s.gap.min, s.gap.max] {
+    for (e, w) in edges(s) {
         for d in [-20.0, -5.0, -1.0, 0.0, 1.0, 5.0, 20.0] {
             let x = e + d * w;
             if x > lo && x < hi {
@@ -162,6 +178,149 @@ fn terrain_xs(s: &Scenario, lo: f64, hi: f64) -> Vec<f64> {
     }
     xs.sort_by(f64::total_cmp);
     xs
+}
+
+/// A data rectangle clipped to the panel, as an SVG rect.
+fn rect(svg: &mut String, p: &Panel, x: [f64; 2], y: [f64; 2], style: &str) {
+    let (x0, x1) = (x[0].max(p.xr.0), x[1].min(p.xr.1));
+    let (y0, y1) = (y[0].max(p.yr.0), y[1].min(p.yr.1));
+    if x0 >= x1 || y0 >= y1 {
+        return;
+    }
+    let _ = writeln!(
+        svg,
+        r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {style}/>"#,
+        p.px(x0),
+        p.py(y1),
+        (p.px(x1) - p.px(x0)).max(0.5),
+        (p.py(y0) - p.py(y1)).max(0.5)
+    );
+}
+
+/// Top view of the terrain: the keep-out pale red, allowed regions white (stones
+/// sand-coloured), gaps dark red, a step's edge as a line, a height map as shaded cells.
+fn terrain_top(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain) {
+    let all = [f64::NEG_INFINITY, f64::INFINITY];
+    rect(svg, p, all, all, r##"fill="#d62728" fill-opacity="0.15""##);
+    let stones = matches!(s.terrain, TerrainSpec::Stones { .. });
+    for r in t.regions() {
+        let style = if stones {
+            r##"fill="#e8dcc0" stroke="#8c7a55" stroke-width="0.8""##
+        } else {
+            r#"fill="white""#
+        };
+        rect(svg, p, r.x, r.y, style);
+    }
+    let dark = r##"fill="#7f1d1d" fill-opacity="0.45""##;
+    match &s.terrain {
+        TerrainSpec::Gap => rect(svg, p, [s.gap.min, s.gap.max], all, dark),
+        TerrainSpec::Gaps { gaps } => {
+            for g in gaps {
+                rect(svg, p, [g.min, g.max], all, dark);
+            }
+        }
+        TerrainSpec::Step { edge, rise, .. } => {
+            let _ = writeln!(
+                svg,
+                r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#6b4f2a" stroke-width="2"/><text x="{:.1}" y="{:.1}" font-size="11" {FONT}>step {rise:+} m</text>"##,
+                p.y0,
+                p.y0 + p.h(),
+                p.px(*edge) + 4.0,
+                p.y0 + 14.0,
+                x = p.px(*edge)
+            );
+        }
+        TerrainSpec::HeightMap { .. } => {
+            // Cells shaded by height (light = low, brown = high) over the grid.
+            let r = t.regions()[0];
+            let (nx, ny) = (60, 24);
+            let (lo, hi) = (terrain_range(s, t).0, terrain_range(s, t).1.max(1e-9));
+            for a in 0..nx {
+                for b in 0..ny {
+                    let x = [
+                        r.x[0] + (r.x[1] - r.x[0]) * a as f64 / nx as f64,
+                        r.x[0] + (r.x[1] - r.x[0]) * (a + 1) as f64 / nx as f64,
+                    ];
+                    let y = [
+                        r.y[0] + (r.y[1] - r.y[0]) * b as f64 / ny as f64,
+                        r.y[0] + (r.y[1] - r.y[0]) * (b + 1) as f64 / ny as f64,
+                    ];
+                    let h = t.height_at((x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0);
+                    let u = ((h - lo) / (hi - lo).max(1e-9)).clamp(0.0, 1.0);
+                    let style = format!(
+                        r##"fill="#8c6d3f" fill-opacity="{:.2}" stroke="none""##,
+                        0.05 + 0.5 * u
+                    );
+                    rect(svg, p, x, y, &style);
+                }
+            }
+        }
+        TerrainSpec::Stones { .. } => {}
+    }
+}
+
+/// Side view of the keep-out: pale red where no allowed region holds (x, y) along the
+/// profile's line (stones: each stone as a block at z = 0 instead).
+fn terrain_side(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain, tx: &[f64]) {
+    let band = |svg: &mut String, a: f64, b: f64| {
+        let _ = writeln!(
+            svg,
+            r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#d62728" fill-opacity="0.12"/>"##,
+            p.px(a),
+            p.y0,
+            (p.px(b) - p.px(a)).max(0.5),
+            p.h()
+        );
+    };
+    if let TerrainSpec::Stones { stones } = &s.terrain {
+        for b in stones {
+            rect(svg, p, [b[0], b[1]], [-0.03, 0.0], r##"fill="#8c7a55""##);
+        }
+        return;
+    }
+    let (y, regions) = (side_y(s), t.regions());
+    let mut out_from: Option<f64> = None;
+    for &x in tx {
+        let out = !regions.iter().any(|r| r.contains(x, y, 0.0));
+        match (out, out_from) {
+            (true, None) => out_from = Some(x),
+            (false, Some(a)) => {
+                band(svg, a, x);
+                out_from = None;
+            }
+            _ => {}
+        }
+    }
+    if let (Some(a), Some(&b)) = (out_from, tx.last()) {
+        band(svg, a, b);
+    }
+}
+
+/// Lowest and highest terrain height along the side view's line (m), for height maps
+/// sampled over the grid.
+fn terrain_range(s: &Scenario, t: &dyn Terrain) -> (f64, f64) {
+    let r = t.regions();
+    let (x0, x1) = (
+        r.iter()
+            .map(|r| r.x[0])
+            .fold(f64::INFINITY, f64::min)
+            .max(-50.0),
+        r.iter()
+            .map(|r| r.x[1])
+            .fold(f64::NEG_INFINITY, f64::max)
+            .min(50.0),
+    );
+    let y = side_y(s);
+    (0..=200)
+        .map(|k| t.height_at(x0 + (x1 - x0) * k as f64 / 200.0, y))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), h| {
+            (a.min(h), b.max(h))
+        })
+}
+
+/// The y of the side view's terrain profile: the mean y of the start feet.
+fn side_y(s: &Scenario) -> f64 {
+    s.start.feet.to_array().iter().map(|p| p[1]).sum::<f64>() / 4.0
 }
 
 /// The plan figure (top view above side view) of a solution file.
@@ -193,13 +352,23 @@ pub fn plan_svg(file: &SolutionFile) -> String {
     let zs: Vec<f64> = pts.iter().map(|p| p[2]).filter(finite).collect();
     let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
     let max = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let (gl, gh) = s.gap.keep_out();
-    let xr = (min(&xs).min(gl) - 0.4, max(&xs).max(gh) + 0.4);
+    let terrain = terrain::of(s);
+    let depth = match &s.terrain {
+        TerrainSpec::Gap => s.gap.depth,
+        TerrainSpec::Gaps { gaps } => gaps.iter().map(|g| g.depth).fold(0.0, f64::max),
+        _ => 0.0,
+    };
+    let xr = (min(&xs) - 0.4, max(&xs) + 0.4);
     let yr = (min(&ys) - 0.3, max(&ys) + 0.3);
-    let shown_depth = s.gap.depth.min(1.0);
+    let shown_depth = depth.min(1.0);
+    let (t_lo, t_hi) = terrain_range(s, &*terrain);
     let zr = (
-        min(&zs).max(-shown_depth - 0.2).min(-shown_depth) - 0.1,
-        max(&zs) + 0.15,
+        min(&zs)
+            .min(t_lo.max(-1.0))
+            .max(-shown_depth - 0.2)
+            .min(-shown_depth)
+            - 0.1,
+        max(&zs).max(t_hi) + 0.15,
     );
     let scale = (WIDTH - MARGIN_L - MARGIN_R) / (xr.1 - xr.0);
     let top = Panel {
@@ -233,10 +402,27 @@ pub fn plan_svg(file: &SolutionFile) -> String {
         esc(&file.solver.status),
         file.solver.objective
     );
+    let ground = match &s.terrain {
+        TerrainSpec::Gap => format!(
+            "gap x ∈ ({}, {}) m, depth {} m, margin {} m",
+            s.gap.min, s.gap.max, s.gap.depth, s.gap.margin
+        ),
+        TerrainSpec::Gaps { gaps } => format!("{} gaps", gaps.len()),
+        TerrainSpec::Step {
+            edge, rise, margin, ..
+        } => format!("step {rise:+} m at x = {edge} m, margin {margin} m"),
+        TerrainSpec::Stones { stones } => format!("{} stepping stones", stones.len()),
+        TerrainSpec::HeightMap { file, heights, .. } => format!(
+            "height map {} ({} × {} nodes, Catmull-Rom)",
+            file,
+            heights.first().map_or(0, Vec::len),
+            heights.len()
+        ),
+    };
     let _ = writeln!(
         svg,
-        r##"<text x="{MARGIN_L}" y="42" font-size="12" fill="#555" {FONT}>gap x ∈ ({}, {}) m, depth {} m, margin {} m; squares = front feet, circles = back feet, diamonds = CoMs; colour = stance</text>"##,
-        s.gap.min, s.gap.max, s.gap.depth, s.gap.margin
+        r##"<text x="{MARGIN_L}" y="42" font-size="12" fill="#555" {FONT}>{}; pale red = keep-out; squares = front feet, circles = back feet, diamonds = CoMs; colour = stance</text>"##,
+        esc(&ground)
     );
     let _ = writeln!(svg, "<defs>");
     top.clip(&mut svg, "clip-top");
@@ -246,18 +432,7 @@ pub fn plan_svg(file: &SolutionFile) -> String {
     // ---- Top view.
     top.axes(&mut svg, "x (m)", "y (m)", "Top view (x–y)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-top)">"##);
-    let band = |svg: &mut String, p: &Panel, a: f64, b: f64, fill: &str, op: f64| {
-        let _ = writeln!(
-            svg,
-            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{fill}" fill-opacity="{op}"/>"#,
-            p.px(a),
-            p.y0,
-            (p.px(b) - p.px(a)).max(0.5),
-            p.h()
-        );
-    };
-    band(&mut svg, &top, gl, gh, "#d62728", 0.15);
-    band(&mut svg, &top, s.gap.min, s.gap.max, "#7f1d1d", 0.45);
+    terrain_top(&mut svg, &top, s, &*terrain);
     // Foot trails (thin grey) and CoM paths.
     for i in Foot::ALL {
         let path: Vec<String> = st
@@ -331,15 +506,16 @@ pub fn plan_svg(file: &SolutionFile) -> String {
     // ---- Side view.
     side.axes(&mut svg, "x (m)", "z (m)", "Side view (x–z)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-side)">"##);
-    band(&mut svg, &side, gl, gh, "#d62728", 0.12);
+    let y_side = side_y(s);
     let tx = terrain_xs(s, xr.0, xr.1);
+    terrain_side(&mut svg, &side, s, &*terrain, &tx);
     let mut d = format!("M{:.1},{:.1}", side.px(xr.0), side.py(zr.0));
     for &x in &tx {
         let _ = write!(
             d,
             " L{:.2},{:.2}",
             side.px(x),
-            side.py(s.gap.height(x).max(zr.0))
+            side.py(terrain.height_at(x, y_side).max(zr.0))
         );
     }
     let _ = write!(d, " L{:.1},{:.1} Z", side.px(xr.1), side.py(zr.0));
@@ -376,13 +552,13 @@ pub fn plan_svg(file: &SolutionFile) -> String {
         let g = s.goal.get(j);
         goal_marker(&mut svg, side.px(g[0]), side.py(g[2]), &format!("goal {j}"));
     }
-    if s.gap.depth > shown_depth {
+    if depth > shown_depth {
         let _ = writeln!(
             svg,
             r#"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="middle" {FONT}>depth {} m (cut)</text>"#,
-            side.px((s.gap.min + s.gap.max) / 2.0),
+            side.px(edges(s).first().map_or(xr.0, |e| e.0)),
             side.py(zr.0) - 4.0,
-            s.gap.depth
+            depth
         );
     }
     let _ = writeln!(svg, "</g>");
@@ -430,7 +606,7 @@ pub fn plan_svg(file: &SolutionFile) -> String {
         ("front foot (FR, FL)", 1),
         ("CoM (B, F)", 2),
         ("goal CoM", 3),
-        ("gap / margin", 4),
+        ("gap / keep-out", 4),
     ];
     for (label, kind) in items {
         match kind {

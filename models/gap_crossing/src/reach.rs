@@ -1,0 +1,244 @@
+//! What no plan can do, proved from the geometry: certificates that a goal is
+//! unreachable.
+//!
+//! Two facts bound every plan, whatever the solver does:
+//! - a foot moves at most `r = √step_radius_sq` (0.3 m) per transition, in 3-D, hence at
+//!   most `r` horizontally (5);
+//! - at the end, each CoM is within `GOAL_TOL` (0.05 m) of its goal and each foot within
+//!   `√leg_length_sq` of its CoM (11), so each foot ends within
+//!   `ρ = √leg_length_sq + GOAL_TOL` of its biped's goal CoM.
+//!
+//! [`uncrossable`]: a foot stands only in the terrain's allowed regions, and can step
+//! from one region to another only when their horizontal distance is below `r` (at
+//! distance ≥ r a step would need `‖Δr‖ ≥ r`; the spec counts equality as not crossable,
+//! see docs/gap-crossing.md). If no region reachable that way from a foot's start comes
+//! within `ρ` of its goal CoM, no plan reaches the goal. For the spec's gap this is "the
+//! keep-out zone (gap plus both margins) is at least as wide as the step reach".
+//!
+//! [`stances_needed`]: each foot needs at least `⌈(‖start − goal CoM‖ − ρ)/r⌉` moves
+//! and one foot moves per transition (10), so `1 + Σ` moves stances at least.
+use crate::check::GOAL_TOL;
+use crate::scenario::{Foot, Scenario};
+use crate::terrain::{self, Region};
+use std::fmt;
+
+/// Proof that a foot cannot reach its goal: the regions it can reach and the step
+/// needed to leave them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uncrossable {
+    /// The foot.
+    pub foot: Foot,
+    /// The step reach r (m).
+    pub reach: f64,
+    /// How close to its goal CoM the foot must end, ρ (m).
+    pub need_within: f64,
+    /// Horizontal distance from the goal CoM to the nearest point the foot can stand on (m).
+    pub nearest: f64,
+    /// The x range covered by the regions the foot can reach (m).
+    pub reachable_x: [f64; 2],
+    /// The shortest horizontal distance from a reachable region to any other region
+    /// (m; ≥ reach), `None` when there is no other region.
+    pub shortest_exit: Option<f64>,
+}
+
+impl fmt::Display for Uncrossable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "foot {} can stand only in x ∈ [{:.4}, {:.4}] m (the regions it can reach from its start)",
+            self.foot, self.reachable_x[0], self.reachable_x[1]
+        )?;
+        if let Some(d) = self.shortest_exit {
+            write!(
+                f,
+                "; the next region is {d:.4} m away, not less than the step reach {:.4} m",
+                self.reach
+            )?;
+        }
+        write!(
+            f,
+            "; it must end within {:.4} m of its goal CoM (leg + 0.05 m goal tolerance) but can come no closer than {:.4} m",
+            self.need_within, self.nearest
+        )
+    }
+}
+
+/// The lower bound on the stances any plan needs to reach the goal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unreachable {
+    /// Stances needed at least: 1 + the sum of `moves`.
+    pub needed: usize,
+    /// Moves needed at least by each foot, BR, BL, FR, FL.
+    pub moves: [usize; 4],
+}
+
+impl fmt::Display for Unreachable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "any plan needs at least {} stances (moves per foot at ≤ 0.3 m each: BR {}, BL {}, FR {}, FL {})",
+            self.needed, self.moves[0], self.moves[1], self.moves[2], self.moves[3]
+        )
+    }
+}
+
+/// `ρ`: how close to its goal CoM each foot must end (m).
+pub fn goal_radius(s: &Scenario) -> f64 {
+    s.leg_length_sq.sqrt() + GOAL_TOL
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The lower bound of the module docs on the stances needed to reach the goal.
+pub fn stances_needed(s: &Scenario) -> Unreachable {
+    let r = s.step_radius_sq.sqrt();
+    let rho = goal_radius(s);
+    let moves = Foot::ALL.map(|i| {
+        let d = dist(s.start.feet.get(i), s.goal.get(i.biped())) - rho;
+        if d <= 0.0 {
+            0
+        } else {
+            (d / r).ceil() as usize
+        }
+    });
+    Unreachable {
+        needed: 1 + moves.iter().sum::<usize>(),
+        moves,
+    }
+}
+
+/// Indices of the regions reachable from the region(s) holding `(x, y)`, by steps
+/// between regions closer than `reach`.
+fn reachable(regions: &[Region], x: f64, y: f64, reach: f64) -> Vec<usize> {
+    let mut seen = vec![false; regions.len()];
+    let mut stack: Vec<usize> = (0..regions.len())
+        .filter(|&k| regions[k].contains(x, y, 1e-9))
+        .collect();
+    for &k in &stack {
+        seen[k] = true;
+    }
+    while let Some(a) = stack.pop() {
+        for b in 0..regions.len() {
+            if !seen[b] && regions[a].distance(&regions[b]) < reach {
+                seen[b] = true;
+                stack.push(b);
+            }
+        }
+    }
+    (0..regions.len()).filter(|&k| seen[k]).collect()
+}
+
+/// A certificate that some foot cannot reach its goal, or `None` when every foot can
+/// (as far as this geometric test sees).
+pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
+    let regions = terrain::of(s).regions();
+    let reach = s.step_radius_sq.sqrt();
+    let rho = goal_radius(s);
+    for i in Foot::ALL {
+        let p = s.start.feet.get(i);
+        let g = s.goal.get(i.biped());
+        let ok = reachable(&regions, p[0], p[1], reach);
+        let nearest = ok
+            .iter()
+            .map(|&k| regions[k].distance_to(g[0], g[1]))
+            .fold(f64::INFINITY, f64::min);
+        if nearest <= rho {
+            continue;
+        }
+        let reachable_x = ok.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |a, &k| {
+            [a[0].min(regions[k].x[0]), a[1].max(regions[k].x[1])]
+        });
+        let shortest_exit = ok
+            .iter()
+            .flat_map(|&a| {
+                (0..regions.len())
+                    .filter(|b| !ok.contains(b))
+                    .map(move |b| (a, b))
+            })
+            .map(|(a, b)| regions[a].distance(&regions[b]))
+            .min_by(f64::total_cmp);
+        return Some(Uncrossable {
+            foot: i,
+            reach,
+            need_within: rho,
+            nearest,
+            reachable_x,
+            shortest_exit,
+        });
+    }
+    None
+}
+
+/// Feet of a plan's last stance `last` that stop before a crossable keep-out zone: the
+/// allowed region nearest the foot's goal (its start moved with its biped's CoM
+/// displacement) is reachable from its start by steps shorter than the reach, n_step is
+/// not below [`stances_needed`], and the foot stands in another allowed region. Each with
+/// its horizontal distance from that region (m).
+pub fn stopped_before_crossable(s: &Scenario, last: &crate::scenario::Feet) -> Vec<(Foot, f64)> {
+    if s.n_step < stances_needed(s).needed {
+        return Vec::new();
+    }
+    let regions = terrain::of(s).regions();
+    let reach = s.step_radius_sq.sqrt();
+    let goals = crate::gait::foot_goals(s);
+    let mut out = Vec::new();
+    for i in Foot::ALL {
+        let (p, g, f) = (s.start.feet.get(i), goals.get(i), last.get(i));
+        let Some(target) = (0..regions.len()).min_by(|&a, &b| {
+            regions[a]
+                .distance_to(g[0], g[1])
+                .total_cmp(&regions[b].distance_to(g[0], g[1]))
+        }) else {
+            continue;
+        };
+        let d = regions[target].distance_to(f[0], f[1]);
+        // A foot in the keep-out itself is the checker's `gap` finding, not this one.
+        let standing = regions.iter().any(|r| r.contains(f[0], f[1], 1e-6));
+        if standing && d > 1e-6 && reachable(&regions, p[0], p[1], reach).contains(&target) {
+            out.push((i, d));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The default scenario's goal is reachable; its bound is below its 60 stances and
+    /// equals the hand count: each foot starts 3.0822 m from its goal CoM
+    /// (√(3² + 0.5² + 0.5²)), ρ = √0.5 + 0.05 = 0.7571, ⌈2.3251/0.3⌉ = 8 moves, 33 stances.
+    #[test]
+    fn default_bound_and_no_certificate() {
+        let s = Scenario::default();
+        assert_eq!(uncrossable(&s), None);
+        let b = stances_needed(&s);
+        assert_eq!(b.moves, [8, 8, 8, 8]);
+        assert_eq!(b.needed, 33);
+    }
+
+    /// A 0.25 m gap with 0.03 m margins is a 0.31 m keep-out: the front feet cannot reach
+    /// the far side (0.31 ≥ 0.3); at 0.299 m they can.
+    #[test]
+    fn keep_out_at_the_reach() {
+        let mut s = Scenario::default();
+        s.gap.min = 2.5;
+        s.gap.max = 2.75;
+        let c = uncrossable(&s).expect("certificate");
+        assert!((c.shortest_exit.unwrap() - 0.31).abs() < 1e-12, "{c}");
+        assert!(c.to_string().contains("0.3100"), "{c}");
+        s.gap.max = 2.5 + 0.299 - 0.06;
+        assert_eq!(uncrossable(&s), None);
+        // Keep-out exactly as wide as the reach (numbers exact in binary: 2.75 − 2.5 =
+        // 0.25 = √0.0625): not crossable, as the spec says.
+        s.gap.max = 2.75;
+        s.gap.margin = 0.0;
+        s.step_radius_sq = 0.0625;
+        assert!(
+            uncrossable(&s).is_some(),
+            "keep-out = reach counts as not crossable"
+        );
+    }
+}
