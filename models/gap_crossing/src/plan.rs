@@ -74,6 +74,11 @@ pub struct SolverInfo {
     pub iterations: usize,
     /// Objective (1) at the returned point.
     pub objective: f64,
+    /// Free gait: objective (1) of the problem without (10) (every foot may move at
+    /// every transition), a reference for what (10) costs (`solve::objective_without_10`);
+    /// absent for the crawl gait or when that solve failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective_without_10: Option<f64>,
     /// Largest constraint violation at the returned point, as the solver measures it.
     pub max_constraint_violation: f64,
     /// Wall time of the solve (s).

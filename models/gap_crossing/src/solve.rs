@@ -307,16 +307,19 @@ pub fn plan_on(
     let mut phases = Vec::new();
     let crawl = gait::crawl_schedule(s.n_step);
     let guess = gait::crawl(s);
-    let last = match s.gait {
-        Gait::Crawl => run(
-            s,
-            terrain,
-            &crawl,
-            &guess,
-            settings,
-            &mut phases,
-            "crawl gait",
-        )?,
+    let (last, without_10) = match s.gait {
+        Gait::Crawl => (
+            run(
+                s,
+                terrain,
+                &crawl,
+                &guess,
+                settings,
+                &mut phases,
+                "crawl gait",
+            )?,
+            None,
+        ),
         Gait::Free => free_gait(s, terrain, settings, &mut phases)?,
     };
     let plan = Plan::from_flat(s, &last.flat)?;
@@ -329,6 +332,7 @@ pub fn plan_on(
         status: status_name(last.solution.status).into(),
         iterations: phases.iter().map(|p| p.iterations).sum(),
         objective: plan.cost(s),
+        objective_without_10: without_10,
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
     };
@@ -340,13 +344,14 @@ pub fn plan_on(
 }
 
 /// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
-/// schedule and the schedule search from the better of the two.
+/// schedule and the schedule search from the better of the two; with the reference
+/// objective without (10) ([`objective_without_10`], from the search's starting plan).
 fn free_gait(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     settings: &Settings,
     phases: &mut Vec<Phase>,
-) -> Result<Run, PlanningError> {
+) -> Result<(Run, Option<f64>), PlanningError> {
     // The two starting schedules are independent: solved on two threads.
     let crawl = gait::crawl_schedule(s.n_step);
     let pair = gait::pair_schedule(s.n_step);
@@ -376,18 +381,66 @@ fn free_gait(
             )
         },
     );
-    let mut best = record(crawl_run?, settings, phases);
+    let crawl_run = record(crawl_run?, settings, phases);
     let pair_run = record(pair_run?, settings, phases);
-    if pair_run.beats(&best) {
-        best = pair_run;
+    let start = if pair_run.beats(&crawl_run) {
+        &pair_run
+    } else {
+        &crawl_run
+    };
+    if !start.solution.status.is_success() {
+        return Ok((pair_run_or(crawl_run, pair_run), None));
     }
-    if !best.solution.status.is_success() {
-        return Ok(best);
+    // The searches from both plans and the reference without (10) are independent:
+    // they share the threads; their logs are printed afterwards, in this order.
+    let (from_crawl, (from_pair, reference)) = rayon::join(
+        || search_from(s, terrain, &candidate, &crawl_run, "crawl"),
+        || {
+            rayon::join(
+                || search_from(s, terrain, &candidate, &pair_run, "biped-pair"),
+                || objective_without_10(s, terrain, &start.flat, &candidate),
+            )
+        },
+    );
+    let (from_crawl, from_pair, reference) = (from_crawl?, from_pair?, reference?);
+    let mut best = pair_run_or(crawl_run, pair_run);
+    for solved in from_crawl.into_iter().chain(from_pair) {
+        let next = record(solved, settings, phases);
+        if next.beats(&best) {
+            best = next;
+        }
     }
-    // Schedule search from the better plan: each round's proposal satisfies every
-    // equation of its schedule with a lower cost; the re-solve frees every variable.
+    Ok((best, reference))
+}
+
+/// The better of the crawl and biped-pair runs (the crawl run on a tie or when both fail).
+fn pair_run_or(crawl: Run, pair: Run) -> Run {
+    if pair.beats(&crawl) {
+        pair
+    } else {
+        crawl
+    }
+}
+
+/// Schedule search from `from` ([`crate::schedule_search`]), not yet recorded: each
+/// round's proposal satisfies every equation of its schedule with a lower cost; its
+/// re-solve frees every variable. Stops when no proposal improves, a re-solve does not
+/// beat the plan it started from, or after [`SEARCH_ROUNDS`] rounds. Nothing when
+/// `from` failed.
+fn search_from(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    candidate: &Settings,
+    from: &Run,
+    label: &str,
+) -> Result<Vec<Solved>, PlanningError> {
+    let mut out: Vec<Solved> = Vec::new();
+    if !from.solution.status.is_success() {
+        return Ok(out);
+    }
     let search_settings = candidate.warm();
     let mut stance_solver = StanceSolver::new(s, terrain)?;
+    let mut best = from;
     for round in 1..=SEARCH_ROUNDS {
         let current = Plan::from_flat(s, &best.flat)?;
         let Some(proposal) =
@@ -395,25 +448,53 @@ fn free_gait(
         else {
             break;
         };
-        let next = run(
+        let next = solve_scheduled(
             s,
             terrain,
             &proposal.schedule,
             &proposal.plan.to_flat(),
             &search_settings,
-            phases,
             &format!(
-                "free gait: schedule search {round} ({} swap{})",
-                proposal.swaps,
-                if proposal.swaps == 1 { "" } else { "s" }
+                "free gait: search from {label} {round} ({} stance{} changed, {} evaluated)",
+                proposal.changed,
+                if proposal.changed == 1 { "" } else { "s" },
+                proposal.evaluated
             ),
         )?;
-        if !next.beats(&best) {
+        let improved = next.run.beats(best);
+        out.push(next);
+        if !improved {
             break;
         }
-        best = next;
+        best = &out.last().expect("just pushed").run;
     }
-    Ok(best)
+    Ok(out)
+}
+
+/// The reference objective of the problem without (10): every foot may move at every
+/// transition (the lifted formulation, [`Formulation::Complementarity`], with its penalty
+/// π set to 0, so (5) bounds each step and nothing couples the feet), warm-started from
+/// `plan` (a plan that satisfies every equation, hence feasible for the relaxation) with
+/// its keep-out sides. Dropping a constraint can only lower the optimum, so this says how
+/// much (10) costs; it is a local optimum of a nonconvex problem, a reference rather than
+/// a certified bound. `None` when the solve does not succeed.
+pub fn objective_without_10(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    plan: &[f64],
+    settings: &Settings,
+) -> Result<Option<f64>, PlanningError> {
+    let model = model::build(s, terrain, &Formulation::Complementarity, plan)?;
+    let mut compiled = model.problem.compile()?;
+    compiled.set_parameter(model::PENALTY, &[0.0])?;
+    let mut quiet = settings.clone();
+    quiet.set_print_level(0);
+    let solution = quiet.solve(&mut compiled, |_| ControlFlow::Continue(()))?;
+    if !solution.status.is_success() {
+        return Ok(None);
+    }
+    let flat = model.problem.evaluate(&model.layout, &solution.x)?;
+    Ok(Some(Plan::from_flat(s, &flat)?.cost(s)))
 }
 
 /// The status word written to the solution file (`solved` for success).
