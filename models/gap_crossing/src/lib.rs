@@ -19,12 +19,15 @@ pub mod check;
 pub mod convergence;
 pub mod export;
 pub mod gait;
+pub mod limits;
 pub mod model;
+pub mod output;
 pub mod plan;
 pub mod render;
 pub mod scenario;
 pub mod schedule_search;
 pub mod solve;
+pub mod strict_json;
 pub mod sweep;
 
 pub mod terrain;

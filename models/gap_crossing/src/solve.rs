@@ -165,6 +165,8 @@ pub enum PlanningError {
     Solve(#[from] SolveError),
     #[error("reading the plan: {0}")]
     Plan(#[from] PlanError),
+    #[error("{0}")]
+    TooLarge(#[from] crate::limits::TooLarge),
 }
 
 /// Residual of (10) for a flat plan: the largest `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²` over transitions.
@@ -303,6 +305,7 @@ pub fn plan_on(
     terrain: &(dyn Terrain + Sync),
     settings: &Settings,
 ) -> Result<Outcome, PlanningError> {
+    crate::limits::check(s)?;
     let started = Instant::now();
     let mut phases = Vec::new();
     let crawl = gait::crawl_schedule(s.n_step);

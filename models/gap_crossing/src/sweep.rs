@@ -24,7 +24,8 @@
 //! the sweep goes on.
 
 use crate::check;
-use crate::plan::{write_atomic, SolutionFile};
+use crate::output::{self, OutputError};
+use crate::plan::SolutionFile;
 use crate::render::ramp;
 use crate::scenario::{Scenario, ScenarioError};
 use crate::solve::{self, Settings};
@@ -248,7 +249,11 @@ impl Grid {
         };
         let root: Node = match format {
             "toml" => toml::from_str(text).map_err(|e| syntax(e.to_string()))?,
-            "json" => serde_json::from_str(text).map_err(|e| syntax(e.to_string()))?,
+            "json" => {
+                // Duplicate keys are an error (as in TOML); Node keeps the file's order.
+                crate::strict_json::parse(text).map_err(|e| syntax(e.to_string()))?;
+                serde_json::from_str(text).map_err(|e| syntax(e.to_string()))?
+            }
             _ => return Err(GridError::Extension(origin.to_path_buf())),
         };
         let Node::Table(top) = root else {
@@ -865,27 +870,26 @@ pub fn to_svg(grid: &Grid, results: &[PointResult]) -> String {
     svg
 }
 
-/// Writes `sweep.csv`, `sweep.json` and `sweep.svg` into `dir` (created if needed).
+/// Writes `sweep.csv`, `sweep.json` and `sweep.svg` into `dir` (created if needed), all
+/// or nothing ([`output::write_all`]).
 pub fn write_outputs(
     dir: &Path,
     grid: &Grid,
     results: &[PointResult],
     wall_seconds: f64,
     threads: usize,
-) -> std::io::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)?;
-    let files = [
-        ("sweep.csv", to_csv(grid, results)),
-        ("sweep.json", to_json(grid, results, wall_seconds, threads)),
-        ("sweep.svg", to_svg(grid, results)),
-    ];
-    let mut out = Vec::new();
-    for (name, text) in files {
-        let p = dir.join(name);
-        write_atomic(&p, text.as_bytes())?;
-        out.push(p);
-    }
-    Ok(out)
+) -> Result<Vec<PathBuf>, OutputError> {
+    let csv = to_csv(grid, results);
+    let json = to_json(grid, results, wall_seconds, threads);
+    let svg = to_svg(grid, results);
+    output::write_all(
+        dir,
+        &[
+            ("sweep.csv", csv.as_bytes()),
+            ("sweep.json", json.as_bytes()),
+            ("sweep.svg", svg.as_bytes()),
+        ],
+    )
 }
 
 #[cfg(test)]

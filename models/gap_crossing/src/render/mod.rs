@@ -7,13 +7,17 @@
 //! - [`convergence`] ([`convergence_svg`]): objective, constraint violation and the
 //!   residual of (10) per iteration of every solver run, each on its own log scale, with
 //!   the runs' boundaries marked.
+//! - [`html`] ([`plan_html`]): the plan animated, one stance at a time, with a slider and
+//!   a play button (a self-contained HTML page with inline SVG and script).
 //!
 //! This module holds what they share: sizes, fonts, the colour ramp, escaping and ticks.
 
 pub mod convergence;
+pub mod html;
 pub mod plan;
 
 pub use convergence::convergence_svg;
+pub use html::plan_html;
 pub use plan::plan_svg;
 
 /// Width of every figure (px).
