@@ -104,10 +104,12 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
     parent.appendChild(e);
     return e;
   }
-  // A view: data ranges mapped with equal scales into a width × height box.
-  function view(svg, yr, height) {
+  // A view: equal scales on both axes, the same x scale in both views (so they line
+  // up); the height follows the y range.
+  function view(svg, yr) {
     var w = 1000, m = 50, xr = D.xRange;
-    var scale = Math.min((w - 2 * m) / (xr[1] - xr[0]), (height - 2 * m) / (yr[1] - yr[0]));
+    var scale = (w - 2 * m) / (xr[1] - xr[0]);
+    var height = (yr[1] - yr[0]) * scale + 2 * m;
     var v = {
       svg: svg,
       px: function (x) { return m + (x - xr[0]) * scale; },
@@ -135,8 +137,8 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
     extra.forEach(function (e) { lo = Math.min(lo, e); hi = Math.max(hi, e); });
     return [lo - 0.3, hi + 0.3];
   }
-  var top = view(document.getElementById("top"), range(1, [D.goal[0][1], D.goal[1][1]]), 330);
-  var side = view(document.getElementById("side"), range(2, D.profile.map(function (p) { return p[1]; })), 300);
+  var top = view(document.getElementById("top"), range(1, [D.goal[0][1], D.goal[1][1]]));
+  var side = view(document.getElementById("side"), range(2, D.profile.map(function (p) { return p[1]; })));
   // Static layers: gap band, terrain, goals, CoM paths.
   var topStatic = el(top.svg, "g", {});
   top.svg.insertBefore(topStatic, top.dyn);
