@@ -25,9 +25,10 @@
 //! The band holds every single adjacent swap (one foot ahead and the other behind at one
 //! stance), but also moving one foot's step several transitions earlier or later (a
 //! foot ahead for several stances in a row), any number of swaps at once, and swaps of
-//! two pairs; the dynamic programme picks the best combination, not a greedy one. Each
-//! band point is solved at most once (the points not on the path: ≈ 18 per stance, less
-//! those failing (6)–(9)).
+//! two pairs; the dynamic programme picks the best combination, not a greedy one. Points
+//! whose feet are within [`NULL_MOVE`] of the path's own at that stance are left out
+//! (the same configuration). The programme is solved lazily ([`propose`]): only the
+//! points the shortest path needs are solved, each once.
 //!
 //! The result, a new schedule and a plan for it that satisfies every equation with a
 //! lower cost, is re-solved with every variable free (`crate::solve`), which moves the
@@ -39,6 +40,7 @@ use crate::scenario::{dist2, Coms, Feet, Foot, Scenario, Vec3};
 use crate::terrain::Terrain;
 use nlp::ipm::Ipm;
 use nlp::{BuildError, Compiled, IpmOptions, Problem};
+use std::collections::HashMap;
 
 /// Iteration limit of one stance solve (they take 10–30 iterations from the old stance).
 pub const STANCE_MAX_ITER: usize = 100;
@@ -213,7 +215,13 @@ struct Band {
 impl Band {
     /// The band around `path`, every point off the path given its lower bound (or
     /// marked infeasible by (6)–(9)), the path's points their plan stance.
-    fn new(s: &Scenario, plan: &Plan, path: &[Counts], holds: &[Vec<Vec3>; 4]) -> Band {
+    fn new(
+        s: &Scenario,
+        plan: &Plan,
+        path: &[Counts],
+        holds: &[Vec<Vec3>; 4],
+        known: &Known,
+    ) -> Band {
         let offsets = band_offsets();
         let n = path.len();
         let mut band = Band {
@@ -222,12 +230,14 @@ impl Band {
             preds: Vec::with_capacity(n),
         };
         for (k, &base) in path.iter().enumerate() {
+            let own = feet_at(holds, &base);
             let points: Vec<Counts> = if k == 0 {
                 vec![base]
             } else {
                 offsets
                     .iter()
                     .filter_map(|d| shifted(base, d, holds))
+                    .filter(|c| *c == base || !same_feet(&feet_at(holds, c), &own))
                     .collect()
             };
             let values = points
@@ -238,7 +248,9 @@ impl Band {
                         return Value::Exact(Box::new(st), stance_cost(s, &st));
                     }
                     let feet = feet_at(holds, c);
-                    if feet_distances_ok(s, &feet) {
+                    if let Some((st, cost)) = known.get(&feet_key(&feet)) {
+                        Value::Exact(Box::new(*st), *cost)
+                    } else if feet_distances_ok(s, &feet) {
                         Value::Bound(cost_lower_bound(s, &feet))
                     } else {
                         Value::Infeasible
@@ -294,6 +306,30 @@ impl Band {
     }
 }
 
+/// Smallest foot displacement (m) for which two lattice points of one stance count as
+/// different configurations: counts that differ only by moves shorter than this (a
+/// robot standing at its goal makes scheduled "moves" of 1e-4 m and less) give the
+/// path's own configuration up to a millimetre, so they are left out of the band.
+pub const NULL_MOVE: f64 = 1e-3;
+
+/// Whether every foot of `a` is within [`NULL_MOVE`] of its place in `b`.
+fn same_feet(a: &Feet, b: &Feet) -> bool {
+    Foot::ALL
+        .iter()
+        .all(|&i| dist2(a.get(i), b.get(i)) < NULL_MOVE * NULL_MOVE)
+}
+
+/// Stances solved for given feet (the plan's own, and those solved by the search), by
+/// the feet's bit patterns: feet repeat across stances (a robot standing at its goal,
+/// scheduled moves that do not displace a foot), and the stance problem depends on the
+/// feet only, so each is solved once.
+type Known = HashMap<[u64; 12], (Stance, f64)>;
+
+fn feet_key(feet: &Feet) -> [u64; 12] {
+    let a = feet.to_array();
+    std::array::from_fn(|i| a[i / 3][i % 3].to_bits())
+}
+
 /// A lower bound of the stance problem's optimum for `feet`, from (11) and the vertical
 /// part of (2) alone: each CoM lies on the circle of points at squared distance
 /// `leg_length_sq` from both feet of its biped, so its cost term is at least the squared
@@ -341,7 +377,13 @@ pub fn propose(
     }
     let holds = footholds(plan, schedule);
     let path = path_counts(schedule);
-    let mut band = Band::new(s, plan, &path, &holds);
+    let mut known: Known = plan
+        .stances
+        .iter()
+        .skip(1)
+        .map(|st| (feet_key(&st.feet), (*st, stance_cost(s, st))))
+        .collect();
+    let mut band = Band::new(s, plan, &path, &holds, &known);
     let mut evaluated = 0;
     let at = loop {
         let at = band.shortest_path()?;
@@ -350,13 +392,23 @@ pub fn propose(
             if let Value::Bound(_) = band.values[k][p] {
                 open += 1;
                 let feet = feet_at(&holds, &band.points[k][p]);
-                band.values[k][p] = match solver.solve(s, &feet, &plan.stances[k]) {
-                    Some((st, c)) => Value::Exact(Box::new(st), c),
+                let key = feet_key(&feet);
+                let solved = match known.get(&key) {
+                    Some(&(st, c)) => Some((st, c)),
+                    None => {
+                        evaluated += 1;
+                        solver.solve(s, &feet, &plan.stances[k])
+                    }
+                };
+                band.values[k][p] = match solved {
+                    Some((st, c)) => {
+                        known.insert(key, (st, c));
+                        Value::Exact(Box::new(st), c)
+                    }
                     None => Value::Infeasible,
                 };
             }
         }
-        evaluated += open;
         if open == 0 {
             break at;
         }

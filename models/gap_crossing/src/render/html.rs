@@ -86,7 +86,7 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
   <span id="label"></span>
 </div>
 <svg id="top" width="1000" height="330"></svg>
-<div class="caption">Top view (x–y): feet (squares BR, BL; circles FR, FL), support polygon, CoMs (B blue, F orange) of the current stance; dots: the CoM path of every stance; red band: the widened gap; rings: goals. A ringed foot has just moved.</div>
+<div class="caption">Top view (x–y): feet (circles: back feet BR, BL; squares: front feet FR, FL, as in plan.svg), support polygon, CoMs (B blue, F orange) of the current stance; dots: the CoM path of every stance; red band: the widened gap; rings: goals. A ringed foot has just moved.</div>
 <svg id="side" width="1000" height="300"></svg>
 <div class="caption">Side view (x–z): terrain, feet, legs (CoM to its feet) and CoMs of the current stance; green arrows: contact forces (1 m per 1000 N).</div>
 <script id="plan-data" type="application/json">__DATA__</script>
@@ -167,8 +167,8 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
   }
   function foot(v, g, p, i, k, ya) {
     var x = v.px(p[0]), y = v.py(p[ya]), c = moved(k, i) ? COL.moved : COL.foot;
-    if (i < 2) el(g, "rect", { x: x - 5, y: y - 5, width: 10, height: 10, fill: c });
-    else el(g, "circle", { cx: x, cy: y, r: 5.5, fill: c });
+    if (i < 2) el(g, "circle", { cx: x, cy: y, r: 5.5, fill: c });
+    else el(g, "rect", { x: x - 5, y: y - 5, width: 10, height: 10, fill: c });
     if (moved(k, i)) el(g, "circle", { cx: x, cy: y, r: 10, fill: "none", stroke: COL.moved, "stroke-width": 1.5 });
     el(g, "text", { x: x + 8, y: y - 8, "font-size": 11, fill: "#333" }, D.feet[i]);
   }
