@@ -37,6 +37,13 @@ pub const SEARCH_ROUNDS: usize = 4;
 /// lateral-goal test scenario, 161 iterations over its rounds instead of 238, same plans.
 pub const SEARCH_MU_INIT: f64 = 1e-6;
 
+/// Iteration limit of the interior-point method on the schedule search's re-solves and
+/// on the reference solve without (10). From a plan that satisfies every equation they
+/// take 14–80 iterations; at n_step 1000 one re-solve ran to the default limit of 3000
+/// (90 of the run's 117 s of CPU) without converging. Past this limit the candidate
+/// counts as failed and the planner keeps what it has.
+pub const SEARCH_MAX_ITER: usize = 200;
+
 /// Bound push (absolute and relative, variables and slacks) of the schedule search's
 /// re-solves (default 1e-2, which moves a foot on a keep-out edge by 2 cm).
 pub const SEARCH_BOUND_PUSH: f64 = 1e-8;
@@ -93,13 +100,20 @@ impl Settings {
     }
 
     fn warm(&self) -> Settings {
-        let mut w = self.clone();
+        let mut w = self.capped();
         w.ipm.mu_init = SEARCH_MU_INIT;
         w.ipm.bound_push = SEARCH_BOUND_PUSH;
         w.ipm.bound_frac = SEARCH_BOUND_PUSH;
         w.ipm.slack_bound_push = SEARCH_BOUND_PUSH;
         w.ipm.slack_bound_frac = SEARCH_BOUND_PUSH;
         w
+    }
+
+    /// These settings with the interior-point method limited to [`SEARCH_MAX_ITER`].
+    fn capped(&self) -> Settings {
+        let mut c = self.clone();
+        c.ipm.max_iter = c.ipm.max_iter.min(SEARCH_MAX_ITER);
+        c
     }
 
     fn print_level(&self) -> u8 {
@@ -490,7 +504,7 @@ pub fn objective_without_10(
     let model = model::build(s, terrain, &Formulation::Complementarity, plan)?;
     let mut compiled = model.problem.compile()?;
     compiled.set_parameter(model::PENALTY, &[0.0])?;
-    let mut quiet = settings.clone();
+    let mut quiet = settings.capped();
     quiet.set_print_level(0);
     let solution = quiet.solve(&mut compiled, |_| ControlFlow::Continue(()))?;
     if !solution.status.is_success() {

@@ -217,6 +217,7 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
   });
   var q = /[?#&]stance=(\d+)/.exec(location.href);
   show(q ? Math.min(Math.max(+q[1], 1), n) - 1 : 0);
+  if (/[?#&]play\b/.test(location.href)) button.click();
 })();
 </script>
 </body>
