@@ -13,7 +13,13 @@
 //!   with plain `f64` arithmetic (no symbolic or solver code);
 //! - [`convergence`]: the per-iteration history of the solver runs (objective,
 //!   constraint violation, residual of (10)), recorded by the solvers' iteration callback;
-//! - [`render`]: hand-written SVG plots of a plan and of solver convergence.
+//! - [`render`]: hand-written SVG plots of a plan, of solver convergence and of a sweep,
+//!   and the animated plan page (`plan.html`);
+//! - [`schedule_search`]: the free gait's search over foot schedules (shortest path over
+//!   foothold counts);
+//! - [`output`]: writing a run's files all or nothing;
+//! - [`limits`]: the largest `n_step` the memory allows, checked before building;
+//! - [`strict_json`]: JSON parsing that rejects duplicate keys.
 
 pub mod check;
 pub mod convergence;
