@@ -19,14 +19,22 @@
 //!   with plain `f64` arithmetic (no symbolic or solver code);
 //! - [`convergence`]: the per-iteration history of the solver runs (objective,
 //!   constraint violation, residual of (10)), recorded by the solvers' iteration callback;
-//! - [`render`]: hand-written SVG plots of a plan and of solver convergence.
+//! - [`render`]: hand-written SVG plots of a plan, of solver convergence and of a sweep,
+//!   and the animated plan page (`plan.html`);
+//! - [`schedule_search`]: the free gait's search over foot schedules (shortest path over
+//!   foothold counts);
+//! - [`output`]: writing a run's files all or nothing;
+//! - [`limits`]: the largest `n_step` the memory allows, checked before building;
+//! - [`strict_json`]: JSON parsing that rejects duplicate keys.
 
 pub mod check;
 pub mod convergence;
 pub mod crossing;
 pub mod export;
 pub mod gait;
+pub mod limits;
 pub mod model;
+pub mod output;
 pub mod plan;
 pub mod reach;
 pub mod render;
@@ -34,6 +42,7 @@ pub mod scenario;
 pub mod schedule_search;
 pub mod solve;
 pub mod status;
+pub mod strict_json;
 pub mod sweep;
 pub mod terrain;
 pub mod terrain_spec;

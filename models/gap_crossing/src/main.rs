@@ -10,7 +10,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use gap_crossing::check::{self, GoalCheck, Options};
 use gap_crossing::convergence::Convergence;
 use gap_crossing::gait;
-use gap_crossing::plan::{write_atomic, PlanError, SolutionFile, SolverInfo};
+use gap_crossing::output::{self, OutputError};
+use gap_crossing::plan::{PlanError, SolutionFile, SolverInfo};
 use gap_crossing::render;
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
@@ -33,11 +34,11 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Solve a scenario; writes DIR/solution.json, DIR/plan.svg, DIR/convergence.svg.
+    /// Solve a scenario; writes DIR/solution.json, plan.svg, plan.html, convergence.svg/json.
     Solve(SolveArgs),
     /// Check a solution file independently; prints each violation, exits 1 on any.
     Check(CheckArgs),
-    /// Redraw the SVGs of a solution file.
+    /// Redraw the SVGs and plan.html of a solution file.
     Render(RenderArgs),
     /// Solve a grid of scenarios in parallel and summarise.
     Sweep(SweepArgs),
@@ -96,7 +97,7 @@ struct CheckArgs {
 struct RenderArgs {
     /// Solution file (JSON).
     file: PathBuf,
-    /// Output directory (default: the solution file's directory). Writes plan.svg, and
+    /// Output directory (default: the solution file's directory). Writes plan.svg, plan.html, and
     /// convergence.svg when a convergence.json (convergence history) sits beside FILE.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -180,6 +181,8 @@ enum CliError {
     Planning(#[from] PlanningError),
     #[error(transparent)]
     Grid(#[from] GridError),
+    #[error("writing the output (nothing was changed): {0}")]
+    Output(#[from] OutputError),
     #[error("cannot start {0} worker threads: {1}")]
     Threads(usize, String),
     #[error("{0}")]
@@ -253,22 +256,24 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
         }
         return Ok(ExitCode::from(kind.exit_code()));
     }
-    std::fs::create_dir_all(&a.out).map_err(io(&a.out))?;
-    let json = a.out.join("solution.json");
-    file.write(&json)?;
-    let conv_json = a.out.join("convergence.json");
-    write_file(
-        &conv_json,
-        &serde_json::to_string_pretty(&history).unwrap_or_default(),
-    )?;
-    write_file(&a.out.join("plan.svg"), &render::plan_svg(file))?;
     let title = format!(
         "Convergence: {} gait, {} iterations",
         s.gait, file.solver.iterations
     );
-    write_file(
-        &a.out.join("convergence.svg"),
-        &render::convergence_svg(&history, &title),
+    // Every file is rendered first, then all are written or none.
+    let history_json = serde_json::to_string_pretty(&history).unwrap_or_default();
+    let plan_svg = render::plan_svg(file);
+    let conv_svg = render::convergence_svg(&history, &title);
+    let plan_html = render::plan_html(file, &html_title(file));
+    output::write_all(
+        &a.out,
+        &[
+            ("solution.json", file.to_json().as_bytes()),
+            ("convergence.json", history_json.as_bytes()),
+            ("plan.svg", plan_svg.as_bytes()),
+            ("convergence.svg", conv_svg.as_bytes()),
+            ("plan.html", plan_html.as_bytes()),
+        ],
     )?;
 
     let moves = gap_crossing::plan::Plan::from_flat(&s, &file.plan().to_flat())
@@ -283,6 +288,12 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     }
     println!("status:     {} ({} gait)", file.solver.status, s.gait);
     println!("objective:  {:.6e}", file.solver.objective);
+    if let Some(r) = file.solver.objective_without_10 {
+        println!(
+            "reference:  {r:.6e} without (10) (every foot free at every transition; what (10) costs: {:.1} %)",
+            100.0 * (file.solver.objective - r) / file.solver.objective
+        );
+    }
     println!(
         "steps:      {} of {} transitions move a foot; moves per foot: {}",
         report.moves,
@@ -292,7 +303,7 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     println!("time:       {:.3} s", file.solver.solve_seconds);
     println!("checker:    {}", report.summary());
     println!(
-        "wrote {}/{{solution.json, plan.svg, convergence.svg, convergence.json}}",
+        "wrote {}/{{solution.json, plan.svg, plan.html, convergence.svg, convergence.json}}",
         a.out.display()
     );
     Ok(ExitCode::SUCCESS)
@@ -358,7 +369,9 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
             let f = failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             bar.set_message(format!("{f} failed"));
         }
-        if let (true, Some(file)) = (a.solutions, file) {
+        // A plan with a non-finite number would not read back (JSON has no NaN): such a
+        // point's file is not written.
+        if let (true, Some(file)) = (a.solutions, file.filter(|f| f.stances_finite())) {
             let p = points_dir.join(format!("{:04}.json", r.index));
             if let Err(e) = file.write(&p) {
                 save_errors
@@ -376,7 +389,7 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         eprintln!("warning: {e}");
     }
 
-    let files = sweep::write_outputs(&a.out, &grid, &results, wall, threads).map_err(io(&a.out))?;
+    let files = sweep::write_outputs(&a.out, &grid, &results, wall, threads)?;
     let widths: Vec<usize> = grid.axes.iter().map(|ax| ax.key.len().max(6)).collect();
     let mut head = String::from("point");
     for (ax, w) in grid.axes.iter().zip(&widths) {
@@ -464,8 +477,15 @@ fn check_cmd(a: &CheckArgs) -> Result<ExitCode, CliError> {
     })
 }
 
-fn write_file(path: &Path, text: &str) -> Result<(), CliError> {
-    write_atomic(path, text.as_bytes()).map_err(io(path))
+/// The heading of plan.html: gait, solver status and objective.
+fn html_title(file: &SolutionFile) -> String {
+    format!(
+        "Gap crossing: {} gait, {} stances, status {}, objective {:.6e}",
+        file.scenario.gait,
+        file.stances.len(),
+        file.solver.status,
+        file.solver.objective
+    )
 }
 
 fn render_cmd(a: &RenderArgs) -> Result<ExitCode, CliError> {
@@ -490,18 +510,24 @@ fn render_cmd(a: &RenderArgs) -> Result<ExitCode, CliError> {
     } else {
         None
     };
-    std::fs::create_dir_all(&dir).map_err(io(&dir))?;
-    let plan = dir.join("plan.svg");
-    write_file(&plan, &render::plan_svg(&file))?;
-    println!("wrote {}", plan.display());
-    if let Some(r) = records {
-        let conv = dir.join("convergence.svg");
+    let plan_svg = render::plan_svg(&file);
+    let plan_html = render::plan_html(&file, &html_title(&file));
+    let mut files: Vec<(&str, &[u8])> = vec![
+        ("plan.svg", plan_svg.as_bytes()),
+        ("plan.html", plan_html.as_bytes()),
+    ];
+    let conv_svg = records.map(|r| {
         let title = format!(
             "Convergence: solver {} ({}), {} iterations",
             file.solver.name, file.solver.status, file.solver.iterations
         );
-        write_file(&conv, &render::convergence_svg(&r, &title))?;
-        println!("wrote {}", conv.display());
+        render::convergence_svg(&r, &title)
+    });
+    if let Some(svg) = &conv_svg {
+        files.push(("convergence.svg", svg.as_bytes()));
+    }
+    for p in output::write_all(&dir, &files)? {
+        println!("wrote {}", p.display());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -520,6 +546,7 @@ fn guess_cmd(a: &GuessArgs) -> Result<ExitCode, CliError> {
         status: format!("initial_guess_{name}"),
         iterations: 0,
         objective: plan.cost(&s),
+        objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
     };
@@ -528,11 +555,15 @@ fn guess_cmd(a: &GuessArgs) -> Result<ExitCode, CliError> {
     // residual instead.
     let report = check::check(&file);
     file.solver.max_constraint_violation = report.max_residual.max(0.0);
-    std::fs::create_dir_all(&a.out).map_err(io(&a.out))?;
-    let json = a.out.join("guess.json");
-    file.write(&json)?;
-    let svg = a.out.join("plan.svg");
-    write_file(&svg, &render::plan_svg(&file))?;
+    let svg = render::plan_svg(&file);
+    let written = output::write_all(
+        &a.out,
+        &[
+            ("guess.json", file.to_json().as_bytes()),
+            ("plan.svg", svg.as_bytes()),
+        ],
+    )?;
+    let (json, svg) = (&written[0], &written[1]);
     println!(
         "wrote {} and {} ({name} guess, cost {:.4e}); checker: {}",
         json.display(),

@@ -63,8 +63,13 @@ pub struct Stance {
 }
 
 /// What the solver reports about the run that produced the plan.
+///
+/// Optional in a file, and every field in it too (a plan written by another tool may
+/// have none, some, or other fields, which are ignored): missing fields take the
+/// [`Default`] (`"unknown"`, 0, NaN), and `null` reads as NaN for the numbers (serde
+/// writes a NaN as `null`). The checker does not use it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default)]
 pub struct SolverInfo {
     /// Solver name (`ipm`, `sqp`, or `guess` for an initial guess written as a plan).
     pub name: String,
@@ -73,11 +78,38 @@ pub struct SolverInfo {
     /// Iterations taken.
     pub iterations: usize,
     /// Objective (1) at the returned point.
+    #[serde(deserialize_with = "nullable_f64")]
     pub objective: f64,
+    /// Free gait: objective (1) of the problem without (10) (every foot may move at
+    /// every transition), a reference for what (10) costs (`solve::objective_without_10`);
+    /// absent for the crawl gait or when that solve failed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub objective_without_10: Option<f64>,
     /// Largest constraint violation at the returned point, as the solver measures it.
+    #[serde(deserialize_with = "nullable_f64")]
     pub max_constraint_violation: f64,
     /// Wall time of the solve (s).
+    #[serde(deserialize_with = "nullable_f64")]
     pub solve_seconds: f64,
+}
+
+impl Default for SolverInfo {
+    fn default() -> SolverInfo {
+        SolverInfo {
+            name: "unknown".into(),
+            status: "unknown".into(),
+            iterations: 0,
+            objective: f64::NAN,
+            objective_without_10: None,
+            max_constraint_violation: f64::NAN,
+            solve_seconds: f64::NAN,
+        }
+    }
+}
+
+/// A number that may be `null` (read as NaN).
+fn nullable_f64<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// A sequence of stances, the numeric content of a plan.
@@ -182,7 +214,8 @@ pub struct SolutionFile {
     /// defaults and unknown ones are rejected, as for a scenario file.
     #[serde(deserialize_with = "scenario_with_defaults")]
     pub scenario: Scenario,
-    /// The solver's report.
+    /// The solver's report (optional on reading, see [`SolverInfo`]).
+    #[serde(default)]
     pub solver: SolverInfo,
     /// Stances 1..n_step.
     pub stances: Vec<Stance>,
@@ -210,12 +243,21 @@ impl SolutionFile {
         }
     }
 
-    /// Parses the JSON text of a solution file (`origin` names it in errors).
+    /// Parses the JSON text of a solution file (`origin` names it in errors). A key
+    /// repeated within one object is an error ([`crate::strict_json`]).
     pub fn from_json(text: &str, origin: &Path) -> Result<SolutionFile, PlanError> {
-        serde_json::from_str(text).map_err(|e| PlanError::Format {
-            path: origin.to_path_buf(),
-            message: e.to_string(),
-        })
+        crate::strict_json::parse(text)
+            .and_then(serde_json::from_value)
+            .map_err(|e| PlanError::Format {
+                path: origin.to_path_buf(),
+                message: e.to_string(),
+            })
+    }
+
+    /// Whether every number of the stances is finite: JSON has no NaN or infinity (serde
+    /// writes them as `null`), so only such a file reads back ([`SolutionFile::read`]).
+    pub fn stances_finite(&self) -> bool {
+        self.plan().to_flat().iter().all(|v| v.is_finite())
     }
 
     /// Reads a solution file.
@@ -235,22 +277,13 @@ impl SolutionFile {
     /// Writes the file atomically (a temporary file renamed into place), so a failed
     /// write never leaves a partial file that looks like a result.
     pub fn write(&self, path: &Path) -> Result<(), PlanError> {
-        write_atomic(path, self.to_json().as_bytes()).map_err(|source| PlanError::Io {
-            path: path.to_path_buf(),
-            source,
+        crate::output::write_atomic(path, self.to_json().as_bytes()).map_err(|source| {
+            PlanError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
         })
     }
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
 }
 
 #[cfg(test)]

@@ -626,7 +626,7 @@ impl Scenario {
                 let t: toml::Table = toml::from_str(text).map_err(|e| syntax(e.to_string()))?;
                 toml_to_json(toml::Value::Table(t), "")?
             }
-            "json" => serde_json::from_str(text).map_err(|e| syntax(e.to_string()))?,
+            "json" => crate::strict_json::parse(text).map_err(|e| syntax(e.to_string()))?,
             _ => return Err(ScenarioError::Extension(origin.to_path_buf())),
         };
         let mut s = Scenario::from_value(value)?;

@@ -1,34 +1,46 @@
-//! Local search over foot schedules: adjacent swaps, each evaluated exactly on one stance.
+//! Search over foot schedules with the footholds kept: a shortest path through the
+//! lattice of foothold counts, each stance evaluated exactly.
 //!
 //! A schedule says which foot moves at each transition (`schedule[t]` moves from stance
-//! `t` to `t + 1`, 0-based). Swapping two consecutive entries `t`, `t + 1` (feet `j`
-//! then `i` become `i` then `j`) with every foothold kept where it is changes **one
-//! stance only**: stance `t + 1` then has foot `i` already at its next foothold and foot
-//! `j` still at its previous one. Every displacement is the same as before, only one
-//! transition earlier or later, so (3), (5) and the keep-out still hold; what is left to
-//! check is (6)–(9) between the new stance's feet (plain numbers) and whether CoMs and
-//! forces exist for it.
+//! `t` to `t + 1`, 0-based). Keep every foot's sequence of footholds (its position after
+//! each of its scheduled moves) and the plan is fixed by how many moves each foot has
+//! made at each stance: the *counts* `c = (c_BR, c_BL, c_FR, c_FL)`, with `Σ c = k` at
+//! stance `k`. A schedule is a monotone path through this 4-D lattice from `(0, 0, 0, 0)`
+//! to the final counts, one foot's count going up by one per transition. Every path
+//! keeps every displacement (only when it happens changes), so (3), (5) and the keep-out
+//! hold on every path, and (10) holds by construction (one foot per transition); what is
+//! left for a lattice point is (6)–(9) between its four feet (plain numbers) and whether
+//! CoMs and forces exist for them.
 //!
 //! CoMs and forces of a stance appear in that stance's equations and cost terms only, so
-//! with the footholds fixed the plan's cost is a sum of independent per-stance problems:
-//! minimise the stance's terms of (1) subject to (2), (4), (11) with the four feet given
-//! ([`crate::model::build_stance`], solved here by [`StanceSolver`]). The gain of a swap
-//! is the old stance's cost minus that problem's optimum: an exact decrease of the cost
-//! at a point that satisfies every equation of the swapped schedule, (10) included
-//! (one foot moves per transition by construction).
+//! with the footholds fixed the plan's cost is a sum over the path of independent
+//! per-stance problems: minimise the stance's terms of (1) subject to (2), (4), (11)
+//! with the four feet given ([`crate::model::build_stance`], solved here by
+//! [`StanceSolver`]). The best path is then a shortest-path problem, solved exactly by
+//! dynamic programming over the stances ([`propose`]).
 //!
-//! [`propose`] evaluates every swap at a solved plan and applies the improving ones
-//! greedily (largest gain first, no two touching the same transition). The result, a
-//! new schedule and a feasible plan for it with a lower cost, is then re-solved with
-//! every variable free (`crate::solve`), which can only lower the cost further, and the
-//! search repeats from there: a descent over schedules in which each step is a
-//! first-order improvement certified by a feasible point, not a guess.
+//! The lattice is restricted to a band around the current schedule's path: at stance
+//! `k`, the counts `c(k) + δ` with every `|δ_i| ≤ 1` and `Σ δ = 0` (19 points: the path's
+//! own, one foot a step ahead and another a step behind, or two ahead and two behind).
+//! The band holds every single adjacent swap (one foot ahead and the other behind at one
+//! stance), but also moving one foot's step several transitions earlier or later (a
+//! foot ahead for several stances in a row), any number of swaps at once, and swaps of
+//! two pairs; the dynamic programme picks the best combination, not a greedy one. Points
+//! whose feet are within [`NULL_MOVE`] of the path's own at that stance are left out
+//! (the same configuration). The programme is solved lazily ([`propose`]): only the
+//! points the shortest path needs are solved, each once.
+//!
+//! The result, a new schedule and a plan for it that satisfies every equation with a
+//! lower cost, is re-solved with every variable free (`crate::solve`), which moves the
+//! footholds and can only lower the cost further, and the search repeats from there: a
+//! descent over schedules in which each step is certified by a feasible point.
 use crate::model::{build_stance, STANCE_FEET};
 use crate::plan::{Plan, Stance};
-use crate::scenario::{dist2, Coms, Feet, Foot, Scenario};
+use crate::scenario::{dist2, Coms, Feet, Foot, Scenario, Vec3};
 use crate::terrain::Terrain;
 use nlp::ipm::Ipm;
 use nlp::{BuildError, Compiled, IpmOptions, Problem};
+use std::collections::HashMap;
 
 /// Iteration limit of one stance solve (they take 10–30 iterations from the old stance).
 pub const STANCE_MAX_ITER: usize = 100;
@@ -110,96 +122,355 @@ pub fn feet_distances_ok(s: &Scenario, feet: &Feet) -> bool {
     })
 }
 
-/// One evaluated swap of `schedule[at]` and `schedule[at + 1]`.
-#[derive(Clone, Debug)]
-pub struct Swap {
-    /// The first of the two transitions swapped.
-    pub at: usize,
-    /// Decrease of the plan's cost (stance `at + 1`'s old cost minus its new one).
-    pub gain: f64,
-    /// The new stance `at + 1`.
-    pub stance: Stance,
+/// Foothold counts: how many scheduled moves each foot (BR, BL, FR, FL) has made.
+pub type Counts = [usize; 4];
+
+/// Each foot's footholds under `schedule` at `plan` (a plan of that schedule): entry `c`
+/// is its position after its `c`-th scheduled move (entry 0: the start). A scheduled
+/// move that does not displace the foot repeats the previous position.
+pub fn footholds(plan: &Plan, schedule: &[Foot]) -> [Vec<Vec3>; 4] {
+    let mut seq: [Vec<Vec3>; 4] = Foot::ALL.map(|i| vec![plan.stances[0].feet.get(i)]);
+    for (t, &i) in schedule.iter().enumerate() {
+        seq[i.index()].push(plan.stances[t + 1].feet.get(i));
+    }
+    seq
 }
 
-/// Every adjacent swap of `schedule` at `plan` (a plan of that schedule) that lowers the
-/// cost, best first.
-pub fn improving_swaps(
-    s: &Scenario,
-    solver: &mut StanceSolver,
-    plan: &Plan,
-    schedule: &[Foot],
-) -> Vec<Swap> {
-    let cost = plan.cost(s);
-    let mut swaps = Vec::new();
-    for at in 0..schedule.len().saturating_sub(1) {
-        let (j, i) = (schedule[at], schedule[at + 1]);
-        if i == j {
-            continue;
-        }
-        let (before, old, after) = (
-            &plan.stances[at],
-            &plan.stances[at + 1],
-            &plan.stances[at + 2],
-        );
-        // Foot i already at its next foothold, foot j still at its previous one.
-        let mut feet = old.feet;
-        *feet.get_mut(i) = after.feet.get(i);
-        *feet.get_mut(j) = before.feet.get(j);
-        if feet == old.feet || !feet_distances_ok(s, &feet) {
-            continue;
-        }
-        let Some((stance, new_cost)) = solver.solve(s, &feet, old) else {
-            continue;
-        };
-        let gain = stance_cost(s, old) - new_cost;
-        if gain > MIN_RELATIVE_GAIN * cost {
-            swaps.push(Swap { at, gain, stance });
+/// The counts of `schedule` at each stance (`n_step` entries, the first all zero).
+pub fn path_counts(schedule: &[Foot]) -> Vec<Counts> {
+    let mut c = [0; 4];
+    let mut out = vec![c];
+    for &i in schedule {
+        c[i.index()] += 1;
+        out.push(c);
+    }
+    out
+}
+
+/// The band's offsets from the path: every `δ ∈ {−1, 0, 1}⁴` with `Σ δ = 0` (19, the
+/// path's own first).
+fn band_offsets() -> Vec<[i64; 4]> {
+    let mut out = vec![[0; 4]];
+    for code in 0..81_i64 {
+        let d = [
+            code % 3 - 1,
+            code / 3 % 3 - 1,
+            code / 9 % 3 - 1,
+            code / 27 % 3 - 1,
+        ];
+        if d.iter().sum::<i64>() == 0 && d != [0; 4] {
+            out.push(d);
         }
     }
-    swaps.sort_by(|a, b| b.gain.total_cmp(&a.gain));
-    swaps
+    out
+}
+
+/// What is known of a band point's stance (the stance is boxed: most points stay bounds).
+#[derive(Clone)]
+enum Value {
+    /// Not solved yet: a lower bound of its cost ([`cost_lower_bound`]).
+    Bound(f64),
+    /// Solved: the stance and its cost.
+    Exact(Box<Stance>, f64),
+    /// (6)–(9) violated, or the stance problem failed.
+    Infeasible,
+}
+
+impl Value {
+    fn cost(&self) -> f64 {
+        match self {
+            Value::Bound(c) | Value::Exact(_, c) => *c,
+            Value::Infeasible => f64::INFINITY,
+        }
+    }
 }
 
 /// An improved schedule: the result of [`propose`].
 #[derive(Clone, Debug)]
 pub struct Proposal {
-    /// The schedule with the swaps applied.
+    /// The new schedule.
     pub schedule: Vec<Foot>,
-    /// A plan of that schedule satisfying every equation (the old plan with the swapped
-    /// stances replaced).
+    /// A plan of that schedule satisfying every equation, with the old plan's footholds
+    /// (the stances off the old path replaced by their stance problem's solution).
     pub plan: Plan,
-    /// Its decrease of the cost (the sum of the swaps' gains).
+    /// Its decrease of the cost (old cost minus the plan's).
     pub gain: f64,
-    /// How many swaps were applied.
-    pub swaps: usize,
+    /// How many stances differ from the old plan.
+    pub changed: usize,
+    /// How many stance problems were solved (band points evaluated).
+    pub evaluated: usize,
 }
 
-/// A better schedule than `schedule` and a plan for it, by the improving adjacent swaps
-/// at `plan` (a plan of `schedule`) applied greedily: largest gain first, skipping swaps
-/// that share a transition with one already taken. `None` when no swap improves.
+/// The band of the dynamic programme: for each stance, its lattice points.
+struct Band {
+    /// `points[k]`: the counts of stance `k`'s band points (the path's own first).
+    points: Vec<Vec<Counts>>,
+    /// `values[k][p]`: what is known of point `p` of stance `k`.
+    values: Vec<Vec<Value>>,
+    /// `preds[k][p]`: indices in stance `k − 1`'s points of `p`'s predecessors (one
+    /// foot's count one lower).
+    preds: Vec<Vec<Vec<usize>>>,
+}
+
+impl Band {
+    /// The band around `path`, every point off the path given its lower bound (or
+    /// marked infeasible by (6)–(9)), the path's points their plan stance.
+    fn new(
+        s: &Scenario,
+        plan: &Plan,
+        path: &[Counts],
+        holds: &[Vec<Vec3>; 4],
+        known: &Known,
+    ) -> Band {
+        let offsets = band_offsets();
+        let n = path.len();
+        let mut band = Band {
+            points: Vec::with_capacity(n),
+            values: Vec::with_capacity(n),
+            preds: Vec::with_capacity(n),
+        };
+        for (k, &base) in path.iter().enumerate() {
+            let own = feet_at(holds, &base);
+            let points: Vec<Counts> = if k == 0 {
+                vec![base]
+            } else {
+                offsets
+                    .iter()
+                    .filter_map(|d| shifted(base, d, holds))
+                    .filter(|c| *c == base || !same_feet(&feet_at(holds, c), &own))
+                    .collect()
+            };
+            let values = points
+                .iter()
+                .map(|c| {
+                    if *c == base {
+                        let st = plan.stances[k];
+                        return Value::Exact(Box::new(st), stance_cost(s, &st));
+                    }
+                    let feet = feet_at(holds, c);
+                    if let Some((st, cost)) = known.get(&feet_key(&feet)) {
+                        Value::Exact(Box::new(*st), *cost)
+                    } else if feet_distances_ok(s, &feet) {
+                        Value::Bound(cost_lower_bound(s, &feet))
+                    } else {
+                        Value::Infeasible
+                    }
+                })
+                .collect();
+            let preds = match band.points.last() {
+                None => vec![Vec::new()],
+                Some(prev) => points
+                    .iter()
+                    .map(|c| {
+                        (0..prev.len())
+                            .filter(|&q| is_successor(&prev[q], c))
+                            .collect()
+                    })
+                    .collect(),
+            };
+            band.points.push(points);
+            band.values.push(values);
+            band.preds.push(preds);
+        }
+        band
+    }
+
+    /// The cheapest path from the start to the final counts with the values known now
+    /// (bounds for unsolved points): the point index at each stance.
+    fn shortest_path(&self) -> Option<Vec<usize>> {
+        let n = self.points.len();
+        let mut best: Vec<Vec<(f64, usize)>> = Vec::with_capacity(n);
+        best.push(vec![(self.values[0][0].cost(), 0)]);
+        for k in 1..n {
+            let layer = (0..self.points[k].len())
+                .map(|p| {
+                    let own = self.values[k][p].cost();
+                    self.preds[k][p]
+                        .iter()
+                        .map(|&q| (best[k - 1][q].0 + own, q))
+                        .min_by(|a, b| a.0.total_cmp(&b.0))
+                        .unwrap_or((f64::INFINITY, 0))
+                })
+                .collect();
+            best.push(layer);
+        }
+        // The path's own point is first: at the last stance it is the final counts.
+        if !best[n - 1][0].0.is_finite() {
+            return None;
+        }
+        let mut at = vec![0; n];
+        for k in (1..n).rev() {
+            at[k - 1] = best[k][at[k]].1;
+        }
+        Some(at)
+    }
+}
+
+/// Smallest foot displacement (m) for which two lattice points of one stance count as
+/// different configurations: counts that differ only by moves shorter than this (a
+/// robot standing at its goal makes scheduled "moves" of 1e-4 m and less) give the
+/// path's own configuration up to a millimetre, so they are left out of the band.
+pub const NULL_MOVE: f64 = 1e-3;
+
+/// Whether every foot of `a` is within [`NULL_MOVE`] of its place in `b`.
+fn same_feet(a: &Feet, b: &Feet) -> bool {
+    Foot::ALL
+        .iter()
+        .all(|&i| dist2(a.get(i), b.get(i)) < NULL_MOVE * NULL_MOVE)
+}
+
+/// Stances solved for given feet (the plan's own, and those solved by the search), by
+/// the feet's bit patterns: feet repeat across stances (a robot standing at its goal,
+/// scheduled moves that do not displace a foot), and the stance problem depends on the
+/// feet only, so each is solved once.
+type Known = HashMap<[u64; 12], (Stance, f64)>;
+
+fn feet_key(feet: &Feet) -> [u64; 12] {
+    let a = feet.to_array();
+    std::array::from_fn(|i| a[i / 3][i % 3].to_bits())
+}
+
+/// A lower bound of the stance problem's optimum for `feet`, from (11) and the vertical
+/// part of (2) alone: each CoM lies on the circle of points at squared distance
+/// `leg_length_sq` from both feet of its biped, so its cost term is at least the squared
+/// distance from its goal to that circle; the four vertical forces sum to the robot's
+/// weight, so `Σ ‖F_i‖² ≥ (M g)² / 4` (Cauchy–Schwarz). Infinite when a biped's feet are
+/// too far apart for its legs.
+pub fn cost_lower_bound(s: &Scenario, feet: &Feet) -> f64 {
+    let mut com = 0.0;
+    for (a, b, goal) in [(feet.br, feet.bl, s.goal.b), (feet.fr, feet.fl, s.goal.f)] {
+        let centre: Vec3 = std::array::from_fn(|d| 0.5 * (a[d] + b[d]));
+        let ab2 = dist2(a, b);
+        let rho2 = s.leg_length_sq - 0.25 * ab2;
+        if rho2 < 0.0 || ab2 == 0.0 {
+            return f64::INFINITY;
+        }
+        let len = ab2.sqrt();
+        let u: Vec3 = std::array::from_fn(|d| (b[d] - a[d]) / len);
+        let v: Vec3 = std::array::from_fn(|d| goal[d] - centre[d]);
+        let h = (0..3).map(|d| v[d] * u[d]).sum::<f64>();
+        let w = (dist2(v, [0.0; 3]) - h * h).max(0.0).sqrt();
+        com += h * h + (w - rho2.sqrt()).powi(2);
+    }
+    let weight = s.masses.total() * s.gravity;
+    s.weights.com * com + s.weights.force * weight * weight / 4.0
+}
+
+/// The best schedule with the footholds of `plan` (a plan of `schedule`) within the band
+/// around `schedule` (module docs), with its plan; `None` when it does not lower the cost
+/// by more than [`MIN_RELATIVE_GAIN`] of it.
+///
+/// Solved lazily, exactly: the shortest path is computed with lower bounds for the
+/// points not solved yet ([`cost_lower_bound`]); the unsolved points on it are solved,
+/// and this repeats until the shortest path runs through solved points only. Its cost is
+/// then at most that of any other path (their unsolved points cost at least their
+/// bounds), so it is the best path of the band, found without solving most of it.
 pub fn propose(
     s: &Scenario,
     solver: &mut StanceSolver,
     plan: &Plan,
     schedule: &[Foot],
 ) -> Option<Proposal> {
-    let mut taken = vec![false; schedule.len()];
-    let mut out = Proposal {
-        schedule: schedule.to_vec(),
-        plan: plan.clone(),
-        gain: 0.0,
-        swaps: 0,
-    };
-    for sw in improving_swaps(s, solver, plan, schedule) {
-        if taken[sw.at] || taken[sw.at + 1] {
-            continue;
-        }
-        taken[sw.at] = true;
-        taken[sw.at + 1] = true;
-        out.schedule.swap(sw.at, sw.at + 1);
-        out.plan.stances[sw.at + 1] = sw.stance;
-        out.gain += sw.gain;
-        out.swaps += 1;
+    let n = plan.stances.len();
+    if n < 2 || schedule.len() != n - 1 {
+        return None;
     }
-    (out.swaps > 0).then_some(out)
+    let holds = footholds(plan, schedule);
+    let path = path_counts(schedule);
+    let mut known: Known = plan
+        .stances
+        .iter()
+        .skip(1)
+        .map(|st| (feet_key(&st.feet), (*st, stance_cost(s, st))))
+        .collect();
+    let mut band = Band::new(s, plan, &path, &holds, &known);
+    let mut evaluated = 0;
+    let at = loop {
+        let at = band.shortest_path()?;
+        let mut open = 0;
+        for (k, &p) in at.iter().enumerate() {
+            if let Value::Bound(_) = band.values[k][p] {
+                open += 1;
+                let feet = feet_at(&holds, &band.points[k][p]);
+                let key = feet_key(&feet);
+                let solved = match known.get(&key) {
+                    Some(&(st, c)) => Some((st, c)),
+                    None => {
+                        evaluated += 1;
+                        solver.solve(s, &feet, &plan.stances[k])
+                    }
+                };
+                band.values[k][p] = match solved {
+                    Some((st, c)) => {
+                        known.insert(key, (st, c));
+                        Value::Exact(Box::new(st), c)
+                    }
+                    None => Value::Infeasible,
+                };
+            }
+        }
+        if open == 0 {
+            break at;
+        }
+    };
+    let mut stances = Vec::with_capacity(n);
+    for (k, &p) in at.iter().enumerate() {
+        let Value::Exact(st, _) = &band.values[k][p] else {
+            return None;
+        };
+        stances.push(**st);
+    }
+    let new_schedule: Vec<Foot> = (1..n)
+        .map(|k| {
+            let (a, b) = (&band.points[k - 1][at[k - 1]], &band.points[k][at[k]]);
+            Foot::ALL[(0..4).find(|&i| a[i] != b[i]).unwrap_or(0)]
+        })
+        .collect();
+    let new_plan = Plan { stances };
+    let cost = plan.cost(s);
+    let gain = cost - new_plan.cost(s);
+    if gain <= MIN_RELATIVE_GAIN * cost {
+        return None;
+    }
+    let changed = (0..n)
+        .filter(|&k| new_plan.stances[k] != plan.stances[k])
+        .count();
+    Some(Proposal {
+        schedule: new_schedule,
+        plan: new_plan,
+        gain,
+        changed,
+        evaluated,
+    })
+}
+
+/// `base + d` when every count stays within its foot's footholds.
+fn shifted(base: Counts, d: &[i64; 4], holds: &[Vec<Vec3>; 4]) -> Option<Counts> {
+    let mut c = [0; 4];
+    for i in 0..4 {
+        let v = base[i] as i64 + d[i];
+        if v < 0 || v >= holds[i].len() as i64 {
+            return None;
+        }
+        c[i] = v as usize;
+    }
+    Some(c)
+}
+
+/// Whether `next` is `prev` with exactly one count one higher.
+fn is_successor(prev: &Counts, next: &Counts) -> bool {
+    let mut ups = 0;
+    for i in 0..4 {
+        match next[i] as i64 - prev[i] as i64 {
+            0 => {}
+            1 => ups += 1,
+            _ => return false,
+        }
+    }
+    ups == 1
+}
+
+/// The feet at lattice point `c`.
+fn feet_at(holds: &[Vec<Vec3>; 4], c: &Counts) -> Feet {
+    Feet::from_array(std::array::from_fn(|i| holds[i][c[i]]))
 }

@@ -47,6 +47,13 @@ pub const CROSSING_ROUNDS: usize = 4;
 /// lateral-goal test scenario, 161 iterations over its rounds instead of 238, same plans.
 pub const SEARCH_MU_INIT: f64 = 1e-6;
 
+/// Iteration limit of the interior-point method on the schedule search's re-solves and
+/// on the reference solve without (10). From a plan that satisfies every equation they
+/// take 14–80 iterations; at n_step 1000 one re-solve ran to the default limit of 3000
+/// (90 of the run's 117 s of CPU) without converging. Past this limit the candidate
+/// counts as failed and the planner keeps what it has.
+pub const SEARCH_MAX_ITER: usize = 200;
+
 /// Bound push (absolute and relative, variables and slacks) of the schedule search's
 /// re-solves (default 1e-2, which moves a foot on a keep-out edge by 2 cm).
 pub const SEARCH_BOUND_PUSH: f64 = 1e-8;
@@ -103,13 +110,20 @@ impl Settings {
     }
 
     fn warm(&self) -> Settings {
-        let mut w = self.clone();
+        let mut w = self.capped();
         w.ipm.mu_init = SEARCH_MU_INIT;
         w.ipm.bound_push = SEARCH_BOUND_PUSH;
         w.ipm.bound_frac = SEARCH_BOUND_PUSH;
         w.ipm.slack_bound_push = SEARCH_BOUND_PUSH;
         w.ipm.slack_bound_frac = SEARCH_BOUND_PUSH;
         w
+    }
+
+    /// These settings with the interior-point method limited to [`SEARCH_MAX_ITER`].
+    fn capped(&self) -> Settings {
+        let mut c = self.clone();
+        c.ipm.max_iter = c.ipm.max_iter.min(SEARCH_MAX_ITER);
+        c
     }
 
     fn print_level(&self) -> u8 {
@@ -178,6 +192,8 @@ pub enum PlanningError {
     Solve(#[from] SolveError),
     #[error("reading the plan: {0}")]
     Plan(#[from] PlanError),
+    #[error("{0}")]
+    TooLarge(#[from] crate::limits::TooLarge),
 }
 
 /// Residual of (10) for a flat plan: the largest `Σ_{i<j} ‖Δr_i‖²‖Δr_j‖²` over transitions.
@@ -317,11 +333,12 @@ pub fn plan_on(
     terrain: &(dyn Terrain + Sync),
     settings: &Settings,
 ) -> Result<Outcome, PlanningError> {
+    crate::limits::check(s)?;
     let started = Instant::now();
     let mut phases = Vec::new();
     let crawl = gait::crawl_schedule(s.n_step);
     let guess = gait::crawl(s);
-    let last = match s.gait {
+    let (last, without_10) = match s.gait {
         Gait::Crawl => {
             let first = run(
                 s,
@@ -332,7 +349,10 @@ pub fn plan_on(
                 &mut phases,
                 "crawl gait",
             )?;
-            crossing_search(s, terrain, settings, first, &mut phases)?
+            (
+                crossing_search(s, terrain, settings, first, &mut phases)?,
+                None,
+            )
         }
         Gait::Free => free_gait(s, terrain, settings, &mut phases)?,
     };
@@ -346,6 +366,7 @@ pub fn plan_on(
         status: String::new(),
         iterations: phases.iter().map(|p| p.iterations).sum(),
         objective: plan.cost(s),
+        objective_without_10: without_10,
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
     };
@@ -417,13 +438,14 @@ pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanS
 }
 
 /// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
-/// schedule and the schedule search from the better of the two.
+/// schedule and the schedule search from the better of the two; with the reference
+/// objective without (10) ([`objective_without_10`], from the search's starting plan).
 fn free_gait(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     settings: &Settings,
     phases: &mut Vec<Phase>,
-) -> Result<Run, PlanningError> {
+) -> Result<(Run, Option<f64>), PlanningError> {
     // The two starting schedules are independent: solved on two threads.
     let crawl = gait::crawl_schedule(s.n_step);
     let pair = gait::pair_schedule(s.n_step);
@@ -453,19 +475,75 @@ fn free_gait(
             )
         },
     );
-    let mut best = record(crawl_run?, settings, phases);
+    let crawl_run = record(crawl_run?, settings, phases);
     let pair_run = record(pair_run?, settings, phases);
-    if pair_run.beats(&best) {
-        best = pair_run;
+    // The crossing search ([`crossing_search`]) from the better of the two plans; the
+    // schedule searches below start from its result.
+    let (crawl_run, pair_run) = if pair_run.beats(&crawl_run) {
+        let pair_run = crossing_search(s, terrain, &candidate, pair_run, phases)?;
+        (crawl_run, pair_run)
+    } else {
+        let crawl_run = crossing_search(s, terrain, &candidate, crawl_run, phases)?;
+        (crawl_run, pair_run)
+    };
+    let start = if pair_run.beats(&crawl_run) {
+        &pair_run
+    } else {
+        &crawl_run
+    };
+    if !start.solution.status.is_success() {
+        return Ok((pair_run_or(crawl_run, pair_run), None));
     }
-    if !best.solution.status.is_success() {
-        return Ok(best);
+    // The searches from both plans and the reference without (10) are independent:
+    // they share the threads; their logs are printed afterwards, in this order.
+    let (from_crawl, (from_pair, reference)) = rayon::join(
+        || search_from(s, terrain, &candidate, &crawl_run, "crawl"),
+        || {
+            rayon::join(
+                || search_from(s, terrain, &candidate, &pair_run, "biped-pair"),
+                || objective_without_10(s, terrain, &start.flat, &candidate),
+            )
+        },
+    );
+    let (from_crawl, from_pair, reference) = (from_crawl?, from_pair?, reference?);
+    let mut best = pair_run_or(crawl_run, pair_run);
+    for solved in from_crawl.into_iter().chain(from_pair) {
+        let next = record(solved, settings, phases);
+        if next.beats(&best) {
+            best = next;
+        }
     }
-    best = crossing_search(s, terrain, &candidate, best, phases)?;
-    // Schedule search from the better plan: each round's proposal satisfies every
-    // equation of its schedule with a lower cost; the re-solve frees every variable.
+    Ok((best, reference))
+}
+
+/// The better of the crawl and biped-pair runs (the crawl run on a tie or when both fail).
+fn pair_run_or(crawl: Run, pair: Run) -> Run {
+    if pair.beats(&crawl) {
+        pair
+    } else {
+        crawl
+    }
+}
+
+/// Schedule search from `from` ([`crate::schedule_search`]), not yet recorded: each
+/// round's proposal satisfies every equation of its schedule with a lower cost; its
+/// re-solve frees every variable. Stops when no proposal improves, a re-solve does not
+/// beat the plan it started from, or after [`SEARCH_ROUNDS`] rounds. Nothing when
+/// `from` failed.
+fn search_from(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    candidate: &Settings,
+    from: &Run,
+    label: &str,
+) -> Result<Vec<Solved>, PlanningError> {
+    let mut out: Vec<Solved> = Vec::new();
+    if !from.solution.status.is_success() {
+        return Ok(out);
+    }
     let search_settings = candidate.warm();
     let mut stance_solver = StanceSolver::new(s, terrain)?;
+    let mut best = from;
     for round in 1..=SEARCH_ROUNDS {
         let current = Plan::from_flat(s, &best.flat)?;
         let Some(proposal) =
@@ -473,25 +551,53 @@ fn free_gait(
         else {
             break;
         };
-        let next = run(
+        let next = solve_scheduled(
             s,
             terrain,
             &proposal.schedule,
             &proposal.plan.to_flat(),
             &search_settings,
-            phases,
             &format!(
-                "free gait: schedule search {round} ({} swap{})",
-                proposal.swaps,
-                if proposal.swaps == 1 { "" } else { "s" }
+                "free gait: search from {label} {round} ({} stance{} changed, {} evaluated)",
+                proposal.changed,
+                if proposal.changed == 1 { "" } else { "s" },
+                proposal.evaluated
             ),
         )?;
-        if !next.beats(&best) {
+        let improved = next.run.beats(best);
+        out.push(next);
+        if !improved {
             break;
         }
-        best = next;
+        best = &out.last().expect("just pushed").run;
     }
-    Ok(best)
+    Ok(out)
+}
+
+/// The reference objective of the problem without (10): every foot may move at every
+/// transition (the lifted formulation, [`Formulation::Complementarity`], with its penalty
+/// π set to 0, so (5) bounds each step and nothing couples the feet), warm-started from
+/// `plan` (a plan that satisfies every equation, hence feasible for the relaxation) with
+/// its keep-out sides. Dropping a constraint can only lower the optimum, so this says how
+/// much (10) costs; it is a local optimum of a nonconvex problem, a reference rather than
+/// a certified bound. `None` when the solve does not succeed.
+pub fn objective_without_10(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    plan: &[f64],
+    settings: &Settings,
+) -> Result<Option<f64>, PlanningError> {
+    let model = model::build(s, terrain, &Formulation::Complementarity, plan)?;
+    let mut compiled = model.problem.compile()?;
+    compiled.set_value(model::PENALTY, &[0.0])?;
+    let mut quiet = settings.capped();
+    quiet.set_print_level(0);
+    let solution = quiet.solve(&mut compiled, |_| ControlFlow::Continue(()))?;
+    if !solution.status.is_success() {
+        return Ok(None);
+    }
+    let flat = model.problem.evaluate(&model.layout, &solution.x)?;
+    Ok(Some(Plan::from_flat(s, &flat)?.cost(s)))
 }
 
 /// Whether the final CoMs of a flat plan are within [`GOAL_TOL`] of their goals.

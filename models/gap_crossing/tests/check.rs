@@ -13,6 +13,7 @@ fn info() -> SolverInfo {
         status: "solved".into(),
         iterations: 0,
         objective: 0.0,
+        objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
     }

@@ -27,17 +27,21 @@ fn free_gait_history_has_every_iteration_and_the_checkers_residual() {
     let report = check::check(&out.file);
     assert!(report.ok(), "{report}");
     // The runs of the free gait: crawl schedule, biped-pair schedule, then the schedule
-    // search's rounds (one on the default scenario).
+    // search's rounds from each (two from each on the default scenario).
     let names: Vec<&str> = out.phases.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(names.len(), 3, "{names:?}");
+    assert_eq!(names.len(), 6, "{names:?}");
     assert_eq!(names[0], "free gait: crawl schedule");
     assert_eq!(names[1], "free gait: biped-pair schedule");
     assert!(
-        names[2].starts_with("free gait: schedule search 1"),
+        names[2].starts_with("free gait: search from crawl 1"),
+        "{names:?}"
+    );
+    assert!(
+        names[4].starts_with("free gait: search from biped-pair 1"),
         "{names:?}"
     );
     let history = Convergence::from_phases(&out.phases);
-    assert_eq!(history.phases.len(), 3);
+    assert_eq!(history.phases.len(), 6);
     let mut total = 0;
     for (k, p) in out.phases.iter().enumerate() {
         // One entry per iteration (and per restoration start), in the solver's order.
@@ -82,8 +86,8 @@ fn free_gait_history_has_every_iteration_and_the_checkers_residual() {
     let svg = render::convergence_svg(&history, "t");
     assert_eq!(
         svg.matches("stroke-dasharray").count(),
-        2,
-        "two run boundaries"
+        5,
+        "five run boundaries"
     );
     assert!(svg.contains("≡ 0"));
 }
@@ -116,6 +120,7 @@ fn probe_matches_the_checker_off_complementarity() {
         status: "guess".into(),
         iterations: 0,
         objective: 0.0,
+        objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
     };

@@ -335,6 +335,7 @@ fn every_terrain_kind_is_drawn() {
             status: "guess".into(),
             iterations: 0,
             objective: 0.0,
+            objective_without_10: None,
             max_constraint_violation: 0.0,
             solve_seconds: 0.0,
         };

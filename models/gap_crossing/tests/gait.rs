@@ -13,6 +13,7 @@ fn as_file(s: &Scenario, plan: Plan) -> SolutionFile {
             status: "initial_guess".into(),
             iterations: 0,
             objective: plan.cost(s),
+            objective_without_10: None,
             max_constraint_violation: 0.0,
             solve_seconds: 0.0,
         },

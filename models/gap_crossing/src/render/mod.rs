@@ -7,14 +7,21 @@
 //! - [`convergence`] ([`convergence_svg`]): objective, constraint violation and the
 //!   residual of (10) per iteration of every solver run, each on its own log scale, with
 //!   the runs' boundaries marked.
+//! - [`sweep`] ([`sweep_svg`]): a sweep's points as a heat map of wall time and failures.
+//! - [`html`] ([`plan_html`]): the plan animated, one stance at a time, with a slider and
+//!   a play button (a self-contained HTML page with inline SVG and script).
 //!
 //! This module holds what they share: sizes, fonts, the colour ramp, escaping and ticks.
 
 pub mod convergence;
+pub mod html;
 pub mod plan;
+pub mod sweep;
 
 pub use convergence::convergence_svg;
+pub use html::plan_html;
 pub use plan::plan_svg;
+pub use sweep::sweep_svg;
 
 /// Width of every figure (px).
 pub(crate) const WIDTH: f64 = 1000.0;
@@ -46,10 +53,12 @@ pub fn ramp(t: f64) -> String {
     format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
 }
 
+/// Escapes text for SVG/HTML content and attribute values.
 pub(crate) fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 /// A "nice" tick step (1, 2 or 5 × 10ⁿ) giving about `target` ticks over `span`.

@@ -1,0 +1,105 @@
+//! The largest problem the planner will build: `n_step` against the memory it needs.
+//!
+//! The model, its compiled derivative tapes and the KKT factorisation all grow linearly
+//! in `n_step`. Without a limit a too-long horizon (`n_step = 100000`) ran for minutes
+//! and aborted on an allocation failure deep in `symx::ad::hessian`. [`check`] refuses
+//! such a scenario before anything is built, with the estimate in its message.
+//!
+//! The estimate is [`BASE_BYTES`] + [`BYTES_PER_STANCE`] · `n_step`, fitted to the peak
+//! resident memory of the release CLI (free gait, the default scenario otherwise;
+//! `/usr/bin/time -f %M`, see docs/performance.md, "Limits"), rounded up. It is compared
+//! with the memory the system reports available (`MemAvailable` of `/proc/meminfo`; when
+//! that cannot be read, [`FALLBACK_AVAILABLE_BYTES`]).
+use crate::scenario::Scenario;
+
+/// Fixed part of the memory estimate (bytes).
+pub const BASE_BYTES: u64 = 200 << 20;
+
+/// Memory per stance (bytes): 0.48 MB per stance measured between n_step 250 and 1000,
+/// rounded up to 1 MiB for the allocator's peaks.
+pub const BYTES_PER_STANCE: u64 = 1 << 20;
+
+/// Memory assumed available when the system does not say (bytes).
+pub const FALLBACK_AVAILABLE_BYTES: u64 = 4 << 30;
+
+/// A problem too large for the memory available.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "n_step = {n_step} is too large: building and solving it needs about {} of memory \
+     (estimate {} + {} per stance), but {} is available; at most n_step = {max_n_step} fits",
+    gib(*estimate), gib(BASE_BYTES), mib(BYTES_PER_STANCE), gib(*available)
+)]
+pub struct TooLarge {
+    /// The scenario's `n_step`.
+    pub n_step: usize,
+    /// Estimated peak memory (bytes).
+    pub estimate: u64,
+    /// Memory available (bytes).
+    pub available: u64,
+    /// The largest `n_step` whose estimate fits.
+    pub max_n_step: usize,
+}
+
+fn gib(b: u64) -> String {
+    format!("{:.1} GiB", b as f64 / (1u64 << 30) as f64)
+}
+
+fn mib(b: u64) -> String {
+    format!("{:.1} MiB", b as f64 / (1u64 << 20) as f64)
+}
+
+/// Estimated peak memory of planning `n_step` stances (bytes).
+pub fn memory_estimate(n_step: usize) -> u64 {
+    BASE_BYTES.saturating_add(BYTES_PER_STANCE.saturating_mul(n_step as u64))
+}
+
+/// The memory available, from `/proc/meminfo` (`MemAvailable`), if readable.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Refuses `s` when its estimate exceeds `available` bytes.
+pub fn check_with(s: &Scenario, available: u64) -> Result<(), TooLarge> {
+    let estimate = memory_estimate(s.n_step);
+    if estimate <= available {
+        return Ok(());
+    }
+    Err(TooLarge {
+        n_step: s.n_step,
+        estimate,
+        available,
+        max_n_step: (available.saturating_sub(BASE_BYTES) / BYTES_PER_STANCE) as usize,
+    })
+}
+
+/// Refuses `s` when its estimate exceeds the memory available now.
+pub fn check(s: &Scenario) -> Result<(), TooLarge> {
+    check_with(s, available_memory().unwrap_or(FALLBACK_AVAILABLE_BYTES))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_past_the_available_memory() {
+        let s = |n_step| Scenario {
+            n_step,
+            ..Scenario::default()
+        };
+        let avail = 2u64 << 30;
+        assert!(check_with(&s(60), avail).is_ok());
+        let e = check_with(&s(100_000), avail).unwrap_err();
+        assert_eq!(e.estimate, memory_estimate(100_000));
+        assert!(e.max_n_step < 100_000 && memory_estimate(e.max_n_step) <= avail);
+        assert!(memory_estimate(e.max_n_step + 1) > avail);
+        let msg = e.to_string();
+        assert!(
+            msg.contains("n_step = 100000") && msg.contains("GiB"),
+            "{msg}"
+        );
+    }
+}
