@@ -155,6 +155,49 @@ fn partial(g: &mut Graph, y: u32, k: usize) -> u32 {
             g.binary(Op::Sub, ONE, y2)
         }
         Op::Abs => g.unary(Op::Sign, a),
+        Op::Erf => {
+            // 2/√π · exp(−a²)
+            let a2 = g.unary(Op::Sq, a);
+            let m = g.unary(Op::Neg, a2);
+            let e = g.unary(Op::Exp, m);
+            let c = g.constant(std::f64::consts::FRAC_2_SQRT_PI);
+            g.binary(Op::Mul, c, e)
+        }
+        Op::Asinh | Op::Acosh => {
+            // 1/√(a² ± 1)
+            let a2 = g.unary(Op::Sq, a);
+            let r = if n.op == Op::Asinh {
+                g.binary(Op::Add, a2, ONE)
+            } else {
+                g.binary(Op::Sub, a2, ONE)
+            };
+            let r = g.unary(Op::Sqrt, r);
+            g.binary(Op::Div, ONE, r)
+        }
+        Op::Atanh => {
+            let a2 = g.unary(Op::Sq, a);
+            let d = g.binary(Op::Sub, ONE, a2);
+            g.binary(Op::Div, ONE, d)
+        }
+        Op::Log1p => {
+            let d = g.binary(Op::Add, ONE, a);
+            g.binary(Op::Div, ONE, d)
+        }
+        Op::Expm1 => g.binary(Op::Add, y, ONE),
+        Op::Fmod => {
+            if k == 0 {
+                ONE
+            } else {
+                // fmod(a,b) = a − trunc(a/b)·b, so ∂/∂b = −trunc(a/b) = (y − a)/b (CasADi's form).
+                let r = g.binary(Op::Sub, y, a);
+                g.binary(Op::Div, r, b)
+            }
+        }
+        Op::Hypot => g.binary(Op::Div, if k == 0 { a } else { b }, y),
+        Op::Interpolant => {
+            let d = g.derivative_table(b);
+            g.interpolant(a, d)
+        }
         Op::Add => ONE,
         Op::Sub => {
             if k == 0 {

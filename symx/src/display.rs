@@ -95,6 +95,11 @@ fn write_tree(
         match n.op {
             Op::Const => write_constant(out, n.value().unwrap_or(f64::NAN))?,
             Op::Sym => out.write_str(g.symbol_name(id))?,
+            Op::Interpolant => {
+                write!(out, "interpolant#{}(", n.args[1])?;
+                tasks.push(Task::Text(")"));
+                tasks.push(Task::Node(n.args[0]));
+            }
             Op::Neg => {
                 out.write_str("(-")?;
                 tasks.push(Task::Text(")"));

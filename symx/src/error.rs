@@ -35,6 +35,9 @@ pub enum SymxError {
         left: (usize, usize),
         right: (usize, usize),
     },
+    /// Bad data for a lookup table ([`crate::Interpolant`]).
+    #[error("interpolant: {reason}")]
+    Table { reason: String },
     /// A syntax error in [`crate::parse`].
     #[error("parse error at byte {position}: {message}")]
     Parse { position: usize, message: String },

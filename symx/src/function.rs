@@ -21,12 +21,15 @@
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::graph::{self, Graph};
+use crate::interpolant::Table;
 use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
 use rustc_hash::FxHashMap;
+use std::sync::Arc;
 
 /// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
-/// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`.
+/// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`;
+/// for [`Op::Interpolant`], `c` is the index of the table in [`Function`]'s own list.
 #[derive(Clone, Copy, Debug)]
 struct Instr {
     op: Op,
@@ -64,6 +67,8 @@ pub struct Function {
     template: Vec<f64>,
     template_start: usize,
     work_size: usize,
+    /// Lookup tables read by `Interpolant` instructions.
+    tables: Vec<Arc<Table>>,
 }
 
 impl Function {
@@ -261,6 +266,17 @@ impl Function {
                 Op::And => f64::from(a != 0.0 && b != 0.0),
                 Op::Or => f64::from(a != 0.0 || b != 0.0),
                 Op::StrongMul => op::strong_mul(a, b),
+                Op::Floor => a.floor(),
+                Op::Ceil => a.ceil(),
+                Op::Erf => libm::erf(a),
+                Op::Asinh => a.asinh(),
+                Op::Acosh => a.acosh(),
+                Op::Atanh => a.atanh(),
+                Op::Log1p => a.ln_1p(),
+                Op::Expm1 => a.exp_m1(),
+                Op::Fmod => a % b,
+                Op::Hypot => a.hypot(b),
+                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(a),
                 Op::IfElse => {
                     if a != 0.0 {
                         b
@@ -461,6 +477,8 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
     let temp_start = slot as u32;
     let mut free: Vec<u32> = Vec::new();
     let mut work_size = temp_start;
+    let mut tables: Vec<Arc<Table>> = Vec::new();
+    let mut table_of: FxHashMap<u32, u32> = FxHashMap::default();
     let mut tape = Vec::with_capacity(steps.len() + copies.len());
     for (s, &id) in steps.iter().enumerate() {
         let node = g.node(id);
@@ -488,12 +506,22 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
             register[l] = d;
             d
         };
+        let c = if node.op == Op::Interpolant {
+            *table_of.entry(node.args[1]).or_insert_with(|| {
+                tables.push(g.tables[node.args[1] as usize].clone());
+                tables.len() as u32 - 1
+            })
+        } else if arity == 3 {
+            regs[2]
+        } else {
+            regs[0]
+        };
         tape.push(Instr {
             op: node.op,
             d,
             a: regs[0],
             b: if arity >= 2 { regs[1] } else { regs[0] },
-            c: if arity == 3 { regs[2] } else { regs[0] },
+            c,
         });
     }
     for mut copy in copies {
@@ -512,5 +540,6 @@ fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Functio
         template,
         template_start,
         work_size: work_size as usize,
+        tables,
     })
 }
