@@ -85,7 +85,7 @@ impl Sweep {
         }
         while let Some(id) = self.stack.pop() {
             self.cone.push(id);
-            for &a in g.nodes[id as usize].operands() {
+            for &a in g.operands(id) {
                 if self.stamp[a as usize] != self.current {
                     self.stamp[a as usize] = self.current;
                     self.stack.push(a);
@@ -99,7 +99,7 @@ impl Sweep {
             self.gated[i] = false;
             self.dep[i] = match self.wrt_position(id) {
                 Some(p) => p < wrt_limit,
-                None => g.nodes[i].operands().iter().any(|&a| self.dep[a as usize]),
+                None => g.operands(id).iter().any(|&a| self.dep[a as usize]),
             };
         }
     }
@@ -279,6 +279,12 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
     for idx in (0..s.cone.len()).rev() {
         let v = s.cone[idx];
         let vi = v as usize;
+        if g.nodes[vi].op == Op::Call {
+            if s.dep[vi] {
+                reverse_call(g, s, v);
+            }
+            continue;
+        }
         let adj = s.value[vi];
         if adj == NONE || !s.dep[vi] || adj == ZERO {
             continue;
@@ -323,6 +329,8 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
                     accumulate(g, s, b, c, true);
                 }
             }
+            // The call node gathers the adjoints of its outputs.
+            Op::CallOutput => {}
             op if op.has_zero_derivative() => {}
             _ => {
                 for k in 0..n.op.arity() {
@@ -336,6 +344,80 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
                 }
             }
         }
+    }
+}
+
+/// The adjoint of node `o` in the current sweep, if it has a non-zero one.
+fn live_adjoint(s: &Sweep, o: u32) -> Option<u32> {
+    let (i, t) = (o as usize, s.value[o as usize]);
+    (s.stamp[i] == s.current && s.dep[i] && t != NONE && t != ZERO).then_some(t)
+}
+
+/// Reverse sweep step at call node `v`: `x̄ⱼ += Σₖ ȳₖ Jₖⱼ` over the callee's Jacobian
+/// nonzeros (see `call.rs`).
+fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
+    let site = &g.calls[g.nodes[v as usize].args[0] as usize];
+    let (function, inputs) = (site.function.clone(), site.inputs.clone());
+    let adj: Vec<Option<u32>> = site.outputs.iter().map(|&o| live_adjoint(s, o)).collect();
+    if adj.iter().all(Option::is_none) {
+        return;
+    }
+    let gated = site
+        .outputs
+        .iter()
+        .any(|&o| s.stamp[o as usize] == s.current && s.gated[o as usize]);
+    let jac = crate::call::call_jacobian(g, &function);
+    let jout = g.call(&jac.function, inputs.clone());
+    let mul = if gated { Op::StrongMul } else { Op::Mul };
+    for (j, &a) in inputs.iter().enumerate() {
+        if !s.dep[a as usize] {
+            continue;
+        }
+        let terms: Vec<u32> = jac.by_input[j]
+            .iter()
+            .filter_map(|&(k, nz)| adj[k as usize].map(|t| g.binary(mul, t, jout[nz as usize])))
+            .collect();
+        if !terms.is_empty() {
+            let c = balanced(g, Op::Add, terms, ZERO);
+            accumulate(g, s, a, c, gated);
+        }
+    }
+}
+
+/// Forward sweep step at call node `v`: `ẏₖ = Σⱼ Jₖⱼ ẋⱼ`, written to the output nodes.
+fn forward_call(g: &mut Graph, s: &mut Sweep, v: u32) {
+    let site = &g.calls[g.nodes[v as usize].args[0] as usize];
+    let (function, inputs, outputs) = (
+        site.function.clone(),
+        site.inputs.clone(),
+        site.outputs.clone(),
+    );
+    let tangents: Vec<u32> = inputs
+        .iter()
+        .map(|&a| {
+            let t = s.value[a as usize];
+            if s.dep[a as usize] && t != NONE {
+                t
+            } else {
+                ZERO
+            }
+        })
+        .collect();
+    if tangents.iter().all(|&t| t == ZERO) {
+        return;
+    }
+    let jac = crate::call::call_jacobian(g, &function);
+    let jout = g.call(&jac.function, inputs);
+    for (k, &o) in outputs.iter().enumerate() {
+        if s.stamp[o as usize] != s.current {
+            continue;
+        }
+        let terms: Vec<u32> = jac.by_output[k]
+            .iter()
+            .filter(|&&(j, _)| tangents[j as usize] != ZERO)
+            .map(|&(j, nz)| g.binary(Op::Mul, jout[nz as usize], tangents[j as usize]))
+            .collect();
+        s.value[o as usize] = balanced(g, Op::Add, terms, ZERO);
     }
 }
 
@@ -358,6 +440,12 @@ fn forward_pass(g: &mut Graph, s: &mut Sweep) {
         };
         s.value[vi] = match n.op {
             Op::Sym | Op::Const => ZERO,
+            Op::Call => {
+                forward_call(g, s, v);
+                ZERO
+            }
+            // (Set by its call when it has a tangent.)
+            Op::CallOutput => ZERO,
             Op::IfElse | Op::Min | Op::Max => {
                 let (first, second) = if n.op == Op::IfElse {
                     (n.args[1], n.args[2])
@@ -509,7 +597,7 @@ pub fn gradient(f: Expr, inputs: &[Expr]) -> Result<Vec<Expr>, SymxError> {
 
 /// Rows of a Jacobian as `(column, expression)` lists, one reverse sweep per output over its
 /// own cone; with `lower_only`, row `i` keeps only columns `≤ i` (for Hessians).
-fn jacobian_rows(
+pub(crate) fn jacobian_rows(
     g: &mut Graph,
     out: &[u32],
     wrt: &[u32],

@@ -35,6 +35,9 @@ pub enum SymxError {
         left: (usize, usize),
         right: (usize, usize),
     },
+    /// Two inputs or two outputs of a function with the same name.
+    #[error("{what} name '{name}' appears more than once")]
+    DuplicateName { what: &'static str, name: String },
     /// Bad data for a lookup table ([`crate::Interpolant`]).
     #[error("interpolant: {reason}")]
     Table { reason: String },

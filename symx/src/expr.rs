@@ -69,8 +69,7 @@ impl Expr {
     /// The operands of the root operation.
     pub fn operands(self) -> Vec<Expr> {
         graph::with(|g| {
-            g.node(self.id)
-                .operands()
+            g.operands(self.id)
                 .iter()
                 .map(|&a| Expr::from_id(a))
                 .collect()

@@ -5,6 +5,7 @@
 //! by construction and constants are interned. Because a node can only refer to nodes that
 //! already exist, ascending index order is a topological order of the whole graph; every
 //! traversal in this crate relies on that and none of them recurses.
+use crate::call::CallSite;
 use crate::interpolant::Table;
 use crate::op::Op;
 use rustc_hash::FxHashMap;
@@ -65,6 +66,12 @@ pub(crate) struct Graph {
     table_index: FxHashMap<usize, u32>,
     /// Table number of each table's derivative, once built.
     table_derivative: Vec<Option<u32>>,
+    /// Calls of compiled functions, by call number (`Call` nodes hold the number).
+    pub calls: Vec<CallSite>,
+    /// Call number of each (function, argument nodes) pair: identical calls are one call.
+    pub call_index: FxHashMap<(u64, Vec<u32>), u32>,
+    /// The called functions, by [`crate::Function`] identity, shared by their call sites.
+    pub functions: FxHashMap<u64, Arc<crate::Function>>,
 }
 
 thread_local! {
@@ -88,6 +95,9 @@ impl Graph {
             tables: Vec::new(),
             table_index: FxHashMap::default(),
             table_derivative: Vec::new(),
+            calls: Vec::new(),
+            call_index: FxHashMap::default(),
+            functions: FxHashMap::default(),
         };
         // Indices 0 and 1 are the constants 0 and 1, used everywhere.
         g.intern(Node::constant(0.0));
@@ -162,6 +172,17 @@ impl Graph {
     #[inline]
     pub fn node(&self, id: u32) -> Node {
         self.nodes[id as usize]
+    }
+
+    /// The operand indices of node `id` (for a `Call`, its argument entries).
+    #[inline]
+    pub fn operands(&self, id: u32) -> &[u32] {
+        let n = &self.nodes[id as usize];
+        if n.op == Op::Call {
+            &self.calls[n.args[0] as usize].inputs
+        } else {
+            n.operands()
+        }
     }
 
     #[inline]

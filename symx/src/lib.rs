@@ -21,6 +21,8 @@
 //! independent of it and can be shared across threads.
 mod ad;
 mod assemble;
+mod call;
+mod compile;
 mod display;
 mod error;
 mod expr;

@@ -72,6 +72,12 @@ pub enum Op {
     /// A lookup table (see [`crate::Interpolant`]) applied to the operand; the node also
     /// records which table, so it prints as `interpolant#k(x)` and does not parse back.
     Interpolant,
+    /// A call of a compiled [`crate::Function`] (see [`crate::Function::apply`]); its
+    /// operands (the argument entries) live in the graph's call table, so `arity` is 0.
+    /// It has no value of its own: its outputs are `CallOutput` nodes.
+    Call,
+    /// Entry `k` (second slot) of the outputs of the `Call` node in the first slot.
+    CallOutput,
 }
 
 impl Op {
@@ -79,10 +85,10 @@ impl Op {
     pub fn arity(self) -> usize {
         use Op::*;
         match self {
-            Const | Sym => 0,
+            Const | Sym | Call => 0,
             Neg | Sq | Sqrt | Exp | Log | Sin | Cos | Tan | Asin | Acos | Atan | Sinh | Cosh
             | Tanh | Abs | Sign | Not | Floor | Ceil | Erf | Asinh | Acosh | Atanh | Log1p
-            | Expm1 | Interpolant => 1,
+            | Expm1 | Interpolant | CallOutput => 1,
             Add | Sub | Mul | Div | Pow | Atan2 | Min | Max | Lt | Le | Eq | Ne | And | Or
             | StrongMul | Fmod | Hypot => 2,
             IfElse => 3,
@@ -219,6 +225,8 @@ impl Op {
             Fmod => "fmod",
             Hypot => "hypot",
             Interpolant => "interpolant",
+            Call => "call",
+            CallOutput => "call_output",
         }
     }
 

@@ -1,0 +1,227 @@
+//! Calls of compiled [`Function`]s inside an expression graph, without inlining.
+//!
+//! [`Function::apply`] adds one `Call` node (its operands: the argument entries) and one
+//! `CallOutput` node per output entry. Identical calls (same function, same argument
+//! nodes) are one call, as every node is hash-consed. The callee is shared by reference,
+//! so an optimal-control problem of N stages holds its dynamics once.
+//!
+//! Derivatives go through the callee's **Jacobian function** (CasADi's `jac_f`): a
+//! compiled function of the same inputs whose single output holds the structural nonzeros
+//! of `∂(outputs)/∂(inputs)`, built once per callee from its tape and kept in it. A reverse
+//! sweep reaching a call turns the adjoints `ȳ` of its outputs into `x̄ⱼ = Σₖ ȳₖ Jₖⱼ` over
+//! the nonzeros only, where `J` are the outputs of one call of the Jacobian function on the
+//! same arguments (shared by all sweeps, so a Jacobian or Hessian evaluates it once per
+//! call site); a forward sweep computes `ẏₖ = Σⱼ Jₖⱼ ẋⱼ`. The Jacobian function is itself a
+//! `Function`, so second derivatives (Hessians) call the Jacobian's Jacobian, and so on:
+//! sparsity stays exact at every order, and the branch-safety rule for `if_else` holds
+//! inside the callee (its Jacobian is built by the same sweeps) and outside (products
+//! below a selection use the guarded product).
+use crate::error::SymxError;
+use crate::expr::Expr;
+use crate::function::Function;
+use crate::graph::{self, Graph, Node};
+use crate::op::Op;
+use std::sync::Arc;
+
+/// One call in the graph.
+pub(crate) struct CallSite {
+    pub function: Arc<Function>,
+    /// Argument entries (inputs stacked).
+    pub inputs: Vec<u32>,
+    /// The `CallOutput` node of each output entry (outputs stacked).
+    pub outputs: Vec<u32>,
+}
+
+/// One call on a tape: registers of the arguments, first register of the outputs.
+#[derive(Clone, Debug)]
+pub(crate) struct CallInstr {
+    pub function: Arc<Function>,
+    pub args: Vec<u32>,
+    pub out: u32,
+}
+
+/// The Jacobian function of a callee and its pattern.
+#[derive(Debug)]
+pub(crate) struct CallJacobian {
+    /// Same inputs as the callee; one output: the nonzeros, row by row.
+    pub function: Arc<Function>,
+    /// For each input entry `j`: `(output entry k, nonzero index)` of column `j`.
+    pub by_input: Vec<Vec<(u32, u32)>>,
+    /// For each output entry `k`: `(input entry j, nonzero index)` of row `k`.
+    pub by_output: Vec<Vec<(u32, u32)>>,
+}
+
+impl Graph {
+    /// The graph's shared copy of `f` (one per function identity).
+    pub fn function_arc(&mut self, f: &Function) -> Arc<Function> {
+        self.functions
+            .entry(f.uid)
+            .or_insert_with(|| Arc::new(f.clone()))
+            .clone()
+    }
+
+    /// The output nodes of the call `f(inputs)` (inputs stacked), creating it if new.
+    pub fn call(&mut self, f: &Arc<Function>, inputs: Vec<u32>) -> Vec<u32> {
+        let key = (f.uid, inputs);
+        if let Some(&c) = self.call_index.get(&key) {
+            return self.calls[c as usize].outputs.clone();
+        }
+        let c = self.calls.len() as u32;
+        self.calls.push(CallSite {
+            function: f.clone(),
+            inputs: key.1.clone(),
+            outputs: Vec::new(),
+        });
+        let node = self.intern(Node {
+            op: Op::Call,
+            args: [c, 0, 0],
+        });
+        let n_out: usize = f.output_sizes.iter().sum();
+        let outputs: Vec<u32> = (0..n_out as u32)
+            .map(|k| {
+                self.intern(Node {
+                    op: Op::CallOutput,
+                    args: [node, k, 0],
+                })
+            })
+            .collect();
+        self.calls[c as usize].outputs = outputs.clone();
+        self.call_index.insert(key, c);
+        outputs
+    }
+}
+
+impl Function {
+    /// Calls this function on expressions, without inlining it: one call node in the
+    /// graph, evaluated by running this function's tape (see the module notes on
+    /// derivatives). `args[k]` has length `input_sizes()[k]`; the result has one vector per
+    /// output.
+    ///
+    /// ```
+    /// use symx::{gradient, Function, Matrix};
+    /// let x = Matrix::sym_vec("x", 2);
+    /// let f = Function::named("f", &[("x", &x)], &[("y", &[x[0] * x[1].sin()])]).unwrap();
+    /// let z = Matrix::sym_vec("z", 2);
+    /// let y = f.apply(&[&[z[1], z[0] * 2.0]]).unwrap()[0][0];   // z₁·sin(2z₀)
+    /// let g = gradient(y, &z).unwrap();
+    /// let h = Function::new(&[&z], &[&[y], &g]).unwrap();
+    /// let out = h.call(&[&[0.3, 1.5]]).unwrap();
+    /// assert!((out[0][0] - 1.5 * 0.6f64.sin()).abs() < 1e-15);
+    /// assert!((out[1][0] - 3.0 * 0.6f64.cos()).abs() < 1e-15 && (out[1][1] - 0.6f64.sin()).abs() < 1e-15);
+    /// ```
+    pub fn apply(&self, args: &[&[Expr]]) -> Result<Vec<Vec<Expr>>, SymxError> {
+        if args.len() != self.input_sizes.len() {
+            return Err(SymxError::ArgumentCount {
+                what: "arguments",
+                expected: self.input_sizes.len(),
+                got: args.len(),
+            });
+        }
+        for (index, (a, &n)) in args.iter().zip(&self.input_sizes).enumerate() {
+            if a.len() != n {
+                return Err(SymxError::Length {
+                    what: "argument",
+                    index,
+                    expected: n,
+                    got: a.len(),
+                });
+            }
+        }
+        let flat: Vec<u32> = args.iter().flat_map(|a| a.iter().map(|e| e.id)).collect();
+        let outs = graph::with(|g| {
+            let f = g.function_arc(self);
+            g.call(&f, flat)
+        });
+        let mut it = outs.into_iter().map(Expr::from_id);
+        Ok(self
+            .output_sizes
+            .iter()
+            .map(|&n| it.by_ref().take(n).collect())
+            .collect())
+    }
+}
+
+/// Rebuilds `f`'s computation in `g` on fresh symbols: the input symbols (stacked) and the
+/// output nodes (stacked).
+fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
+    const UNSET: u32 = u32::MAX;
+    let mut reg = vec![UNSET; f.work_size];
+    let mut inputs = Vec::new();
+    for (k, (&n, &at)) in f.input_sizes.iter().zip(&f.input_offsets).enumerate() {
+        for i in 0..n {
+            let s = g.symbol(&format!("{}.{}[{i}]", f.name, f.input_names[k]));
+            reg[at + i] = s;
+            inputs.push(s);
+        }
+    }
+    for (i, &v) in f.template.iter().enumerate() {
+        reg[f.template_start + i] = g.constant(v);
+    }
+    for ins in &f.tape {
+        let (a, b, c) = (ins.a as usize, ins.b as usize, ins.c as usize);
+        let v = match ins.op {
+            Op::Call => {
+                let call = &f.calls[ins.d as usize];
+                let args = call.args.iter().map(|&r| reg[r as usize]).collect();
+                let outs = g.call(&call.function, args);
+                for (q, o) in outs.into_iter().enumerate() {
+                    reg[call.out as usize + q] = o;
+                }
+                continue;
+            }
+            Op::Sym => reg[a],
+            Op::Interpolant => {
+                let t = g.table_id(&f.tables[c]);
+                g.interpolant(reg[a], t)
+            }
+            Op::IfElse => g.if_else(reg[a], reg[b], reg[c]),
+            op if op.arity() == 1 => g.unary(op, reg[a]),
+            op => g.binary(op, reg[a], reg[b]),
+        };
+        reg[ins.d as usize] = v;
+    }
+    let outputs = f
+        .output_sizes
+        .iter()
+        .zip(&f.output_offsets)
+        .flat_map(|(&n, &at)| at..at + n)
+        .map(|r| reg[r])
+        .collect();
+    (inputs, outputs)
+}
+
+/// The Jacobian function of `f`, built on first use (in `g`) and kept in `f`.
+pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>) -> Arc<CallJacobian> {
+    if let Some(j) = f.jacobian.get() {
+        return j.clone();
+    }
+    let (inputs, outputs) = instantiate(g, f);
+    let entries = crate::ad::jacobian_rows(g, &outputs, &inputs, false);
+    let (n_in, n_out) = (inputs.len(), outputs.len());
+    let mut by_input = vec![Vec::new(); n_in];
+    let mut by_output = vec![Vec::new(); n_out];
+    for (nz, &(k, j, _)) in entries.iter().enumerate() {
+        by_input[j].push((k as u32, nz as u32));
+        by_output[k].push((j as u32, nz as u32));
+    }
+    let values: Vec<Expr> = entries.iter().map(|e| Expr::from_id(e.2)).collect();
+    let syms: Vec<Expr> = inputs.iter().map(|&s| Expr::from_id(s)).collect();
+    let mut groups: Vec<&[Expr]> = Vec::new();
+    let mut rest = &syms[..];
+    for &n in &f.input_sizes {
+        let (head, tail) = rest.split_at(n);
+        groups.push(head);
+        rest = tail;
+    }
+    let mut jf = crate::compile::compile(g, &groups, &[&values])
+        .expect("a Jacobian depends only on the callee's inputs");
+    jf.name = format!("jac_{}", f.name);
+    jf.input_names = f.input_names.clone();
+    jf.output_names = vec!["jac".into()];
+    let jac = Arc::new(CallJacobian {
+        function: g.function_arc(&jf),
+        by_input,
+        by_output,
+    });
+    f.jacobian.get_or_init(|| jac).clone()
+}
