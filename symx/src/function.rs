@@ -211,6 +211,17 @@ impl Function {
         self.tape.len()
     }
 
+    /// Checks argument counts and lengths for `points` points.
+    pub(crate) fn check_batch(
+        &self,
+        inputs: &[&[f64]],
+        outputs: &[&mut [f64]],
+        work: &[f64],
+        points: usize,
+    ) -> Result<(), SymxError> {
+        self.check(inputs, outputs, work, points)
+    }
+
     fn check(
         &self,
         inputs: &[&[f64]],
