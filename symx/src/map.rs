@@ -2,13 +2,14 @@
 //! or split over threads with rayon.
 use crate::error::SymxError;
 use crate::function::Function;
+use std::sync::Arc;
 
 /// `n` evaluations of a function, each input and output holding the `n` points one after
 /// the other (the layout of [`Function::eval_batch`]).
 ///
 /// With [`Map::parallel`]`(t)`, the points are split into `t` contiguous chunks evaluated
-/// as rayon tasks in the current rayon pool (the global one unless the caller runs it
-/// inside `ThreadPool::install`), each chunk with its own part of the work vector. Every
+/// as tasks of a rayon pool of `t` threads owned by the map, each chunk with its own part
+/// of the work vector. Every
 /// point is computed by the same tape on the same numbers, so the results are
 /// bit-identical whatever the number of threads.
 ///
@@ -16,7 +17,7 @@ use crate::function::Function;
 /// use symx::{Function, Matrix};
 /// let x = Matrix::sym_vec("x", 2);
 /// let f = Function::new(&[&x], &[&[x[0] * x[1], x[0] + x[1]]]).unwrap();
-/// let map = f.map(3).parallel(2);
+/// let map = f.map(3).parallel(2).unwrap();
 /// let xs = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
 /// let mut ys = [0.0; 6];
 /// let mut work = vec![0.0; map.work_size()];
@@ -28,6 +29,7 @@ pub struct Map {
     function: Function,
     n: usize,
     chunks: usize,
+    pool: Option<Arc<rayon::ThreadPool>>,
 }
 
 impl Function {
@@ -37,15 +39,28 @@ impl Function {
             function: self.clone(),
             n,
             chunks: 1,
+            pool: None,
         }
     }
 }
 
 impl Map {
-    /// Splits the points over `threads` rayon tasks (1 or 0: serial).
-    pub fn parallel(mut self, threads: usize) -> Map {
+    /// Splits the points over `threads` threads of a rayon pool built here (1 or 0:
+    /// serial); `Err` if the operating system refuses the threads.
+    pub fn parallel(mut self, threads: usize) -> Result<Map, SymxError> {
         self.chunks = threads.clamp(1, self.n.max(1));
-        self
+        self.pool = if self.chunks > 1 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(self.chunks)
+                .build()
+                .map_err(|e| SymxError::Threads {
+                    message: e.to_string(),
+                })?;
+            Some(Arc::new(pool))
+        } else {
+            None
+        };
+        Ok(self)
     }
 
     /// Number of points.
@@ -85,9 +100,10 @@ impl Map {
                 got: work.len(),
             });
         }
-        if self.chunks == 1 {
-            return f.eval_batch(inputs, outputs, work, self.n);
-        }
+        let pool = match &self.pool {
+            Some(pool) => pool,
+            None => return f.eval_batch(inputs, outputs, work, self.n),
+        };
         // Validate all sizes once, with the serial entry point's checks.
         f.check_batch(inputs, outputs, work, self.n)?;
         let per = self.n.div_ceil(self.chunks);
@@ -102,7 +118,7 @@ impl Map {
             }
         }
         let w = f.work_size();
-        rayon::scope(|s| {
+        pool.scope(|s| {
             for ((c, mut outs), work) in out_parts
                 .into_iter()
                 .enumerate()

@@ -24,7 +24,7 @@ fn parallel_map_is_bit_identical_to_the_serial_batch() {
         f.eval_batch(&[&xs, &ps], &mut [&mut y_ref, &mut z_ref], &mut work, n)
             .unwrap();
         for threads in [1usize, 2, 3, 8] {
-            let map = f.map(n).parallel(threads);
+            let map = f.map(n).parallel(threads).unwrap();
             let (mut y, mut z) = (vec![f64::NAN; 3 * n], vec![f64::NAN; n]);
             let mut work = vec![0.0; map.work_size()];
             map.eval(&[&xs, &ps], &mut [&mut y, &mut z], &mut work)
@@ -42,7 +42,7 @@ fn parallel_map_is_bit_identical_to_the_serial_batch() {
 #[test]
 fn map_rejects_bad_sizes() {
     let f = function();
-    let map = f.map(4).parallel(2);
+    let map = f.map(4).parallel(2).unwrap();
     let mut work = vec![0.0; map.work_size()];
     let (mut y, mut z) = (vec![0.0; 12], vec![0.0; 4]);
     let xs = vec![0.0; 11];
