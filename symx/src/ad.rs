@@ -353,8 +353,15 @@ fn live_adjoint(s: &Sweep, o: u32) -> Option<u32> {
     (s.stamp[i] == s.current && s.dep[i] && t != NONE && t != ZERO).then_some(t)
 }
 
-/// Reverse sweep step at call node `v`: `x̄ⱼ += Σₖ ȳₖ Jₖⱼ` over the callee's Jacobian
-/// nonzeros (see `call.rs`).
+/// Reverse sweep step at call node `v` (see `call.rs`): `x̄ⱼ += Σₖ ȳₖ Jₖⱼ`.
+///
+/// * Constant adjoints (a Jacobian row's seed) or adjoints below a selection: the
+///   contraction is written out over the nonzeros of one call of the callee's Jacobian
+///   function (with guarded products below a selection); with unit seeds it is just the
+///   Jacobian's entries.
+/// * Other adjoints (e.g. multipliers in a Lagrangian gradient): one call of the callee's
+///   vector-Jacobian product, so that differentiating again (a Hessian) needs only that
+///   function's Jacobian, not the callee's whole second-derivative tensor.
 fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
     let site = &g.calls[g.nodes[v as usize].args[0] as usize];
     let (function, inputs) = (site.function.clone(), site.inputs.clone());
@@ -366,7 +373,22 @@ fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
         .outputs
         .iter()
         .any(|&o| s.stamp[o as usize] == s.current && s.gated[o as usize]);
+    let constant = adj.iter().flatten().all(|&t| g.value(t).is_some());
     let jac = crate::call::call_jacobian(g, &function);
+    if !gated && !constant {
+        let mut args = inputs.clone();
+        args.extend(adj.iter().map(|t| t.unwrap_or(ZERO)));
+        let xbar = g.call(&jac.vjp, args);
+        for (j, &a) in inputs.iter().enumerate() {
+            let reached = jac.by_input[j]
+                .iter()
+                .any(|&(k, _)| adj[k as usize].is_some());
+            if s.dep[a as usize] && reached {
+                accumulate(g, s, a, xbar[j], false);
+            }
+        }
+        return;
+    }
     let jout = g.call(&jac.function, inputs.clone());
     let mul = if gated { Op::StrongMul } else { Op::Mul };
     for (j, &a) in inputs.iter().enumerate() {

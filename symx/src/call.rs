@@ -40,11 +40,15 @@ pub(crate) struct CallInstr {
     pub out: u32,
 }
 
-/// The Jacobian function of a callee and its pattern.
+/// The Jacobian function of a callee, its pattern, and its vector-Jacobian product.
 #[derive(Debug)]
 pub(crate) struct CallJacobian {
     /// Same inputs as the callee; one output: the nonzeros, row by row.
     pub function: Arc<Function>,
+    /// `x̄ = Jᵀȳ`: the callee's inputs plus one input `ȳ` (one entry per output entry);
+    /// one output `x̄` (one entry per input entry). Its products are guarded (`ȳₖ ⊛ Jₖⱼ`),
+    /// so an adjoint that is exactly 0 never meets a NaN partial derivative.
+    pub vjp: Arc<Function>,
     /// For each input entry `j`: `(output entry k, nonzero index)` of column `j`.
     pub by_input: Vec<Vec<(u32, u32)>>,
     /// For each output entry `k`: `(input entry j, nonzero index)` of row `k`.
@@ -218,8 +222,36 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>) -> Arc<CallJacobia
     jf.name = format!("jac_{}", f.name);
     jf.input_names = f.input_names.clone();
     jf.output_names = vec!["jac".into()];
+    // The vector-Jacobian product, from the same nonzero expressions.
+    let ybar: Vec<u32> = (0..n_out)
+        .map(|k| g.symbol(&format!("{}.adj[{k}]", f.name)))
+        .collect();
+    let xbar: Vec<Expr> = by_input
+        .iter()
+        .map(|col| {
+            let terms = col
+                .iter()
+                .map(|&(k, nz)| g.binary(Op::StrongMul, ybar[k as usize], entries[nz as usize].2))
+                .collect();
+            Expr::from_id(crate::expr::balanced(
+                g,
+                Op::Add,
+                terms,
+                crate::simplify::ZERO,
+            ))
+        })
+        .collect();
+    let ybar: Vec<Expr> = ybar.into_iter().map(Expr::from_id).collect();
+    groups.push(&ybar);
+    let mut vf = crate::compile::compile(g, &groups, &[&xbar])
+        .expect("a vector-Jacobian product depends only on its inputs");
+    vf.name = format!("adj_{}", f.name);
+    vf.input_names = f.input_names.clone();
+    vf.input_names.push("adj".into());
+    vf.output_names = vec!["adj_in".into()];
     let jac = Arc::new(CallJacobian {
         function: g.function_arc(&jf),
+        vjp: g.function_arc(&vf),
         by_input,
         by_output,
     });
