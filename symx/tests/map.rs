@@ -67,3 +67,12 @@ fn map_rejects_bad_sizes() {
     ));
     assert_eq!((map.len(), map.is_empty()), (4, false));
 }
+
+/// Compiled functions (with their call and table data), maps and tables cross threads.
+#[test]
+fn compiled_objects_are_send_and_sync() {
+    const fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Function>();
+    assert_send_sync::<symx::Map>();
+    assert_send_sync::<symx::Interpolant>();
+}
