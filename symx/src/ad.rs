@@ -31,6 +31,9 @@ pub(crate) struct Sweep {
     value: Vec<u32>,
     /// Whether the node depends on a differentiation variable.
     dep: Vec<bool>,
+    /// Whether the node depends on any differentiation variable, also those beyond the
+    /// limit of a Hessian row (so that all rows choose the same callee Jacobian).
+    dep_all: Vec<bool>,
     /// Whether the node's adjoint may be an exact zero chosen by a branch.
     gated: Vec<bool>,
     /// Position of each differentiation variable, for variable nodes.
@@ -48,6 +51,7 @@ impl Sweep {
             current: 0,
             value: vec![NONE; n],
             dep: vec![false; n],
+            dep_all: vec![false; n],
             gated: vec![false; n],
             wrt_pos: vec![0; n],
             wrt_stamp: vec![0; n],
@@ -97,9 +101,15 @@ impl Sweep {
             let i = id as usize;
             self.value[i] = NONE;
             self.gated[i] = false;
-            self.dep[i] = match self.wrt_position(id) {
-                Some(p) => p < wrt_limit,
-                None => g.operands(id).iter().any(|&a| self.dep[a as usize]),
+            (self.dep[i], self.dep_all[i]) = match self.wrt_position(id) {
+                Some(p) => (p < wrt_limit, true),
+                None => {
+                    let ops = g.operands(id);
+                    (
+                        ops.iter().any(|&a| self.dep[a as usize]),
+                        ops.iter().any(|&a| self.dep_all[a as usize]),
+                    )
+                }
             };
         }
     }
@@ -374,7 +384,8 @@ fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
         .iter()
         .any(|&o| s.stamp[o as usize] == s.current && s.gated[o as usize]);
     let constant = adj.iter().flatten().all(|&t| g.value(t).is_some());
-    let jac = crate::call::call_jacobian(g, &function);
+    let wrt: Vec<bool> = inputs.iter().map(|&a| s.dep_all[a as usize]).collect();
+    let jac = crate::call::call_jacobian(g, &function, &wrt);
     if !gated && !constant {
         let mut args = inputs.clone();
         args.extend(adj.iter().map(|t| t.unwrap_or(ZERO)));
@@ -428,7 +439,8 @@ fn forward_call(g: &mut Graph, s: &mut Sweep, v: u32) {
     if tangents.iter().all(|&t| t == ZERO) {
         return;
     }
-    let jac = crate::call::call_jacobian(g, &function);
+    let wrt: Vec<bool> = tangents.iter().map(|&t| t != ZERO).collect();
+    let jac = crate::call::call_jacobian(g, &function, &wrt);
     let jout = g.call(&jac.function, inputs);
     for (k, &o) in outputs.iter().enumerate() {
         if s.stamp[o as usize] != s.current {
@@ -594,6 +606,27 @@ pub fn reverse(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
         reverse_pass(g, &mut s);
         wrt.iter().map(|&w| Expr::from_id(adjoint(&s, w))).collect()
     }))
+}
+
+/// `Σᵢ seedᵢ ∂outputᵢ/∂inputⱼ` for symbol nodes `inputs`, with every product guarded
+/// (`0 ⊛ NaN = 0`): the body of a callee's vector-Jacobian-product function, whose seeds
+/// are exactly 0 for outputs the caller does not use.
+pub(crate) fn guarded_vjp(
+    g: &mut Graph,
+    outputs: &[u32],
+    inputs: &[u32],
+    seeds: &[u32],
+) -> Vec<u32> {
+    let mut s = Sweep::new(g.len());
+    s.set_wrt(inputs);
+    s.collect(g, outputs, u32::MAX);
+    for (&o, &seed) in outputs.iter().zip(seeds) {
+        if s.dep[o as usize] {
+            accumulate(g, &mut s, o, seed, true);
+        }
+    }
+    reverse_pass(g, &mut s);
+    inputs.iter().map(|&w| adjoint(&s, w)).collect()
 }
 
 fn adjoint(s: &Sweep, w: u32) -> u32 {

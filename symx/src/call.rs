@@ -23,6 +23,9 @@ use crate::graph::{self, Graph, Node};
 use crate::op::Op;
 use std::sync::Arc;
 
+/// Jacobian functions of one callee, by the input entries differentiated.
+pub(crate) type JacobianCache = rustc_hash::FxHashMap<Vec<bool>, Arc<CallJacobian>>;
+
 /// One call in the graph.
 pub(crate) struct CallSite {
     pub function: Arc<Function>,
@@ -46,8 +49,9 @@ pub(crate) struct CallJacobian {
     /// Same inputs as the callee; one output: the nonzeros, row by row.
     pub function: Arc<Function>,
     /// `x̄ = Jᵀȳ`: the callee's inputs plus one input `ȳ` (one entry per output entry);
-    /// one output `x̄` (one entry per input entry). Its products are guarded (`ȳₖ ⊛ Jₖⱼ`),
-    /// so an adjoint that is exactly 0 never meets a NaN partial derivative.
+    /// one output `x̄` (one entry per input entry), built by one reverse sweep whose
+    /// products are all guarded (`0 ⊛ NaN = 0`), so an adjoint that is exactly 0 never
+    /// meets a NaN partial derivative.
     pub vjp: Arc<Function>,
     /// For each input entry `j`: `(output entry k, nonzero index)` of column `j`.
     pub by_input: Vec<Vec<(u32, u32)>>,
@@ -194,17 +198,25 @@ fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
     (inputs, outputs)
 }
 
-/// The Jacobian function of `f`, built on first use (in `g`) and kept in `f`.
-pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>) -> Arc<CallJacobian> {
-    if let Some(j) = f.jacobian.get() {
+/// The Jacobian function of `f` with respect to the input entries where `wrt` is true
+/// (the other columns are left out, and the vector-Jacobian product gives 0 for them),
+/// built on first use (in `g`) and kept in `f` for that choice of columns.
+pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> Arc<CallJacobian> {
+    fn cache(f: &Function) -> std::sync::MutexGuard<'_, JacobianCache> {
+        f.jacobians.lock().unwrap_or_else(|e| e.into_inner())
+    }
+    if let Some(j) = cache(f).get(wrt) {
         return j.clone();
     }
     let (inputs, outputs) = instantiate(g, f);
-    let entries = crate::ad::jacobian_rows(g, &outputs, &inputs, false);
+    let columns: Vec<usize> = (0..inputs.len()).filter(|&j| wrt[j]).collect();
+    let wrt_syms: Vec<u32> = columns.iter().map(|&j| inputs[j]).collect();
+    let entries = crate::ad::jacobian_rows(g, &outputs, &wrt_syms, false);
     let (n_in, n_out) = (inputs.len(), outputs.len());
     let mut by_input = vec![Vec::new(); n_in];
     let mut by_output = vec![Vec::new(); n_out];
-    for (nz, &(k, j, _)) in entries.iter().enumerate() {
+    for (nz, &(k, c, _)) in entries.iter().enumerate() {
+        let j = columns[c];
         by_input[j].push((k as u32, nz as u32));
         by_output[k].push((j as u32, nz as u32));
     }
@@ -222,25 +234,17 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>) -> Arc<CallJacobia
     jf.name = format!("jac_{}", f.name);
     jf.input_names = f.input_names.clone();
     jf.output_names = vec!["jac".into()];
-    // The vector-Jacobian product, from the same nonzero expressions.
+    // The vector-Jacobian product: one guarded reverse sweep with symbolic seeds.
     let ybar: Vec<u32> = (0..n_out)
         .map(|k| g.symbol(&format!("{}.adj[{k}]", f.name)))
         .collect();
-    let xbar: Vec<Expr> = by_input
+    let mut xbar = vec![Expr::zero(); n_in];
+    for (&j, d) in columns
         .iter()
-        .map(|col| {
-            let terms = col
-                .iter()
-                .map(|&(k, nz)| g.binary(Op::StrongMul, ybar[k as usize], entries[nz as usize].2))
-                .collect();
-            Expr::from_id(crate::expr::balanced(
-                g,
-                Op::Add,
-                terms,
-                crate::simplify::ZERO,
-            ))
-        })
-        .collect();
+        .zip(crate::ad::guarded_vjp(g, &outputs, &wrt_syms, &ybar))
+    {
+        xbar[j] = Expr::from_id(d);
+    }
     let ybar: Vec<Expr> = ybar.into_iter().map(Expr::from_id).collect();
     groups.push(&ybar);
     let mut vf = crate::compile::compile(g, &groups, &[&xbar])
@@ -255,5 +259,5 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>) -> Arc<CallJacobia
         by_input,
         by_output,
     });
-    f.jacobian.get_or_init(|| jac).clone()
+    cache(f).entry(wrt.to_vec()).or_insert(jac).clone()
 }

@@ -226,7 +226,7 @@ pub(crate) fn compile(
         calls: ext.calls,
         call_scratch,
         dependencies: OnceLock::new(),
-        jacobian: OnceLock::new(),
+        jacobians: Default::default(),
     })
 }
 

@@ -24,7 +24,7 @@
 //! work vector laid out as the callee's own work vector, runs the callee's tape there and
 //! scatters the callee's outputs into a block of registers of its own. The callee is
 //! shared (`Arc`), not copied, and the evaluation still allocates nothing.
-use crate::call::{CallInstr, CallJacobian};
+use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::graph;
@@ -32,7 +32,7 @@ use crate::interpolant::Table;
 use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
 /// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`;
@@ -88,8 +88,9 @@ pub struct Function {
     pub(crate) call_scratch: usize,
     /// For each output entry (outputs stacked), the input entries (stacked) it depends on.
     pub(crate) dependencies: OnceLock<Arc<Vec<Vec<u32>>>>,
-    /// The Jacobian function used to differentiate calls of this function, once built.
-    pub(crate) jacobian: OnceLock<Arc<CallJacobian>>,
+    /// The Jacobian functions used to differentiate calls of this function, by the set
+    /// of input entries differentiated (built on first use; shared by clones).
+    pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
 }
 
 /// A fresh function identity.
@@ -220,6 +221,17 @@ impl Function {
         points: usize,
     ) -> Result<(), SymxError> {
         self.check(inputs, outputs, work, points)
+    }
+
+    /// Number of instructions one evaluation executes: this tape's, plus those of every
+    /// called function's tape per call (a measure of evaluation work).
+    pub fn executed_instruction_count(&self) -> usize {
+        self.tape.len()
+            + self
+                .calls
+                .iter()
+                .map(|c| c.function.executed_instruction_count())
+                .sum::<usize>()
     }
 
     fn check(
