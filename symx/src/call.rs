@@ -5,17 +5,27 @@
 //! nodes) are one call, as every node is hash-consed. The callee is shared by reference,
 //! so an optimal-control problem of N stages holds its dynamics once.
 //!
-//! Derivatives go through the callee's **Jacobian function** (CasADi's `jac_f`): a
-//! compiled function of the same inputs whose single output holds the structural nonzeros
-//! of `∂(outputs)/∂(inputs)`, built once per callee from its tape and kept in it. A reverse
-//! sweep reaching a call turns the adjoints `ȳ` of its outputs into `x̄ⱼ = Σₖ ȳₖ Jₖⱼ` over
-//! the nonzeros only, where `J` are the outputs of one call of the Jacobian function on the
-//! same arguments (shared by all sweeps, so a Jacobian or Hessian evaluates it once per
-//! call site); a forward sweep computes `ẏₖ = Σⱼ Jₖⱼ ẋⱼ`. The Jacobian function is itself a
-//! `Function`, so second derivatives (Hessians) call the Jacobian's Jacobian, and so on:
-//! sparsity stays exact at every order, and the branch-safety rule for `if_else` holds
-//! inside the callee (its Jacobian is built by the same sweeps) and outside (products
-//! below a selection use the guarded product).
+//! Derivatives go through two derived functions of the callee, built once from its tape
+//! for each set of differentiated argument entries and kept in it (shared by clones):
+//! * its **Jacobian function** (CasADi's `jac_f`): the callee's inputs, one output holding
+//!   the structural nonzeros of `∂(outputs)/∂(inputs)`. A forward sweep reaching a call
+//!   computes `ẏₖ = Σⱼ Jₖⱼ ẋⱼ`; a reverse sweep whose adjoints are constants (a Jacobian
+//!   row's seed) or lie below a selection computes `x̄ⱼ = Σₖ ȳₖ Jₖⱼ` (guarded products
+//!   below a selection), over the nonzeros only, from one call of the Jacobian function on
+//!   the same arguments (shared by all sweeps, so a Jacobian evaluates it once per call
+//!   site, and with unit seeds its entries are the Jacobian's entries);
+//! * its **vector-Jacobian product** `x̄ = Jᵀȳ` (one reverse sweep of the callee with
+//!   symbolic seeds, every product guarded so an exactly-zero adjoint never meets a NaN
+//!   partial): used by reverse sweeps with other adjoints, e.g. the multipliers of a
+//!   Lagrangian gradient. Differentiating that gradient again (a Hessian) then needs only
+//!   the Jacobian of the vector-Jacobian product — the multiplier-weighted second
+//!   derivatives, reverse over reverse — not the callee's whole second-derivative tensor.
+//!
+//! Both are `Function`s called through call nodes, so derivatives of any order work the
+//! same way. Sparsity stays exact (the Jacobian function has the structural pattern; a
+//! vector-Jacobian product is used only for the arguments its active outputs reach), and
+//! the `if_else` rule holds inside the callee (its derivative functions are built by the
+//! same sweeps) and around the call.
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::function::Function;
