@@ -329,3 +329,22 @@ fn bad_calls_are_errors() {
         Err(SymxError::DuplicateName { what: "input", .. })
     ));
 }
+
+/// An output the caller does not use may have NaN derivatives at the point (`√x` at
+/// x < 0); its zero adjoint must not turn them into NaN in a multiplier-weighted gradient
+/// (the vector-Jacobian-product path) or in the Hessian built from it.
+#[test]
+fn unused_outputs_with_nan_derivatives_do_not_leak() {
+    let x = Expr::sym("x");
+    let f = Function::new(&[&[x]], &[&[x.sqrt(), x.sq() * x]]).unwrap();
+    let z = Expr::sym("z");
+    let lambda = Expr::sym("lambda");
+    let y = f.apply(&[&[z]]).unwrap().remove(0);
+    let l = lambda * y[1];
+    let g = gradient(l, &[z]).unwrap();
+    let h = hessian(l, &[z]).unwrap();
+    let fun = Function::new(&[&[z], &[lambda]], &[&g, h.values()]).unwrap();
+    let out = fun.call(&[&[-2.0], &[0.5]]).unwrap();
+    // ∂(λz³)/∂z = 3λz² = 6, ∂² = 6λz = −6.
+    assert_eq!(out, vec![vec![6.0], vec![-6.0]]);
+}
