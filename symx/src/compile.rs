@@ -149,6 +149,7 @@ pub(crate) fn compile(
     let mut template = constants;
     let mut output_offsets = Vec::with_capacity(outputs.len());
     let mut copies: Vec<Instr> = Vec::new();
+    let mut call_copies: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     let mut pinned = vec![false; loc.register.len()];
     let mut slot = outputs_start;
     for y in outputs {
@@ -163,9 +164,12 @@ pub(crate) fn compile(
                 pinned[l] = true;
                 loc.register[l] = slot as u32;
                 template.push(0.0);
+            } else if node.op == Op::CallOutput {
+                // A call's output: copied to its slot right after the call.
+                template.push(0.0);
+                call_copies.entry(e.id).or_default().push(slot as u32);
             } else {
-                // An input, a call's output or a node already written to another slot:
-                // copy at the end.
+                // An input or a node already written to another slot: copy at the end.
                 template.push(0.0);
                 if node.op == Op::Sym {
                     input_used[input_of[&e.id]] = true;
@@ -195,9 +199,13 @@ pub(crate) fn compile(
 
     let temp_start = slot as u32;
     let mut ext = Externals::default();
-    let (mut tape, work_size) = allocate(
-        g, &steps, &mut loc, &pinned, &last_use, temp_start, &mut ext,
-    );
+    let plan = Plan {
+        pinned: &pinned,
+        last_use: &last_use,
+        call_copies: &call_copies,
+        temp_start,
+    };
+    let (mut tape, work_size) = allocate(g, &steps, &mut loc, &plan, &mut ext);
     for mut copy in copies {
         let r = loc.register[loc.local(copy.a)];
         // All operand fields name the source, so that readers of `b` see it too.
@@ -230,25 +238,51 @@ pub(crate) fn compile(
     })
 }
 
+/// What register allocation needs to know about the nodes (by local index).
+struct Plan<'a> {
+    /// Nodes computed straight into their output slot.
+    pinned: &'a [bool],
+    /// Last step reading each node (`usize::MAX`: none).
+    last_use: &'a [usize],
+    /// Output slots of call outputs that are outputs of the function, by node.
+    call_copies: &'a FxHashMap<u32, Vec<u32>>,
+    /// First register after the output slots.
+    temp_start: u32,
+}
+
 /// Emits the instructions of `steps` with registers for temporaries allocated after
-/// `temp_start` and reused after their last use. A call gets a block of registers of its
-/// own for its outputs (never reused); its output nodes are names for those registers and
-/// emit nothing. Returns the tape and the number of registers used.
+/// `temp_start` and reused after their last use. A call gets a block of registers for its
+/// outputs (its output nodes are names for those registers and emit nothing); the block is
+/// reused by a later call with as many outputs once no step reads the outputs any more.
+/// Returns the tape and the number of registers used.
 fn allocate(
     g: &Graph,
     steps: &[u32],
     loc: &mut Locals,
-    pinned: &[bool],
-    last_use: &[usize],
-    temp_start: u32,
+    plan: &Plan,
     ext: &mut Externals,
 ) -> (Vec<Instr>, u32) {
+    let Plan {
+        pinned,
+        last_use,
+        call_copies,
+        temp_start,
+    } = *plan;
     let mut free: Vec<u32> = Vec::new();
     let mut work_size = temp_start;
     let mut tape = Vec::with_capacity(steps.len());
-    // Registers inside call blocks are never put on the free list.
+    // Registers inside call blocks are never put on the scalar free list; whole blocks
+    // are freed after their last reader (`block_ends[s]`: blocks whose last reader is
+    // step s) into free lists by size.
     let freeable = |g: &Graph, id: u32| !matches!(g.node(id).op, Op::Call | Op::CallOutput);
+    let mut block_ends: Vec<Vec<(u32, u32)>> = vec![Vec::new(); steps.len()];
+    let mut free_blocks: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for (s, &id) in steps.iter().enumerate() {
+        if s > 0 {
+            for (block, size) in std::mem::take(&mut block_ends[s - 1]) {
+                free_blocks.entry(size).or_default().push(block);
+            }
+        }
         let node = g.node(id);
         let l = loc.local(id);
         match node.op {
@@ -274,8 +308,27 @@ fn allocate(
                 dying.sort_unstable();
                 dying.dedup();
                 free.extend(dying);
-                let block = work_size;
-                work_size += site.outputs.len() as u32;
+                let size = site.outputs.len() as u32;
+                let block = match free_blocks.get_mut(&size).and_then(Vec::pop) {
+                    Some(b) => b,
+                    None => {
+                        work_size += size;
+                        work_size - size
+                    }
+                };
+                // The last step reading any output (outputs of the function are copied
+                // right after the call, so they do not keep the block).
+                let end = site
+                    .outputs
+                    .iter()
+                    .filter(|&&o| loc.is_seen(o))
+                    .map(|&o| match last_use[loc.local(o)] {
+                        usize::MAX => s,
+                        e => e,
+                    })
+                    .max()
+                    .unwrap_or(s);
+                block_ends[end].push((block, size));
                 loc.register[l] = block;
                 tape.push(Instr {
                     op: Op::Call,
@@ -289,6 +342,19 @@ fn allocate(
                     args,
                     out: block,
                 });
+                // Outputs of the function that are outputs of this call.
+                for (k, o) in site.outputs.iter().enumerate() {
+                    for &slot in call_copies.get(o).into_iter().flatten() {
+                        let r = block + k as u32;
+                        tape.push(Instr {
+                            op: Op::Sym,
+                            d: slot,
+                            a: r,
+                            b: r,
+                            c: r,
+                        });
+                    }
+                }
                 continue;
             }
             _ => {}

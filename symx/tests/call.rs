@@ -348,3 +348,40 @@ fn unused_outputs_with_nan_derivatives_do_not_leak() {
     // ∂(λz³)/∂z = 3λz² = 6, ∂² = 6λz = −6.
     assert_eq!(out, vec![vec![6.0], vec![-6.0]]);
 }
+
+/// Call output registers are reused by later calls once no step reads them; outputs of
+/// every stage that are also read by the next stage (and copied out at the end) must
+/// survive. Compared with the same chain inlined.
+#[test]
+fn call_output_blocks_are_reused_safely() {
+    let x = Matrix::sym_vec("x", 3);
+    let u = Matrix::sym_vec("u", 1);
+    let step = Function::new(&[&x, &u], &[&rk4(&ode, &x, &u, 0.1)]).unwrap();
+    let w = Matrix::sym_vec("w", 3 + 8);
+    let (mut s, mut r) = (w[..3].to_vec(), w[..3].to_vec());
+    let (mut with_calls, mut inlined) = (Vec::new(), Vec::new());
+    for k in 0..8 {
+        s = step.apply(&[&s, &[w[3 + k]]]).unwrap().remove(0);
+        r = rk4(&ode, &r, &[w[3 + k]], 0.1);
+        // Raw call outputs as function outputs, plus arithmetic reading them.
+        with_calls.extend_from_slice(&s);
+        with_calls.push(s[0] * s[2]);
+        inlined.extend_from_slice(&r);
+        inlined.push(r[0] * r[2]);
+    }
+    let fc = Function::new(&[&w], &[&with_calls]).unwrap();
+    let p = point(11);
+    let c = fc.call(&[&p]).unwrap();
+    let i = eval(&w, &[&inlined], &p);
+    assert_close("chain outputs", &c[0], &i[0], SAME_MATH);
+    // And the gradient, whose tape reuses the blocks of the Jacobian calls.
+    let g = gradient(with_calls.iter().copied().sum(), &w).unwrap();
+    let fg = Function::new(&[&w], &[&g]).unwrap();
+    let gi = gradient(inlined.iter().copied().sum(), &w).unwrap();
+    assert_close(
+        "gradient",
+        &fg.call(&[&p]).unwrap()[0],
+        &eval(&w, &[&gi], &p)[0],
+        SAME_MATH,
+    );
+}
