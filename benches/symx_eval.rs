@@ -18,6 +18,17 @@
 //! triangle of ∇²(σf + λᵀg) (σ, λ symbolic) and the three `Function`s, taken directly on
 //! `problem.objective()`, `problem.constraint_expressions()` and `problem.variables()`;
 //! evaluation at the problem's initial point with σ = 1, λᵢ = (i+1)/m.
+//!
+//! `ocp_chain_inlined` and `ocp_chain_calls` (`cargo bench --bench symx_eval -- ocp_chain`):
+//! the same quantities on the quadrotor OCP of benches/common/quadrotor_ocp.rs (12 states,
+//! 4 controls, N = 1000 stages, RK4, multiple shooting), with the RK4 step written out at
+//! every stage or compiled once and called (call nodes); the build phase includes compiling
+//! the step function, and its derivative functions are built inside the derivative phases.
+//! benches/reference/ocp_chain_casadi.py does the same with CasADi SX (inlined). Graph
+//! sizes (nodes) and tape sizes are printed first: the memory comparison.
+//!
+//! `map` (`cargo bench --bench symx_eval -- map`): 10 000 evaluations of the RK4 step F
+//! with `Function::map`, serial and on 2 threads.
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use gap_crossing::model::{self, Formulation, Model};
 use gap_crossing::scenario::Scenario;
@@ -29,6 +40,8 @@ use symx::{gradient, jacobian, lagrangian_hessian, Expr, Function, Matrix, Spars
 
 #[path = "common/hanging_chain.rs"]
 mod hanging_chain;
+#[path = "common/quadrotor_ocp.rs"]
+mod quadrotor_ocp;
 
 const LINKS: usize = 1000;
 
@@ -318,5 +331,70 @@ fn bench_gap(c: &mut Criterion) {
     );
 }
 
-criterion_group!(benches, bench, bench_gap);
+const OCP_STAGES: usize = 1000;
+
+fn ocp_symbolic(calls: bool) -> Symbolic {
+    let o = quadrotor_ocp::build(OCP_STAGES, calls);
+    Symbolic {
+        f: o.f,
+        g: o.g,
+        x: o.w,
+    }
+}
+
+fn bench_ocp(c: &mut Criterion) {
+    for (calls, group) in [(false, "ocp_chain_inlined"), (true, "ocp_chain_calls")] {
+        // Built on a fresh thread so that the node count is this problem's alone.
+        let (fns, nodes) = std::thread::spawn(move || {
+            let fns = compile(&differentiate(ocp_symbolic(calls)));
+            (fns, symx::node_count())
+        })
+        .join()
+        .unwrap();
+        eprintln!("{group}: graph after build + derivatives + compile: {nodes} nodes");
+        let m = (OCP_STAGES + 1) * quadrotor_ocp::NX;
+        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(OCP_STAGES));
+        measure(
+            c,
+            group,
+            &fns,
+            [&x, &sigma, &lambda],
+            "build",
+            Duration::from_secs(20),
+            move || setup_phases(move || ocp_symbolic(calls)),
+        );
+    }
+}
+
+fn bench_map(c: &mut Criterion) {
+    const COPIES: usize = 10_000;
+    let f = quadrotor_ocp::step_function();
+    let (nx, nu) = (quadrotor_ocp::NX, quadrotor_ocp::NU);
+    let p = quadrotor_ocp::point(COPIES);
+    let xs: Vec<f64> = (0..COPIES)
+        .flat_map(|k| p[k * (nx + nu)..k * (nx + nu) + nx].to_vec())
+        .collect();
+    let us: Vec<f64> = (0..COPIES)
+        .flat_map(|k| p[k * (nx + nu) + nx..(k + 1) * (nx + nu)].to_vec())
+        .collect();
+    let mut g = c.benchmark_group("map");
+    g.sample_size(20)
+        .measurement_time(Duration::from_secs(3))
+        .warm_up_time(Duration::from_secs(1));
+    for threads in [1usize, 2] {
+        let map = f.map(COPIES).parallel(threads).unwrap();
+        let mut out = vec![0.0; COPIES * nx];
+        let mut work = vec![0.0; map.work_size()];
+        g.bench_function(BenchmarkId::new("rk4_step_10000", threads), |b| {
+            b.iter(|| {
+                map.eval(black_box(&[&xs, &us]), &mut [&mut out], &mut work)
+                    .unwrap();
+                black_box(&out);
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_gap, bench_ocp, bench_map);
 criterion_main!(benches);

@@ -31,6 +31,9 @@ pub(crate) struct Sweep {
     value: Vec<u32>,
     /// Whether the node depends on a differentiation variable.
     dep: Vec<bool>,
+    /// Whether the node depends on any differentiation variable, also those beyond the
+    /// limit of a Hessian row (so that all rows choose the same callee Jacobian).
+    dep_all: Vec<bool>,
     /// Whether the node's adjoint may be an exact zero chosen by a branch.
     gated: Vec<bool>,
     /// Position of each differentiation variable, for variable nodes.
@@ -48,6 +51,7 @@ impl Sweep {
             current: 0,
             value: vec![NONE; n],
             dep: vec![false; n],
+            dep_all: vec![false; n],
             gated: vec![false; n],
             wrt_pos: vec![0; n],
             wrt_stamp: vec![0; n],
@@ -85,7 +89,7 @@ impl Sweep {
         }
         while let Some(id) = self.stack.pop() {
             self.cone.push(id);
-            for &a in g.nodes[id as usize].operands() {
+            for &a in g.operands(id) {
                 if self.stamp[a as usize] != self.current {
                     self.stamp[a as usize] = self.current;
                     self.stack.push(a);
@@ -97,9 +101,15 @@ impl Sweep {
             let i = id as usize;
             self.value[i] = NONE;
             self.gated[i] = false;
-            self.dep[i] = match self.wrt_position(id) {
-                Some(p) => p < wrt_limit,
-                None => g.nodes[i].operands().iter().any(|&a| self.dep[a as usize]),
+            (self.dep[i], self.dep_all[i]) = match self.wrt_position(id) {
+                Some(p) => (p < wrt_limit, true),
+                None => {
+                    let ops = g.operands(id);
+                    (
+                        ops.iter().any(|&a| self.dep[a as usize]),
+                        ops.iter().any(|&a| self.dep_all[a as usize]),
+                    )
+                }
             };
         }
     }
@@ -155,6 +165,49 @@ fn partial(g: &mut Graph, y: u32, k: usize) -> u32 {
             g.binary(Op::Sub, ONE, y2)
         }
         Op::Abs => g.unary(Op::Sign, a),
+        Op::Erf => {
+            // 2/√π · exp(−a²)
+            let a2 = g.unary(Op::Sq, a);
+            let m = g.unary(Op::Neg, a2);
+            let e = g.unary(Op::Exp, m);
+            let c = g.constant(std::f64::consts::FRAC_2_SQRT_PI);
+            g.binary(Op::Mul, c, e)
+        }
+        Op::Asinh | Op::Acosh => {
+            // 1/√(a² ± 1)
+            let a2 = g.unary(Op::Sq, a);
+            let r = if n.op == Op::Asinh {
+                g.binary(Op::Add, a2, ONE)
+            } else {
+                g.binary(Op::Sub, a2, ONE)
+            };
+            let r = g.unary(Op::Sqrt, r);
+            g.binary(Op::Div, ONE, r)
+        }
+        Op::Atanh => {
+            let a2 = g.unary(Op::Sq, a);
+            let d = g.binary(Op::Sub, ONE, a2);
+            g.binary(Op::Div, ONE, d)
+        }
+        Op::Log1p => {
+            let d = g.binary(Op::Add, ONE, a);
+            g.binary(Op::Div, ONE, d)
+        }
+        Op::Expm1 => g.binary(Op::Add, y, ONE),
+        Op::Fmod => {
+            if k == 0 {
+                ONE
+            } else {
+                // fmod(a,b) = a − trunc(a/b)·b, so ∂/∂b = −trunc(a/b) = (y − a)/b (CasADi's form).
+                let r = g.binary(Op::Sub, y, a);
+                g.binary(Op::Div, r, b)
+            }
+        }
+        Op::Hypot => g.binary(Op::Div, if k == 0 { a } else { b }, y),
+        Op::Interpolant => {
+            let d = g.derivative_table(b);
+            g.interpolant(a, d)
+        }
         Op::Add => ONE,
         Op::Sub => {
             if k == 0 {
@@ -236,6 +289,12 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
     for idx in (0..s.cone.len()).rev() {
         let v = s.cone[idx];
         let vi = v as usize;
+        if g.nodes[vi].op == Op::Call {
+            if s.dep[vi] {
+                reverse_call(g, s, v);
+            }
+            continue;
+        }
         let adj = s.value[vi];
         if adj == NONE || !s.dep[vi] || adj == ZERO {
             continue;
@@ -280,6 +339,8 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
                     accumulate(g, s, b, c, true);
                 }
             }
+            // The call node gathers the adjoints of its outputs.
+            Op::CallOutput => {}
             op if op.has_zero_derivative() => {}
             _ => {
                 for k in 0..n.op.arity() {
@@ -293,6 +354,104 @@ fn reverse_pass(g: &mut Graph, s: &mut Sweep) {
                 }
             }
         }
+    }
+}
+
+/// The adjoint of node `o` in the current sweep, if it has a non-zero one.
+fn live_adjoint(s: &Sweep, o: u32) -> Option<u32> {
+    let (i, t) = (o as usize, s.value[o as usize]);
+    (s.stamp[i] == s.current && s.dep[i] && t != NONE && t != ZERO).then_some(t)
+}
+
+/// Reverse sweep step at call node `v` (see `call.rs`): `x̄ⱼ += Σₖ ȳₖ Jₖⱼ`.
+///
+/// * Constant adjoints (a Jacobian row's seed) or adjoints below a selection: the
+///   contraction is written out over the nonzeros of one call of the callee's Jacobian
+///   function (with guarded products below a selection); with unit seeds it is just the
+///   Jacobian's entries.
+/// * Other adjoints (e.g. multipliers in a Lagrangian gradient): one call of the callee's
+///   vector-Jacobian product, so that differentiating again (a Hessian) needs only that
+///   function's Jacobian, not the callee's whole second-derivative tensor.
+fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
+    let site = &g.calls[g.nodes[v as usize].args[0] as usize];
+    let (function, inputs) = (site.function.clone(), site.inputs.clone());
+    let adj: Vec<Option<u32>> = site.outputs.iter().map(|&o| live_adjoint(s, o)).collect();
+    if adj.iter().all(Option::is_none) {
+        return;
+    }
+    let gated = site
+        .outputs
+        .iter()
+        .any(|&o| s.stamp[o as usize] == s.current && s.gated[o as usize]);
+    let constant = adj.iter().flatten().all(|&t| g.value(t).is_some());
+    let wrt: Vec<bool> = inputs.iter().map(|&a| s.dep_all[a as usize]).collect();
+    let jac = crate::call::call_jacobian(g, &function, &wrt);
+    if !gated && !constant {
+        let mut args = inputs.clone();
+        args.extend(adj.iter().map(|t| t.unwrap_or(ZERO)));
+        let xbar = g.call(&jac.vjp, args);
+        for (j, &a) in inputs.iter().enumerate() {
+            let reached = jac.by_input[j]
+                .iter()
+                .any(|&(k, _)| adj[k as usize].is_some());
+            if s.dep[a as usize] && reached {
+                accumulate(g, s, a, xbar[j], false);
+            }
+        }
+        return;
+    }
+    let jout = g.call(&jac.function, inputs.clone());
+    let mul = if gated { Op::StrongMul } else { Op::Mul };
+    for (j, &a) in inputs.iter().enumerate() {
+        if !s.dep[a as usize] {
+            continue;
+        }
+        let terms: Vec<u32> = jac.by_input[j]
+            .iter()
+            .filter_map(|&(k, nz)| adj[k as usize].map(|t| g.binary(mul, t, jout[nz as usize])))
+            .collect();
+        if !terms.is_empty() {
+            let c = balanced(g, Op::Add, terms, ZERO);
+            accumulate(g, s, a, c, gated);
+        }
+    }
+}
+
+/// Forward sweep step at call node `v`: `ẏₖ = Σⱼ Jₖⱼ ẋⱼ`, written to the output nodes.
+fn forward_call(g: &mut Graph, s: &mut Sweep, v: u32) {
+    let site = &g.calls[g.nodes[v as usize].args[0] as usize];
+    let (function, inputs, outputs) = (
+        site.function.clone(),
+        site.inputs.clone(),
+        site.outputs.clone(),
+    );
+    let tangents: Vec<u32> = inputs
+        .iter()
+        .map(|&a| {
+            let t = s.value[a as usize];
+            if s.dep[a as usize] && t != NONE {
+                t
+            } else {
+                ZERO
+            }
+        })
+        .collect();
+    if tangents.iter().all(|&t| t == ZERO) {
+        return;
+    }
+    let wrt: Vec<bool> = tangents.iter().map(|&t| t != ZERO).collect();
+    let jac = crate::call::call_jacobian(g, &function, &wrt);
+    let jout = g.call(&jac.function, inputs);
+    for (k, &o) in outputs.iter().enumerate() {
+        if s.stamp[o as usize] != s.current {
+            continue;
+        }
+        let terms: Vec<u32> = jac.by_output[k]
+            .iter()
+            .filter(|&&(j, _)| tangents[j as usize] != ZERO)
+            .map(|&(j, nz)| g.binary(Op::Mul, jout[nz as usize], tangents[j as usize]))
+            .collect();
+        s.value[o as usize] = balanced(g, Op::Add, terms, ZERO);
     }
 }
 
@@ -315,6 +474,12 @@ fn forward_pass(g: &mut Graph, s: &mut Sweep) {
         };
         s.value[vi] = match n.op {
             Op::Sym | Op::Const => ZERO,
+            Op::Call => {
+                forward_call(g, s, v);
+                ZERO
+            }
+            // (Set by its call when it has a tangent.)
+            Op::CallOutput => ZERO,
             Op::IfElse | Op::Min | Op::Max => {
                 let (first, second) = if n.op == Op::IfElse {
                     (n.args[1], n.args[2])
@@ -443,6 +608,27 @@ pub fn reverse(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
     }))
 }
 
+/// `Σᵢ seedᵢ ∂outputᵢ/∂inputⱼ` for symbol nodes `inputs`, with every product guarded
+/// (`0 ⊛ NaN = 0`): the body of a callee's vector-Jacobian-product function, whose seeds
+/// are exactly 0 for outputs the caller does not use.
+pub(crate) fn guarded_vjp(
+    g: &mut Graph,
+    outputs: &[u32],
+    inputs: &[u32],
+    seeds: &[u32],
+) -> Vec<u32> {
+    let mut s = Sweep::new(g.len());
+    s.set_wrt(inputs);
+    s.collect(g, outputs, u32::MAX);
+    for (&o, &seed) in outputs.iter().zip(seeds) {
+        if s.dep[o as usize] {
+            accumulate(g, &mut s, o, seed, true);
+        }
+    }
+    reverse_pass(g, &mut s);
+    inputs.iter().map(|&w| adjoint(&s, w)).collect()
+}
+
 fn adjoint(s: &Sweep, w: u32) -> u32 {
     if s.stamp[w as usize] == s.current && s.value[w as usize] != NONE {
         s.value[w as usize]
@@ -466,7 +652,7 @@ pub fn gradient(f: Expr, inputs: &[Expr]) -> Result<Vec<Expr>, SymxError> {
 
 /// Rows of a Jacobian as `(column, expression)` lists, one reverse sweep per output over its
 /// own cone; with `lower_only`, row `i` keeps only columns `≤ i` (for Hessians).
-fn jacobian_rows(
+pub(crate) fn jacobian_rows(
     g: &mut Graph,
     out: &[u32],
     wrt: &[u32],

@@ -33,6 +33,8 @@ fn write_constant(out: &mut impl Write, v: f64) -> fmt::Result {
 enum Task {
     Node(u32),
     Text(&'static str),
+    /// `[k]`: an entry of a call's outputs.
+    Index(u32),
 }
 
 /// Writes `root` with shared subexpressions bound to `@k` names.
@@ -42,13 +44,13 @@ fn write_expr(g: &Graph, root: u32, out: &mut impl Write) -> fmt::Result {
     let mut stack = vec![root];
     while let Some(id) = stack.pop() {
         let n = g.node(id);
-        if n.op.arity() == 0 {
+        if matches!(n.op, Op::Const | Op::Sym) {
             continue;
         }
         let count = uses.entry(id).or_insert(0);
         *count += 1;
         if *count == 1 {
-            stack.extend_from_slice(n.operands());
+            stack.extend_from_slice(g.operands(id));
         }
     }
     // Shared nodes in ascending (topological) order get bindings.
@@ -82,6 +84,10 @@ fn write_tree(
                 out.write_str(t)?;
                 continue;
             }
+            Task::Index(k) => {
+                write!(out, "[{k}]")?;
+                continue;
+            }
             Task::Node(id) => id,
         };
         let n = g.node(id);
@@ -95,6 +101,26 @@ fn write_tree(
         match n.op {
             Op::Const => write_constant(out, n.value().unwrap_or(f64::NAN))?,
             Op::Sym => out.write_str(g.symbol_name(id))?,
+            Op::CallOutput => {
+                tasks.push(Task::Index(n.args[1]));
+                tasks.push(Task::Node(n.args[0]));
+            }
+            Op::Call => {
+                let site = &g.calls[n.args[0] as usize];
+                write!(out, "{}(", site.function.name())?;
+                tasks.push(Task::Text(")"));
+                for (i, &a) in site.inputs.iter().enumerate().rev() {
+                    tasks.push(Task::Node(a));
+                    if i > 0 {
+                        tasks.push(Task::Text(","));
+                    }
+                }
+            }
+            Op::Interpolant => {
+                write!(out, "interpolant#{}(", n.args[1])?;
+                tasks.push(Task::Text(")"));
+                tasks.push(Task::Node(n.args[0]));
+            }
             Op::Neg => {
                 out.write_str("(-")?;
                 tasks.push(Task::Text(")"));

@@ -35,6 +35,15 @@ pub enum SymxError {
         left: (usize, usize),
         right: (usize, usize),
     },
+    /// Two inputs or two outputs of a function with the same name.
+    #[error("{what} name '{name}' appears more than once")]
+    DuplicateName { what: &'static str, name: String },
+    /// The thread pool of a parallel [`crate::Map`] could not be built.
+    #[error("could not start threads: {message}")]
+    Threads { message: String },
+    /// Bad data for a lookup table ([`crate::Interpolant`]).
+    #[error("interpolant: {reason}")]
+    Table { reason: String },
     /// A syntax error in [`crate::parse`].
     #[error("parse error at byte {position}: {message}")]
     Parse { position: usize, message: String },

@@ -69,8 +69,7 @@ impl Expr {
     /// The operands of the root operation.
     pub fn operands(self) -> Vec<Expr> {
         graph::with(|g| {
-            g.node(self.id)
-                .operands()
+            g.operands(self.id)
                 .iter()
                 .map(|&a| Expr::from_id(a))
                 .collect()
@@ -170,6 +169,47 @@ impl Expr {
     pub fn sign(self) -> Expr {
         self.un(Op::Sign)
     }
+    /// Largest integer `≤ x` (derivative zero).
+    pub fn floor(self) -> Expr {
+        self.un(Op::Floor)
+    }
+    /// Smallest integer `≥ x` (derivative zero).
+    pub fn ceil(self) -> Expr {
+        self.un(Op::Ceil)
+    }
+    /// The error function `erf(x) = 2/√π ∫₀ˣ e^(−t²) dt` (evaluated by the `libm` crate).
+    pub fn erf(self) -> Expr {
+        self.un(Op::Erf)
+    }
+    /// Inverse hyperbolic sine.
+    pub fn asinh(self) -> Expr {
+        self.un(Op::Asinh)
+    }
+    /// Inverse hyperbolic cosine (defined for `x ≥ 1`).
+    pub fn acosh(self) -> Expr {
+        self.un(Op::Acosh)
+    }
+    /// Inverse hyperbolic tangent (defined for `|x| < 1`).
+    pub fn atanh(self) -> Expr {
+        self.un(Op::Atanh)
+    }
+    /// `ln(1 + x)`, accurate for small `x`.
+    pub fn log1p(self) -> Expr {
+        self.un(Op::Log1p)
+    }
+    /// `eˣ − 1`, accurate for small `x`.
+    pub fn expm1(self) -> Expr {
+        self.un(Op::Expm1)
+    }
+    /// Remainder of `self / y` with the sign of `self` (C's `fmod`); derivatives `1` and
+    /// `−trunc(self / y)`.
+    pub fn fmod(self, y: impl Into<Expr>) -> Expr {
+        self.bin(Op::Fmod, y)
+    }
+    /// `√(self² + y²)`, without intermediate overflow.
+    pub fn hypot(self, y: impl Into<Expr>) -> Expr {
+        self.bin(Op::Hypot, y)
+    }
     /// Real power `selfʸ`.
     pub fn pow(self, y: impl Into<Expr>) -> Expr {
         self.bin(Op::Pow, y)
@@ -243,6 +283,20 @@ comparison! {
     and => Op::And, swap: false;
     /// Logical or of two conditions (non-zero is true).
     or => Op::Or, swap: false;
+}
+
+/// `ln Σ eˣⁱ`, computed as CasADi does: `m + ln Σ e^(xᵢ − m)` with `m = max xᵢ`, so that
+/// large entries do not overflow. The derivative is the softmax (the terms through `m`
+/// cancel). An empty slice gives `−∞`, one entry gives the entry itself.
+pub fn logsumexp(x: &[Expr]) -> Expr {
+    match x {
+        [] => Expr::constant(f64::NEG_INFINITY),
+        [only] => *only,
+        [first, rest @ ..] => {
+            let m = rest.iter().fold(*first, |m, &e| m.max(e));
+            m + x.iter().map(|&e| (e - m).exp()).sum::<Expr>().ln()
+        }
+    }
 }
 
 /// Logical negation of a condition.

@@ -18,22 +18,33 @@
 //!   instructions);
 //! * only the operations themselves remain on the tape: one byte of opcode and register
 //!   numbers, dispatched by a single `match`.
+//!
+//! A call of another compiled function (a `Call` node, see [`Function::apply`]) is one
+//! instruction: it gathers the argument registers into a scratch block at the end of the
+//! work vector laid out as the callee's own work vector, runs the callee's tape there and
+//! scatters the callee's outputs into a block of registers of its own. The callee is
+//! shared (`Arc`), not copied, and the evaluation still allocates nothing.
+use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
-use crate::graph::{self, Graph};
+use crate::graph;
+use crate::interpolant::Table;
 use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
-use rustc_hash::FxHashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
-/// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`.
+/// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`;
+/// for [`Op::Interpolant`], `c` is the index of the table in [`Function`]'s own list; for
+/// [`Op::Call`], `d` is the index of the call in [`Function`]'s list and `a = b = c = 0`.
 #[derive(Clone, Copy, Debug)]
-struct Instr {
-    op: Op,
-    d: u32,
-    a: u32,
-    b: u32,
-    c: u32,
+pub(crate) struct Instr {
+    pub op: Op,
+    pub d: u32,
+    pub a: u32,
+    pub b: u32,
+    pub c: u32,
 }
 
 /// A compiled function from vectors of numbers to vectors of numbers.
@@ -50,20 +61,55 @@ struct Instr {
 /// ```
 #[derive(Clone, Debug)]
 pub struct Function {
-    input_sizes: Vec<usize>,
-    output_sizes: Vec<usize>,
+    pub(crate) name: String,
+    pub(crate) input_names: Vec<String>,
+    pub(crate) output_names: Vec<String>,
+    /// Identity shared by clones: the graph's call table recognises a function by it.
+    pub(crate) uid: u64,
+    pub(crate) input_sizes: Vec<usize>,
+    pub(crate) output_sizes: Vec<usize>,
     /// Register of entry 0 of each input (entries are consecutive).
-    input_offsets: Vec<usize>,
+    pub(crate) input_offsets: Vec<usize>,
     /// Whether any instruction or output reads input `k` (unread inputs are not copied).
-    input_used: Vec<bool>,
+    pub(crate) input_used: Vec<bool>,
     /// Register of entry 0 of each output.
-    output_offsets: Vec<usize>,
-    tape: Vec<Instr>,
+    pub(crate) output_offsets: Vec<usize>,
+    pub(crate) tape: Vec<Instr>,
     /// Values of registers `template_start..template_start + template.len()`: the constants
     /// followed by the output slots (constant entries hold their value, others 0).
-    template: Vec<f64>,
-    template_start: usize,
-    work_size: usize,
+    pub(crate) template: Vec<f64>,
+    pub(crate) template_start: usize,
+    pub(crate) work_size: usize,
+    /// Lookup tables read by `Interpolant` instructions.
+    pub(crate) tables: Vec<Arc<Table>>,
+    /// Functions called by `Call` instructions.
+    pub(crate) calls: Vec<CallInstr>,
+    /// First register of the scratch block where callees run.
+    pub(crate) call_scratch: usize,
+    /// For each output entry (outputs stacked), the input entries (stacked) it depends on.
+    pub(crate) dependencies: OnceLock<Arc<Vec<Vec<u32>>>>,
+    /// The Jacobian functions used to differentiate calls of this function, by the set
+    /// of input entries differentiated (built on first use; shared by clones).
+    pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
+}
+
+/// A fresh function identity.
+pub(crate) fn next_uid() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+/// Checks that `names` are distinct.
+fn distinct(what: &'static str, names: &[&str]) -> Result<(), SymxError> {
+    for (k, n) in names.iter().enumerate() {
+        if names[..k].contains(n) {
+            return Err(SymxError::DuplicateName {
+                what,
+                name: n.to_string(),
+            });
+        }
+    }
+    Ok(())
 }
 
 impl Function {
@@ -71,10 +117,67 @@ impl Function {
     ///
     /// Errors: an input entry that is not a symbol, a symbol given twice, or an output that
     /// depends on a symbol not among the inputs.
+    ///
+    /// The function is named `f`, its inputs `i0, i1, …` and its outputs `o0, o1, …`
+    /// (CasADi's defaults); [`Function::named`] chooses the names.
     pub fn new(inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Function, SymxError> {
         let all: Vec<Expr> = inputs.iter().flat_map(|i| i.iter().copied()).collect();
         crate::ad::symbol_ids(&all, "Function inputs")?;
-        graph::with(|g| compile(g, inputs, outputs))
+        graph::with(|g| crate::compile::compile(g, inputs, outputs))
+    }
+
+    /// Compiles like [`Function::new`], with a name for the function and for each input
+    /// and output; `Err` if two inputs or two outputs share a name.
+    ///
+    /// ```
+    /// use symx::{Function, Matrix};
+    /// let x = Matrix::sym_vec("x", 2);
+    /// let u = Matrix::sym_vec("u", 1);
+    /// let xdot = Matrix::from_vec(vec![x[1], u[0] - x[0]]);
+    /// let f = Function::named("ode", &[("x", &x), ("u", &u)], &[("xdot", &xdot)]).unwrap();
+    /// assert_eq!((f.name(), f.input_index("u"), f.output_names()), ("ode", Some(1), &["xdot".to_string()][..]));
+    /// ```
+    pub fn named(
+        name: &str,
+        inputs: &[(&str, &[Expr])],
+        outputs: &[(&str, &[Expr])],
+    ) -> Result<Function, SymxError> {
+        let in_names: Vec<&str> = inputs.iter().map(|p| p.0).collect();
+        let out_names: Vec<&str> = outputs.iter().map(|p| p.0).collect();
+        distinct("input", &in_names)?;
+        distinct("output", &out_names)?;
+        let ins: Vec<&[Expr]> = inputs.iter().map(|p| p.1).collect();
+        let outs: Vec<&[Expr]> = outputs.iter().map(|p| p.1).collect();
+        let mut f = Function::new(&ins, &outs)?;
+        f.name = name.to_string();
+        f.input_names = in_names.iter().map(|s| s.to_string()).collect();
+        f.output_names = out_names.iter().map(|s| s.to_string()).collect();
+        Ok(f)
+    }
+
+    /// The function's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The names of the inputs, in order.
+    pub fn input_names(&self) -> &[String] {
+        &self.input_names
+    }
+
+    /// The names of the outputs, in order.
+    pub fn output_names(&self) -> &[String] {
+        &self.output_names
+    }
+
+    /// The position of the input called `name`.
+    pub fn input_index(&self, name: &str) -> Option<usize> {
+        self.input_names.iter().position(|n| n == name)
+    }
+
+    /// The position of the output called `name`.
+    pub fn output_index(&self, name: &str) -> Option<usize> {
+        self.output_names.iter().position(|n| n == name)
     }
 
     /// Number of input vectors.
@@ -107,6 +210,28 @@ impl Function {
     /// is an input or repeats another entry (inputs, constants and outputs move in bulk).
     pub fn instruction_count(&self) -> usize {
         self.tape.len()
+    }
+
+    /// Checks argument counts and lengths for `points` points.
+    pub(crate) fn check_batch(
+        &self,
+        inputs: &[&[f64]],
+        outputs: &[&mut [f64]],
+        work: &[f64],
+        points: usize,
+    ) -> Result<(), SymxError> {
+        self.check(inputs, outputs, work, points)
+    }
+
+    /// Number of instructions one evaluation executes: this tape's, plus those of every
+    /// called function's tape per call (a measure of evaluation work).
+    pub fn executed_instruction_count(&self) -> usize {
+        self.tape.len()
+            + self
+                .calls
+                .iter()
+                .map(|c| c.function.executed_instruction_count())
+                .sum::<usize>()
     }
 
     fn check(
@@ -219,6 +344,20 @@ impl Function {
                 std::ptr::copy_nonoverlapping(x.as_ptr().add(p * n), w.add(at), n);
             }
         }
+        self.exec(w);
+        for (k, y) in outputs.iter_mut().enumerate() {
+            let n = *self.output_sizes.get_unchecked(k);
+            let at = *self.output_offsets.get_unchecked(k);
+            std::ptr::copy_nonoverlapping(w.add(at), y.as_mut_ptr().add(p * n), n);
+        }
+    }
+
+    /// Runs the tape on a work vector whose input registers are filled.
+    ///
+    /// # Safety
+    /// `w` must point to at least `work_size` numbers.
+    #[inline(always)]
+    pub(crate) unsafe fn exec(&self, w: *mut f64) {
         std::ptr::copy_nonoverlapping(
             self.template.as_ptr(),
             w.add(self.template_start),
@@ -261,6 +400,17 @@ impl Function {
                 Op::And => f64::from(a != 0.0 && b != 0.0),
                 Op::Or => f64::from(a != 0.0 || b != 0.0),
                 Op::StrongMul => op::strong_mul(a, b),
+                Op::Floor => a.floor(),
+                Op::Ceil => a.ceil(),
+                Op::Erf => libm::erf(a),
+                Op::Asinh => a.asinh(),
+                Op::Acosh => a.acosh(),
+                Op::Atanh => a.atanh(),
+                Op::Log1p => a.ln_1p(),
+                Op::Expm1 => a.exp_m1(),
+                Op::Fmod => a % b,
+                Op::Hypot => a.hypot(b),
+                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(a),
                 Op::IfElse => {
                     if a != 0.0 {
                         b
@@ -268,21 +418,46 @@ impl Function {
                         *w.add(ins.c as usize)
                     }
                 }
-                Op::Const => std::hint::unreachable_unchecked(),
+                Op::Call => {
+                    self.exec_call(self.calls.get_unchecked(ins.d as usize), w);
+                    continue;
+                }
+                Op::Const | Op::CallOutput => std::hint::unreachable_unchecked(),
             };
             *w.add(ins.d as usize) = v;
         }
-        for (k, y) in outputs.iter_mut().enumerate() {
-            let n = *self.output_sizes.get_unchecked(k);
-            let at = *self.output_offsets.get_unchecked(k);
-            std::ptr::copy_nonoverlapping(w.add(at), y.as_mut_ptr().add(p * n), n);
+    }
+
+    /// Runs one call: arguments into the scratch block, the callee's tape there, its
+    /// outputs into the call's output registers.
+    ///
+    /// # Safety
+    /// As [`Function::exec`]; the registers of `call` were bounded at compilation.
+    #[inline(never)]
+    unsafe fn exec_call(&self, call: &CallInstr, w: *mut f64) {
+        let f = &*call.function;
+        let s = w.add(self.call_scratch);
+        let mut p = 0;
+        for (&n, &at) in f.input_sizes.iter().zip(&f.input_offsets) {
+            for i in 0..n {
+                *s.add(at + i) = *w.add(*call.args.get_unchecked(p) as usize);
+                p += 1;
+            }
+        }
+        f.exec(s);
+        let out = w.add(call.out as usize);
+        let mut q = 0;
+        for (&n, &at) in f.output_sizes.iter().zip(&f.output_offsets) {
+            std::ptr::copy_nonoverlapping(s.add(at), out.add(q), n);
+            q += n;
         }
     }
 
     /// Which entries of output `output` depend on which entries of input `input`: the
     /// structural Jacobian pattern (`output_sizes()[output] × input_sizes()[input]`), found
     /// by propagating 64-column bit masks along the tape. Operations with zero derivative
-    /// (comparisons, `sign`) and the conditions of `if_else` do not propagate dependence.
+    /// (comparisons, `sign`) and the conditions of `if_else` do not propagate dependence;
+    /// a call propagates the dependencies of the called function.
     pub fn dependency_sparsity(&self, input: usize, output: usize) -> Result<Sparsity, SymxError> {
         let (n_in, n_out) = (self.input_sizes.len(), self.output_sizes.len());
         if input >= n_in {
@@ -299,218 +474,70 @@ impl Function {
                 got: output,
             });
         }
-        let ncols = self.input_sizes[input];
-        let first = self.input_offsets[input];
-        let (out_first, nrows) = (self.output_offsets[output], self.output_sizes[output]);
-        let mut bits = vec![0u64; self.work_size];
-        let mut entries = Vec::new();
-        for block in (0..ncols).step_by(64) {
-            bits.iter_mut().for_each(|b| *b = 0);
-            for j in block..ncols.min(block + 64) {
-                bits[first + j] = 1u64 << (j - block);
-            }
-            for ins in &self.tape {
-                bits[ins.d as usize] = match ins.op {
-                    o if o.has_zero_derivative() => 0,
-                    Op::IfElse => bits[ins.b as usize] | bits[ins.c as usize],
-                    _ => bits[ins.a as usize] | bits[ins.b as usize],
-                };
-            }
-            for i in 0..nrows {
-                let mut m = bits[out_first + i];
-                while m != 0 {
-                    entries.push((i, block + m.trailing_zeros() as usize));
-                    m &= m - 1;
-                }
-            }
-        }
+        let col0: usize = self.input_sizes[..input].iter().sum();
+        let row0: usize = self.output_sizes[..output].iter().sum();
+        let (ncols, nrows) = (self.input_sizes[input], self.output_sizes[output]);
+        let rows = &self.dependency_rows()[row0..row0 + nrows];
+        let entries = rows.iter().enumerate().flat_map(|(i, cols)| {
+            cols.iter()
+                .map(|&j| j as usize)
+                .filter(|&j| j >= col0 && j < col0 + ncols)
+                .map(move |j| (i, j - col0))
+        });
         Ok(pattern_from_entries(nrows, ncols, entries))
     }
-}
 
-fn compile(g: &Graph, inputs: &[&[Expr]], outputs: &[&[Expr]]) -> Result<Function, SymxError> {
-    // Per-node scratch indexed by node id. Zero-initialised vectors are allocated lazily
-    // by the OS, so a small function in a large graph only touches the pages of its cone.
-    // `seen[id]`: 0 = not visited, else 1 + the node's local index.
-    let mut seen = vec![0u32; g.len()];
-    let mut register: Vec<u32> = Vec::new();
-    fn visit(seen: &mut [u32], id: u32, reg: u32, register: &mut Vec<u32>) {
-        register.push(reg);
-        seen[id as usize] = register.len() as u32;
-    }
-
-    // Inputs occupy the first registers.
-    let input_sizes: Vec<usize> = inputs.iter().map(|x| x.len()).collect();
-    let output_sizes: Vec<usize> = outputs.iter().map(|y| y.len()).collect();
-    let mut input_offsets = Vec::with_capacity(inputs.len());
-    let mut input_of: FxHashMap<u32, usize> = FxHashMap::default();
-    let mut next = 0usize;
-    for (k, x) in inputs.iter().enumerate() {
-        input_offsets.push(next);
-        for e in x.iter() {
-            input_of.insert(e.id, k);
-            visit(&mut seen, e.id, next as u32, &mut register);
-            next += 1;
-        }
-    }
-    let mut input_used = vec![false; inputs.len()];
-
-    // Depth-first post-order of the computed nodes; constants are collected on the way.
-    let mut constants: Vec<f64> = Vec::new();
-    let mut const_ids: Vec<u32> = Vec::new();
-    let mut steps: Vec<u32> = Vec::new();
-    let mut stack: Vec<(u32, u8)> = Vec::new();
-    let is_seen = |seen: &[u32], id: u32| seen[id as usize] != 0;
-    for (k, y) in outputs.iter().enumerate() {
-        for e in y.iter() {
-            stack.push((e.id, 0));
-            while let Some(&mut (id, ref mut child)) = stack.last_mut() {
-                let node = g.node(id);
-                if *child == 0 {
-                    if is_seen(&seen, id) {
-                        stack.pop();
-                        continue;
-                    }
-                    match node.op {
-                        Op::Const => {
-                            const_ids.push(id);
-                            constants.push(node.value().unwrap_or(f64::NAN));
-                            visit(&mut seen, id, u32::MAX, &mut register);
-                            stack.pop();
-                            continue;
-                        }
-                        Op::Sym => {
-                            return Err(SymxError::FreeSymbol {
-                                output: k,
-                                name: g.symbol_name(id).to_string(),
-                            })
-                        }
-                        _ => {}
+    /// For each output entry (outputs stacked), the sorted input entries (inputs stacked)
+    /// it depends on; computed once and kept.
+    pub(crate) fn dependency_rows(&self) -> &Arc<Vec<Vec<u32>>> {
+        self.dependencies.get_or_init(|| {
+            let n_in: usize = self.input_sizes.iter().sum();
+            let mut rows: Vec<Vec<u32>> = vec![Vec::new(); self.output_sizes.iter().sum()];
+            let input_regs: Vec<usize> = (0..self.input_sizes.len())
+                .flat_map(|k| (0..self.input_sizes[k]).map(move |i| (k, i)))
+                .map(|(k, i)| self.input_offsets[k] + i)
+                .collect();
+            let output_regs: Vec<usize> = (0..self.output_sizes.len())
+                .flat_map(|k| (0..self.output_sizes[k]).map(move |i| (k, i)))
+                .map(|(k, i)| self.output_offsets[k] + i)
+                .collect();
+            let mut bits = vec![0u64; self.work_size];
+            for block in (0..n_in).step_by(64) {
+                bits.iter_mut().for_each(|b| *b = 0);
+                for j in block..n_in.min(block + 64) {
+                    bits[input_regs[j]] = 1u64 << (j - block);
+                }
+                self.propagate_bits(&mut bits);
+                for (row, &r) in rows.iter_mut().zip(&output_regs) {
+                    let mut m = bits[r];
+                    while m != 0 {
+                        row.push((block + m.trailing_zeros() as usize) as u32);
+                        m &= m - 1;
                     }
                 }
-                let operands = node.operands();
-                if (*child as usize) < operands.len() {
-                    let c = operands[*child as usize];
-                    *child += 1;
-                    if !is_seen(&seen, c) {
-                        stack.push((c, 0));
+            }
+            Arc::new(rows)
+        })
+    }
+
+    /// Propagates dependence bit masks along the tape (`bits` has `work_size` entries).
+    fn propagate_bits(&self, bits: &mut [u64]) {
+        for ins in &self.tape {
+            match ins.op {
+                Op::Call => {
+                    let call = &self.calls[ins.d as usize];
+                    let deps = call.function.dependency_rows();
+                    for (q, cols) in deps.iter().enumerate() {
+                        let m = cols
+                            .iter()
+                            .fold(0, |m, &j| m | bits[call.args[j as usize] as usize]);
+                        bits[call.out as usize + q] = m;
                     }
-                } else {
-                    visit(&mut seen, id, u32::MAX, &mut register);
-                    steps.push(id);
-                    stack.pop();
                 }
+                o if o.has_zero_derivative() => bits[ins.d as usize] = 0,
+                Op::IfElse => bits[ins.d as usize] = bits[ins.b as usize] | bits[ins.c as usize],
+                _ => bits[ins.d as usize] = bits[ins.a as usize] | bits[ins.b as usize],
             }
         }
     }
-    let local = |id: u32| seen[id as usize] as usize - 1;
-
-    // Constants, then output slots.
-    let template_start = next;
-    for (c, &id) in const_ids.iter().enumerate() {
-        register[local(id)] = (template_start + c) as u32;
-    }
-    let outputs_start = template_start + constants.len();
-    let mut template = constants;
-    let mut output_offsets = Vec::with_capacity(outputs.len());
-    let mut copies: Vec<Instr> = Vec::new();
-    let mut pinned = vec![false; register.len()];
-    let mut slot = outputs_start;
-    for y in outputs {
-        output_offsets.push(slot);
-        for e in y.iter() {
-            let l = local(e.id);
-            let node = g.node(e.id);
-            if let Some(v) = node.value() {
-                template.push(v);
-            } else if node.op != Op::Sym && !pinned[l] {
-                // The operation computing this entry writes its output slot directly.
-                pinned[l] = true;
-                register[l] = slot as u32;
-                template.push(0.0);
-            } else {
-                // An input, or a node already written to another slot: copy at the end.
-                template.push(0.0);
-                if node.op == Op::Sym {
-                    input_used[input_of[&e.id]] = true;
-                }
-                copies.push(Instr {
-                    op: Op::Sym,
-                    d: slot as u32,
-                    a: e.id, // resolved to a register below
-                    b: 0,
-                    c: 0,
-                });
-            }
-            slot += 1;
-        }
-    }
-
-    // Last step reading each node (by local index).
-    let mut last_use: Vec<usize> = vec![usize::MAX; register.len()];
-    for (s, &id) in steps.iter().enumerate() {
-        for &a in g.node(id).operands() {
-            last_use[local(a)] = s;
-            if g.node(a).op == Op::Sym {
-                input_used[input_of[&a]] = true;
-            }
-        }
-    }
-
-    // Temporaries: allocated after the output slots, reused after their last use.
-    let temp_start = slot as u32;
-    let mut free: Vec<u32> = Vec::new();
-    let mut work_size = temp_start;
-    let mut tape = Vec::with_capacity(steps.len() + copies.len());
-    for (s, &id) in steps.iter().enumerate() {
-        let node = g.node(id);
-        let arity = node.op.arity();
-        let mut regs = [0u32; 3];
-        for k in 0..arity {
-            regs[k] = register[local(node.args[k])];
-        }
-        // Operands whose last use is here free their registers first, so the result may
-        // take one of them (operands are read before the write).
-        for k in 0..arity {
-            let l = local(node.args[k]);
-            if last_use[l] == s && regs[k] >= temp_start && !regs[..k].contains(&regs[k]) {
-                free.push(regs[k]);
-            }
-        }
-        let l = local(id);
-        let d = if pinned[l] {
-            register[l]
-        } else {
-            let d = free.pop().unwrap_or_else(|| {
-                work_size += 1;
-                work_size - 1
-            });
-            register[l] = d;
-            d
-        };
-        tape.push(Instr {
-            op: node.op,
-            d,
-            a: regs[0],
-            b: if arity >= 2 { regs[1] } else { regs[0] },
-            c: if arity == 3 { regs[2] } else { regs[0] },
-        });
-    }
-    for mut copy in copies {
-        let r = register[local(copy.a)];
-        // All operand fields name the source, so that readers of `b` see it too.
-        (copy.a, copy.b, copy.c) = (r, r, r);
-        tape.push(copy);
-    }
-    Ok(Function {
-        input_sizes,
-        output_sizes,
-        input_offsets,
-        input_used,
-        output_offsets,
-        tape,
-        template,
-        template_start,
-        work_size: work_size as usize,
-    })
 }

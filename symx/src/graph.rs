@@ -5,9 +5,12 @@
 //! by construction and constants are interned. Because a node can only refer to nodes that
 //! already exist, ascending index order is a topological order of the whole graph; every
 //! traversal in this crate relies on that and none of them recurses.
+use crate::call::CallSite;
+use crate::interpolant::Table;
 use crate::op::Op;
 use rustc_hash::FxHashMap;
 use std::cell::RefCell;
+use std::sync::Arc;
 
 /// One node: an operation and up to three operand indices.
 ///
@@ -56,6 +59,19 @@ pub(crate) struct Graph {
     pub symbol_names: Vec<Box<str>>,
     /// Node index of each symbol, by symbol number.
     pub symbol_nodes: Vec<u32>,
+    /// Lookup tables used by `Interpolant` nodes, by table number.
+    pub tables: Vec<Arc<Table>>,
+    /// Table number of each registered table, by address (the graph keeps the `Arc`, so an
+    /// address is never reused while registered).
+    table_index: FxHashMap<usize, u32>,
+    /// Table number of each table's derivative, once built.
+    table_derivative: Vec<Option<u32>>,
+    /// Calls of compiled functions, by call number (`Call` nodes hold the number).
+    pub calls: Vec<CallSite>,
+    /// Call number of each (function, argument nodes) pair: identical calls are one call.
+    pub call_index: FxHashMap<(u64, Vec<u32>), u32>,
+    /// The called functions, by [`crate::Function`] identity, shared by their call sites.
+    pub functions: FxHashMap<u64, Arc<crate::Function>>,
 }
 
 thread_local! {
@@ -76,6 +92,12 @@ impl Graph {
             index: FxHashMap::default(),
             symbol_names: Vec::new(),
             symbol_nodes: Vec::new(),
+            tables: Vec::new(),
+            table_index: FxHashMap::default(),
+            table_derivative: Vec::new(),
+            calls: Vec::new(),
+            call_index: FxHashMap::default(),
+            functions: FxHashMap::default(),
         };
         // Indices 0 and 1 are the constants 0 and 1, used everywhere.
         g.intern(Node::constant(0.0));
@@ -107,6 +129,42 @@ impl Graph {
         id
     }
 
+    /// The number of `table` in this graph, registering it on first use.
+    pub fn table_id(&mut self, table: &Arc<Table>) -> u32 {
+        let key = Arc::as_ptr(table) as usize;
+        if let Some(&t) = self.table_index.get(&key) {
+            return t;
+        }
+        let t = self.tables.len() as u32;
+        self.tables.push(table.clone());
+        self.table_derivative.push(None);
+        self.table_index.insert(key, t);
+        t
+    }
+
+    /// The number of the derivative of table `t`, built once.
+    pub fn derivative_table(&mut self, t: u32) -> u32 {
+        if let Some(d) = self.table_derivative[t as usize] {
+            return d;
+        }
+        let d = Arc::new(self.tables[t as usize].derivative());
+        let d = self.table_id(&d);
+        self.table_derivative[t as usize] = Some(d);
+        d
+    }
+
+    /// `table_t(x)`: a lookup node (folded when `x` is a constant).
+    pub fn interpolant(&mut self, x: u32, t: u32) -> u32 {
+        if let Some(v) = self.value(x) {
+            let y = self.tables[t as usize].eval(v);
+            return self.constant(y);
+        }
+        self.intern(Node {
+            op: Op::Interpolant,
+            args: [x, t, 0],
+        })
+    }
+
     pub fn constant(&mut self, v: f64) -> u32 {
         self.intern(Node::constant(v))
     }
@@ -114,6 +172,17 @@ impl Graph {
     #[inline]
     pub fn node(&self, id: u32) -> Node {
         self.nodes[id as usize]
+    }
+
+    /// The operand indices of node `id` (for a `Call`, its argument entries).
+    #[inline]
+    pub fn operands(&self, id: u32) -> &[u32] {
+        let n = &self.nodes[id as usize];
+        if n.op == Op::Call {
+            &self.calls[n.args[0] as usize].inputs
+        } else {
+            n.operands()
+        }
     }
 
     #[inline]

@@ -20,11 +20,17 @@
 //! Expressions live in a graph owned by the current thread; a compiled [`Function`] is
 //! independent of it and can be shared across threads.
 mod ad;
+mod assemble;
+mod call;
+mod compile;
 mod display;
 mod error;
 mod expr;
 mod function;
 mod graph;
+mod interpolant;
+mod linalg;
+mod map;
 mod matrix;
 mod op;
 mod simplify;
@@ -33,9 +39,11 @@ pub mod sparsity;
 pub use ad::{forward, gradient, hessian, jacobian, lagrangian_hessian, reverse};
 pub use display::parse;
 pub use error::SymxError;
-pub use expr::{and, eq, ge, gt, if_else, le, lt, ne, not, or, Expr};
+pub use expr::{and, eq, ge, gt, if_else, le, logsumexp, lt, ne, not, or, Expr};
 pub use function::Function;
 pub use graph::node_count;
+pub use interpolant::Interpolant;
+pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
 pub use op::Op;
 pub use sparsity::Sparsity;

@@ -49,6 +49,35 @@ pub enum Op {
     StrongMul,
     /// `if_else(c, a, b)`: `a` where `c != 0`, else `b`; the other branch never leaks NaN.
     IfElse,
+    /// Largest integer not above the operand (derivative zero).
+    Floor,
+    /// Smallest integer not below the operand (derivative zero).
+    Ceil,
+    /// The error function.
+    Erf,
+    /// Inverse hyperbolic sine.
+    Asinh,
+    /// Inverse hyperbolic cosine.
+    Acosh,
+    /// Inverse hyperbolic tangent.
+    Atanh,
+    /// `ln(1 + x)`, accurate near 0.
+    Log1p,
+    /// `eˣ − 1`, accurate near 0.
+    Expm1,
+    /// Remainder of `a / b` with the sign of `a` (C's `fmod`, Rust's `%`).
+    Fmod,
+    /// `√(a² + b²)` without overflow.
+    Hypot,
+    /// A lookup table (see [`crate::Interpolant`]) applied to the operand; the node also
+    /// records which table, so it prints as `interpolant#k(x)` and does not parse back.
+    Interpolant,
+    /// A call of a compiled [`crate::Function`] (see [`crate::Function::apply`]); its
+    /// operands (the argument entries) live in the graph's call table, so `arity` is 0.
+    /// It has no value of its own: its outputs are `CallOutput` nodes.
+    Call,
+    /// Entry `k` (second slot) of the outputs of the `Call` node in the first slot.
+    CallOutput,
 }
 
 impl Op {
@@ -56,11 +85,12 @@ impl Op {
     pub fn arity(self) -> usize {
         use Op::*;
         match self {
-            Const | Sym => 0,
+            Const | Sym | Call => 0,
             Neg | Sq | Sqrt | Exp | Log | Sin | Cos | Tan | Asin | Acos | Atan | Sinh | Cosh
-            | Tanh | Abs | Sign | Not => 1,
+            | Tanh | Abs | Sign | Not | Floor | Ceil | Erf | Asinh | Acosh | Atanh | Log1p
+            | Expm1 | Interpolant | CallOutput => 1,
             Add | Sub | Mul | Div | Pow | Atan2 | Min | Max | Lt | Le | Eq | Ne | And | Or
-            | StrongMul => 2,
+            | StrongMul | Fmod | Hypot => 2,
             IfElse => 3,
         }
     }
@@ -68,13 +98,16 @@ impl Op {
     /// Whether swapping the two operands leaves the value unchanged.
     pub fn is_commutative(self) -> bool {
         use Op::*;
-        matches!(self, Add | Mul | Min | Max | Eq | Ne | And | Or)
+        matches!(self, Add | Mul | Min | Max | Eq | Ne | And | Or | Hypot)
     }
 
     /// Operations whose derivative is identically zero (piecewise constant results).
     pub fn has_zero_derivative(self) -> bool {
         use Op::*;
-        matches!(self, Sign | Not | Lt | Le | Eq | Ne | And | Or)
+        matches!(
+            self,
+            Sign | Not | Lt | Le | Eq | Ne | And | Or | Floor | Ceil
+        )
     }
 
     /// Operations that select one operand at run time: adjoints below them may be an exact zero.
@@ -104,6 +137,14 @@ impl Op {
             Abs => a.abs(),
             Sign => sign(a),
             Not => b2f(a == 0.0),
+            Floor => a.floor(),
+            Ceil => a.ceil(),
+            Erf => libm::erf(a),
+            Asinh => a.asinh(),
+            Acosh => a.acosh(),
+            Atanh => a.atanh(),
+            Log1p => a.ln_1p(),
+            Expm1 => a.exp_m1(),
             _ => unreachable!("eval1 on {self:?}"),
         }
     }
@@ -128,6 +169,8 @@ impl Op {
             And => b2f(a != 0.0 && b != 0.0),
             Or => b2f(a != 0.0 || b != 0.0),
             StrongMul => strong_mul(a, b),
+            Fmod => a % b,
+            Hypot => a.hypot(b),
             _ => unreachable!("eval2 on {self:?}"),
         }
     }
@@ -171,16 +214,30 @@ impl Op {
             Or => "or",
             StrongMul => "strong_mul",
             IfElse => "if_else",
+            Floor => "floor",
+            Ceil => "ceil",
+            Erf => "erf",
+            Asinh => "asinh",
+            Acosh => "acosh",
+            Atanh => "atanh",
+            Log1p => "log1p",
+            Expm1 => "expm1",
+            Fmod => "fmod",
+            Hypot => "hypot",
+            Interpolant => "interpolant",
+            Call => "call",
+            CallOutput => "call_output",
         }
     }
 
     /// All operations with operands, for the parser's name lookup.
-    pub(crate) const WITH_OPERANDS: [Op; 33] = {
+    /// (`Interpolant` is not listed: its table cannot be named in text.)
+    pub(crate) const WITH_OPERANDS: [Op; 43] = {
         use Op::*;
         [
             Neg, Sq, Sqrt, Exp, Log, Sin, Cos, Tan, Asin, Acos, Atan, Sinh, Cosh, Tanh, Abs, Sign,
             Not, Add, Sub, Mul, Div, Pow, Atan2, Min, Max, Lt, Le, Eq, Ne, And, Or, StrongMul,
-            IfElse,
+            IfElse, Floor, Ceil, Erf, Asinh, Acosh, Atanh, Log1p, Expm1, Fmod, Hypot,
         ]
     };
 }

@@ -16,6 +16,11 @@ impl Graph {
     /// Creates `op(a)`, simplified.
     pub fn unary(&mut self, op: Op, a: u32) -> u32 {
         debug_assert_eq!(op.arity(), 1);
+        debug_assert_ne!(
+            op,
+            Op::Interpolant,
+            "lookups are built by Graph::interpolant"
+        );
         if let Some(v) = self.value(a) {
             return self.constant(op.eval1(v));
         }
