@@ -151,6 +151,7 @@ fn wrong_jacobian_entry_is_named() {
         m.finite_difference
     );
     assert!(m.to_string().contains("jac_g[wave, vel]"), "{m}");
+    eprintln!("{m}");
 }
 
 #[test]
@@ -173,6 +174,7 @@ fn wrong_hessian_entry_is_named_with_its_constraint() {
         m.finite_difference
     );
     assert_eq!(m.culprits, vec!["product".to_string()]);
+    eprintln!("{m}");
 }
 
 #[test]
