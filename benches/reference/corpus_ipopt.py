@@ -19,6 +19,10 @@ Usage:
       --out benches/reference/results/corpus.jsonl [--filter rocket,glider] [--kind ocp] \\
       [--max-n 5000] [--max-wall 600]
   target/release/corpus report benches/reference/results/corpus.jsonl --svg-dir docs
+  # how the iterations went, for a few instances (symnlp: `corpus diagnose`; IPOPT: the
+  # per-iteration stats CasADi records):
+  python3 benches/reference/corpus_ipopt.py --diagnose --out results/corpus_diagnosis.jsonl \
+      --filter rocket_trap_400,race_car_rk4_400
 """
 import argparse
 import json
@@ -68,6 +72,48 @@ def ipopt_on(d, a):
     }
 
 
+def ipopt_diagnosis(d, a):
+    """IPOPT's per-iteration records summarised like corpus::diagnose::Diagnosis."""
+    x = gap_crossing_casadi.ca.SX.sym("x", d["n"])
+    p = gap_crossing_casadi.Parser({v["name"]: x[i] for i, v in enumerate(d["variables"])})
+    f = p.parse(d["objective"])
+    g = gap_crossing_casadi.ca.vertcat(*[p.parse(c["expr"]) for c in d["constraints"]])
+    bound = gap_crossing_casadi.bound
+    inf = float("inf")
+    opts = {"ipopt.tol": 1e-8, "ipopt.print_level": 0, "ipopt.max_iter": 3000,
+            "ipopt.max_wall_time": a.max_wall, "ipopt.sb": "yes", "print_time": False}
+    S = gap_crossing_casadi.ca.nlpsol("S", "ipopt", {"x": x, "f": f, "g": g}, opts)
+    S(x0=[v["x0"] for v in d["variables"]],
+      lbx=[bound(v["lower"], -inf) for v in d["variables"]], ubx=[bound(v["upper"], inf) for v in d["variables"]],
+      lbg=[bound(c["lower"], -inf) for c in d["constraints"]], ubg=[bound(c["upper"], inf) for c in d["constraints"]])
+    st = S.stats()
+    it = st["iterations"]
+    alpha, reg = it["alpha_pr"][1:], it["regularization_size"][1:]
+    return {
+        "status": st["return_status"],
+        "iterations": st["iter_count"],
+        "tiny_alpha": sum(1 for v in alpha if v < 1e-8),
+        "small_alpha": sum(1 for v in alpha if v < 1e-3),
+        "regularized": sum(1 for v in reg if v > 0),
+        "max_regularization": max(reg, default=0.0),
+        "final_mu": it["mu"][-1],
+        "final_inf_pr": it["inf_pr"][-1],
+        "final_inf_du": it["inf_du"][-1],
+    }
+
+
+def diagnose(inst, a):
+    name = inst["instance"]
+    ours = json.loads(subprocess.run([a.bin, "diagnose", name, "--max-wall", str(a.max_wall)], check=True,
+                                     stdout=subprocess.PIPE).stdout)
+    d = json.loads(subprocess.run([a.bin, "export", name], check=True, stdout=subprocess.PIPE).stdout)
+    result = {}
+    t = threading.Thread(target=lambda: result.update(r=ipopt_diagnosis(d, a)))
+    t.start()
+    t.join()
+    return {"instance": name, "symnlp": dict(status=ours["status"], **ours["diagnosis"]), "ipopt": result["r"]}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default="target/release/corpus", help="the corpus binary")
@@ -78,6 +124,8 @@ def main():
     ap.add_argument("--max-wall", type=float, default=600.0, help="wall-time cap per solve (both solvers)")
     ap.add_argument("--print-level", type=int, default=0)
     ap.add_argument("--fresh", action="store_true", help="truncate --out first")
+    ap.add_argument("--diagnose", action="store_true",
+                    help="write iteration summaries of both solvers (regularised and tiny steps) instead of results")
     a = ap.parse_args()
     sys.setrecursionlimit(1_000_000)
     threading.stack_size(512 * 1024 * 1024)
@@ -92,6 +140,10 @@ def main():
         if name in done:
             continue
         print(f"== {name} (n {inst['n']}, m {inst['m']})", file=sys.stderr)
+        if a.diagnose:
+            with open(a.out, "a") as fh:
+                fh.write(json.dumps(diagnose(inst, a)) + "\n")
+            continue
         cmd = [a.bin, "export", name, "--solve", "--max-wall", str(a.max_wall)]
         d = json.loads(subprocess.run(cmd, check=True, stdout=subprocess.PIPE).stdout)
         line = {"instance": name, "symnlp": d["symnlp"], "ipopt": ipopt_on(d, a)}

@@ -16,6 +16,7 @@
 //! result sets into a table and Dolan–Moré performance profiles. See `docs/corpus.md`.
 
 pub mod cute;
+pub mod diagnose;
 pub mod export;
 pub mod ocp;
 pub mod profile;

@@ -4,6 +4,7 @@
 //! corpus list [--filter S] [--kind ocp|cute] [--max-n N]      # one JSON line per instance
 //! corpus solve [--filter S] [--kind K] [--max-n N] [--max-wall S]   # symnlp, one JSON line each
 //! corpus export NAME [--solve] [--max-wall S]                 # the dump IPOPT reads (JSON)
+//! corpus diagnose NAME... [--max-wall S]                     # how the IPM's iterations went
 //! corpus report FILE [--svg-dir DIR]                          # markdown + profile SVGs
 //! ```
 use clap::{Parser, Subcommand};
@@ -50,6 +51,14 @@ enum Command {
         #[arg(long)]
         solve: bool,
         /// Wall-time cap of that solve in seconds.
+        #[arg(long, default_value_t = 600.0)]
+        max_wall: f64,
+    },
+    /// Solves one instance with symnlp and prints a summary of its iteration records.
+    Diagnose {
+        /// Instance names (`family_size`).
+        names: Vec<String>,
+        /// Wall-time cap per solve in seconds.
         #[arg(long, default_value_t = 600.0)]
         max_wall: f64,
     },
@@ -149,6 +158,17 @@ fn real_main() -> Result<(), CorpusError> {
                 d.symnlp = Some(outcome);
             }
             println!("{}", serde_json::to_string(&d).expect("serialisable"));
+        }
+        Command::Diagnose { names, max_wall } => {
+            for name in names {
+                let inst = corpus::instance(&name)
+                    .ok_or_else(|| CorpusError::UnknownInstance(name.clone()))?;
+                let mut compiled = inst.build()?.compile()?;
+                let sol = nlp::Ipm::new(run::options(max_wall)).solve(&mut compiled)?;
+                let d = corpus::diagnose::diagnose(&sol);
+                let line = serde_json::json!({"instance": name, "status": format!("{:?}", sol.status), "diagnosis": d});
+                println!("{line}");
+            }
         }
         Command::Report { file, svg_dir } => {
             let text = std::fs::read_to_string(&file)
