@@ -180,19 +180,35 @@ fn real_main() -> Result<(), CorpusError> {
                     std::fs::write(&path, body)
                         .map_err(|e| CorpusError::Results(format!("{path}: {e}")))
                 };
-                let it = profile::ratios(&rows, |s| s.iterations);
-                write(
-                    "corpus_profile_iterations.svg",
-                    profile::svg("Performance profile: iterations", &it),
-                )?;
-                let tm = profile::ratios(&rows, |s| s.seconds);
-                write(
-                    "corpus_profile_time.svg",
-                    profile::svg(
-                        "Performance profile: solve wall time (provisional, noisy machine)",
-                        &tm,
+                type Metric = fn(&profile::SolverResult) -> f64;
+                let metrics: [(&str, &str, Metric); 2] = [
+                    ("iterations", "Performance profile: iterations", |s| {
+                        s.iterations
+                    }),
+                    (
+                        "time",
+                        "Performance profile: solve wall time (provisional: shared, noisy machine)",
+                        |s| s.seconds,
                     ),
-                )?;
+                ];
+                for (file, title, metric) in metrics {
+                    let panels: Vec<(String, [Vec<f64>; 2])> =
+                        [("Ocp", "optimal control"), ("Cute", "CUTEst-style")]
+                            .iter()
+                            .map(|(kind, label)| {
+                                let part: Vec<_> =
+                                    rows.iter().filter(|r| r.kind == *kind).cloned().collect();
+                                (
+                                    format!("{label} ({} instances)", part.len()),
+                                    profile::ratios(&part, metric),
+                                )
+                            })
+                            .collect();
+                    write(
+                        &format!("corpus_profile_{file}.svg"),
+                        profile::svg(title, &panels),
+                    )?;
+                }
             }
             for kind in ["Ocp", "Cute"] {
                 let part: Vec<_> = rows.iter().filter(|r| r.kind == kind).cloned().collect();

@@ -124,9 +124,34 @@ pub fn ratios(rows: &[Row], metric: fn(&SolverResult) -> f64) -> [Vec<f64>; 2] {
     out
 }
 
-/// A Dolan–Moré profile of the two solvers as a standalone SVG document.
-pub fn svg(title: &str, ratios: &[Vec<f64>; 2]) -> String {
-    let (w, h, left, right, top, bottom) = (640.0, 400.0, 60.0, 20.0, 40.0, 50.0);
+/// Dolan–Moré profiles of the two solvers as one standalone SVG document: one panel per
+/// `(title, ratios)`, side by side, under a common `title`.
+pub fn svg(title: &str, panels: &[(String, [Vec<f64>; 2])]) -> String {
+    let (w, h) = (640.0, 420.0);
+    let mut s = String::new();
+    let total = w * panels.len() as f64;
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{total}" height="{h}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(s, r#"<rect width="{total}" height="{h}" fill="white"/>"#);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="20" text-anchor="middle" font-size="15">{title}</text>"#,
+        total / 2.0
+    );
+    for (k, (name, ratios)) in panels.iter().enumerate() {
+        let _ = writeln!(s, r#"<g transform="translate({},20)">"#, w * k as f64);
+        panel(&mut s, name, ratios, w, h - 20.0);
+        s.push_str("</g>\n");
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// One profile panel of size `w × h` at the origin.
+fn panel(s: &mut String, title: &str, ratios: &[Vec<f64>; 2], w: f64, h: f64) {
+    let (left, right, top, bottom) = (60.0, 20.0, 30.0, 50.0);
     let finite_max = ratios
         .iter()
         .flatten()
@@ -136,15 +161,9 @@ pub fn svg(title: &str, ratios: &[Vec<f64>; 2]) -> String {
     let xmax = finite_max.log2().ceil().clamp(1.0, 12.0);
     let px = |t: f64| left + (w - left - right) * (t / xmax);
     let py = |rho: f64| top + (h - top - bottom) * (1.0 - rho);
-    let mut s = String::new();
     let _ = writeln!(
         s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="22" text-anchor="middle" font-size="14">{title}</text>"#,
+        r#"<text x="{}" y="18" text-anchor="middle" font-size="13">{title}</text>"#,
         w / 2.0
     );
     for k in 0..=xmax as usize {
@@ -193,10 +212,10 @@ pub fn svg(title: &str, ratios: &[Vec<f64>; 2]) -> String {
             .filter(|(_, x)| x.is_finite() && **x > 1.0)
         {
             let t = x.log2().min(xmax);
-            points.push((t, points.last().unwrap().1));
+            points.push((t, points.last().expect("not empty").1));
             points.push((t, (i + 1) as f64 / np));
         }
-        points.push((xmax, points.last().unwrap().1));
+        points.push((xmax, points.last().expect("not empty").1));
         let path: Vec<String> = points
             .iter()
             .map(|&(t, rho)| format!("{:.1},{:.1}", px(t), py(rho)))
@@ -219,8 +238,6 @@ pub fn svg(title: &str, ratios: &[Vec<f64>; 2]) -> String {
             names[k]
         );
     }
-    s.push_str("</svg>\n");
-    s
 }
 
 fn cell(r: &SolverResult) -> String {
