@@ -61,6 +61,9 @@ enum Command {
         /// Wall-time cap per solve in seconds.
         #[arg(long, default_value_t = 600.0)]
         max_wall: f64,
+        /// The IPM's print level (5: IPOPT-style iteration table on stdout, before the summary).
+        #[arg(long, default_value_t = 0)]
+        print_level: u8,
     },
     /// Prints the markdown table and summary of a results file and writes the profiles.
     Report {
@@ -159,12 +162,13 @@ fn real_main() -> Result<(), CorpusError> {
             }
             println!("{}", serde_json::to_string(&d).expect("serialisable"));
         }
-        Command::Diagnose { names, max_wall } => {
+        Command::Diagnose { names, max_wall, print_level } => {
             for name in names {
                 let inst = corpus::instance(&name)
                     .ok_or_else(|| CorpusError::UnknownInstance(name.clone()))?;
                 let mut compiled = inst.build()?.compile()?;
-                let sol = nlp::Ipm::new(run::options(max_wall)).solve(&mut compiled)?;
+                let options = nlp::IpmOptions { print_level, ..run::options(max_wall) };
+                let sol = nlp::Ipm::new(options).solve(&mut compiled)?;
                 let d = corpus::diagnose::diagnose(&sol);
                 let line = serde_json::json!({"instance": name, "status": format!("{:?}", sol.status), "diagnosis": d});
                 println!("{line}");
