@@ -162,12 +162,19 @@ fn real_main() -> Result<(), CorpusError> {
             }
             println!("{}", serde_json::to_string(&d).expect("serialisable"));
         }
-        Command::Diagnose { names, max_wall, print_level } => {
+        Command::Diagnose {
+            names,
+            max_wall,
+            print_level,
+        } => {
             for name in names {
                 let inst = corpus::instance(&name)
                     .ok_or_else(|| CorpusError::UnknownInstance(name.clone()))?;
                 let mut compiled = inst.build()?.compile()?;
-                let options = nlp::IpmOptions { print_level, ..run::options(max_wall) };
+                let options = nlp::IpmOptions {
+                    print_level,
+                    ..run::options(max_wall)
+                };
                 let sol = nlp::Ipm::new(options).solve(&mut compiled)?;
                 let d = corpus::diagnose::diagnose(&sol);
                 let line = serde_json::json!({"instance": name, "status": format!("{:?}", sol.status), "diagnosis": d});
