@@ -198,8 +198,13 @@ fn column(pattern: &SymbolicSparseColMat<usize>, values: &[f64], c: usize) -> Ve
     d
 }
 
-fn in_pattern(pattern: &SymbolicSparseColMat<usize>, r: usize, c: usize) -> bool {
-    pattern.col_range(c).any(|p| pattern.row_idx()[p] == r)
+/// Which rows of column `c` are in the pattern.
+fn column_mask(pattern: &SymbolicSparseColMat<usize>, c: usize) -> Vec<bool> {
+    let mut mask = vec![false; pattern.nrows()];
+    for p in pattern.col_range(c) {
+        mask[pattern.row_idx()[p]] = true;
+    }
+    mask
 }
 
 fn finite(what: &'static str, v: &[f64]) -> Result<(), DerivativeCheckError> {
@@ -311,6 +316,7 @@ fn first_order(
         nlp.eval_g(&xp, &mut gm);
         xp[j] = x[j];
         let jac = column(&pattern, &values, j);
+        let mask = column_mask(&pattern, j);
         let fd = (fp - fm) / (2.0 * h);
         out.push(Mismatch {
             derivative: Derivative::Gradient,
@@ -326,7 +332,7 @@ fn first_order(
         });
         for i in 0..m {
             let fd = (gp[i] - gm[i]) / (2.0 * h);
-            let structural = in_pattern(&pattern, i, j);
+            let structural = mask[i];
             if !structural && fd.abs() <= options.tol {
                 continue;
             }
@@ -415,8 +421,9 @@ fn second_order(
     for k in 0..n {
         let fd_column = fd_hessian_column(nlp, x, k, sigma, lambda, options.perturbation);
         let hess = column(&pattern, &values, k);
+        let mask = column_mask(&pattern, k);
         for (j, &fd) in fd_column.iter().enumerate().skip(k) {
-            let structural = in_pattern(&pattern, j, k);
+            let structural = mask[j];
             let error = relative_error(hess[j], fd);
             max_error = max_error.max(error);
             if error > options.tol {
