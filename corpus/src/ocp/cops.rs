@@ -381,3 +381,118 @@ pub fn channel(nh: usize) -> Result<Problem, BuildError> {
     pb.minimize(Expr::constant(1.0));
     Ok(pb)
 }
+
+/// α-pinene isomerisation: estimate the 5 rate constants of a linear reaction network from 8
+/// measurements of 5 species, 3-point Gauss collocation on `nh` intervals of [0, 36420].
+/// n = 50·nh + 5.
+pub fn pinene(nh: usize) -> Result<Problem, BuildError> {
+    const NC: usize = 3;
+    const NE: usize = 5;
+    let rho: [f64; 3] = [0.11270166537926, 0.5, 0.88729833462074];
+    let bc = [100.0, 0.0, 0.0, 0.0, 0.0];
+    let tau = [
+        1230.0, 3060.0, 4920.0, 7800.0, 10680.0, 15030.0, 22620.0, 36420.0,
+    ];
+    let z = [
+        [88.35, 7.3, 2.3, 0.4, 1.75],
+        [76.4, 15.6, 4.5, 0.7, 2.8],
+        [65.1, 23.1, 5.3, 1.1, 5.8],
+        [50.4, 32.9, 6.0, 1.5, 9.3],
+        [37.5, 42.7, 6.0, 1.9, 12.0],
+        [25.9, 49.1, 5.9, 2.2, 17.0],
+        [14.0, 57.4, 5.1, 2.6, 21.0],
+        [4.5, 63.1, 3.8, 2.9, 25.7],
+    ];
+    let h = tau[7] / nh as f64;
+    // itau[j]: the (0-based) interval holding measurement j.
+    let itau: Vec<usize> = tau
+        .iter()
+        .map(|&t| ((t / h).floor() as usize).min(nh - 1))
+        .collect();
+    // COPS's start: each interval takes the value of the next measurement (bc before the first).
+    let v0 = |i: usize, s: usize| match itau.iter().position(|&k| i <= k) {
+        Some(0) => bc[s],
+        Some(j) => z[j][s],
+        None => z[7][s],
+    };
+    let mut pb = Problem::new();
+    let theta = pb.variable("theta", 5);
+    pb.set_bounds(&theta, 0.0, f64::INFINITY)?;
+    let v = pb.variable("v", nh * NE);
+    let w = pb.variable("w", nh * NC * NE);
+    let uc = pb.variable("uc", nh * NC * NE);
+    let duc = pb.variable("Duc", nh * NC * NE);
+    let (iv, iw) = (
+        |i: usize, s: usize| NE * i + s,
+        |i: usize, j: usize, s: usize| NE * (NC * i + j) + s,
+    );
+    pb.set_initial(
+        &v,
+        &(0..nh * NE).map(|k| v0(k / NE, k % NE)).collect::<Vec<_>>(),
+    )?;
+    pb.set_initial(
+        &uc,
+        &(0..nh * NC * NE)
+            .map(|k| v0(k / (NC * NE), k % NE))
+            .collect::<Vec<_>>(),
+    )?;
+    let mut f = Expr::zero();
+    for (j, &t) in tau.iter().enumerate() {
+        let i = itau[j];
+        let dt = t - i as f64 * h;
+        for s in 0..NE {
+            let mut e = v[iv(i, s)] - z[j][s];
+            for k in 0..NC {
+                e += w[iw(i, k, s)]
+                    * (dt.powi(k as i32 + 1) / (factorial(k + 1) * h.powi(k as i32)));
+            }
+            f += e.sq();
+        }
+    }
+    pb.minimize(f);
+    let mut rows = Vec::new();
+    for i in 0..nh {
+        for j in 0..NC {
+            for s in 0..NE {
+                let (mut u, mut du) = (v[iv(i, s)], Expr::zero());
+                for k in 0..NC {
+                    u += h * w[iw(i, k, s)] * (rho[j].powi(k as i32 + 1) / factorial(k + 1));
+                    du += w[iw(i, k, s)] * (rho[j].powi(k as i32) / factorial(k));
+                }
+                rows.push((uc[iw(i, j, s)] - u).eq(0.0));
+                rows.push((duc[iw(i, j, s)] - du).eq(0.0));
+            }
+        }
+    }
+    pb.subject_to_named("collocation", Constraint::all(rows))?;
+    fix(
+        &mut pb,
+        &(0..NE).map(|s| v[iv(0, s)]).collect::<Vec<_>>(),
+        &bc,
+    )?;
+    for i in 0..nh - 1 {
+        for s in 0..NE {
+            let mut e = v[iv(i, s)];
+            for k in 0..NC {
+                e += w[iw(i, k, s)] * h / factorial(k + 1);
+            }
+            pb.subject_to_named("continuity", (e - v[iv(i + 1, s)]).eq(0.0))?;
+        }
+    }
+    let th = |k: usize| theta[k];
+    for i in 0..nh {
+        for j in 0..NC {
+            let (u, du) = (|s: usize| uc[iw(i, j, s)], |s: usize| duc[iw(i, j, s)]);
+            let rhs = [
+                -(th(0) + th(1)) * u(0),
+                th(0) * u(0),
+                th(1) * u(0) - (th(2) + th(3)) * u(2) + th(4) * u(4),
+                th(2) * u(2),
+                th(3) * u(2) - th(4) * u(4),
+            ];
+            let rows = (0..NE).map(|s| (du(s) - rhs[s]).eq(0.0));
+            pb.subject_to_named("ode", Constraint::all(rows))?;
+        }
+    }
+    Ok(pb)
+}

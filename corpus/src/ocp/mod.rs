@@ -2,7 +2,7 @@
 //!
 //! - [`cops`]: the control problems of COPS 3.0 (Dolan, Moré, Munson, "Benchmarking
 //!   optimization software with COPS 3.0", Argonne ANL/MCS-TM-273, 2004), in COPS's own
-//!   transcriptions (trapezoidal rule, or Gauss collocation for catmix and channel);
+//!   transcriptions (trapezoidal rule, or Gauss collocation for catmix, channel and pinene);
 //! - [`casadi`]: CasADi's examples (race car, Van der Pol);
 //! - [`robotics`]: cart-pole swing-up, planar quadrotor point to point, two-link arm in
 //!   minimum time.
@@ -128,6 +128,15 @@ pub static FAMILIES: &[Family] = &[
         sizes: &[100, 250, 500],
         build: cops::channel,
         references: &[],
+    },
+    Family {
+        name: "pinene_colloc",
+        kind: Kind::Ocp,
+        transcription: "collocation",
+        source: "COPS 3.0 §12 α-pinene isomerisation (parameter estimation, 3-point Gauss collocation); statement and data read in MadNLP/COPSBenchmark.jl ext/COPSBenchmarkJuMP/pinene.jl",
+        sizes: &[100, 200, 400],
+        build: cops::pinene,
+        references: &[Reference { size: 100, value: 1.98721e1, source: COPS_OPTIMA }],
     },
     Family {
         name: "race_car_rk4",
