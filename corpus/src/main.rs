@@ -209,9 +209,14 @@ fn real_main() -> Result<(), CorpusError> {
                             .map(|(kind, label)| {
                                 let part: Vec<_> =
                                     rows.iter().filter(|r| r.kind == *kind).cloned().collect();
+                                let r = profile::ratios(&part, metric);
+                                let n = (r[0].len(), part.len());
                                 (
-                                    format!("{label} ({} instances)", part.len()),
-                                    profile::ratios(&part, metric),
+                                    format!(
+                                        "{label}: {} of {} instances solved by either",
+                                        n.0, n.1
+                                    ),
+                                    r,
                                 )
                             })
                             .collect();
