@@ -119,7 +119,7 @@ pub fn dump(
         .iter()
         .enumerate()
         .map(|(i, e)| ConstraintDump {
-            name: pb.constraint_name(i),
+            name: compiled.constraint_name(i),
             expr: e.to_string(),
             lower: finite(gl[i]),
             upper: finite(gu[i]),

@@ -225,7 +225,7 @@ fn bad_arguments_are_errors() {
 fn compiled_problem_passes() {
     // symx's exact derivatives of a problem with every kind of row.
     let mut pb = Problem::new();
-    let x = pb.variable("x", 4);
+    let x = pb.variable("x", 4).unwrap();
     pb.minimize((x[0] - x[1]).sq() * x[2].exp() + (x[3] * x[0]).sin());
     pb.subject_to_named("ball", (x[0].sq() + x[1].sq() + x[2].sq()).le(4.0))
         .unwrap();

@@ -55,9 +55,9 @@ pub fn clnlbeam(n: usize) -> Result<Problem, BuildError> {
     let big_n = n / 3 - 1;
     let (h, alpha) = (1.0 / big_n as f64, 350.0);
     let mut pb = Problem::new();
-    let t = pb.variable("t", big_n + 1);
-    let x = pb.variable("x", big_n + 1);
-    let u = pb.variable("u", big_n + 1);
+    let t = pb.variable("t", big_n + 1)?;
+    let x = pb.variable("x", big_n + 1)?;
+    let u = pb.variable("u", big_n + 1)?;
     pb.set_bounds(&t, -1.0, 1.0)?;
     pb.set_bounds(&x, -0.05, 0.05)?;
     pb.minimize(sum(0..big_n, |i| {
@@ -75,9 +75,9 @@ pub fn clnlbeam(n: usize) -> Result<Problem, BuildError> {
 pub fn hovercraft1d(n: usize) -> Result<Problem, BuildError> {
     let t = n / 3;
     let mut pb = Problem::new();
-    let x = pb.variable("x", t);
-    let v = pb.variable("v", t);
-    let u = pb.variable("u", t - 1);
+    let x = pb.variable("x", t)?;
+    let v = pb.variable("v", t)?;
+    let u = pb.variable("u", t - 1)?;
     pb.set_bounds(&[x[0], v[0], v[t - 1]], 0.0, 0.0)?;
     pb.set_bounds(&[x[t - 1]], 100.0, 100.0)?;
     pb.subject_to_named(
@@ -97,8 +97,8 @@ pub fn controlinvestment(n: usize) -> Result<Problem, BuildError> {
     let big_n = n / 2;
     let (h, gamma) = (1.0 / big_n as f64, 3.0);
     let mut pb = Problem::new();
-    let x = pb.variable("x", big_n);
-    let u = pb.variable("u", big_n);
+    let x = pb.variable("x", big_n)?;
+    let u = pb.variable("u", big_n)?;
     pb.set_initial(&x, &vec![1.0; big_n])?;
     pb.set_bounds(&u, 0.0, 1.0)?;
     pb.set_bounds(&[x[0]], 1.0, 1.0)?;
@@ -146,7 +146,7 @@ pub fn torsion(nx: usize) -> Result<Problem, BuildError> {
     let dist =
         |i: usize, j: usize| ((i.min(nx + 1 - i) as f64) * h).min((j.min(nx + 1 - j) as f64) * h);
     let mut pb = Problem::new();
-    let v = pb.variable("v", g * g);
+    let v = pb.variable("v", g * g)?;
     let at = |i: usize, j: usize| v[i * g + j];
     for i in 0..g {
         for j in 0..g {
@@ -183,10 +183,10 @@ pub fn chain(nh: usize) -> Result<Problem, BuildError> {
     let s = |k: usize| k as f64 / nh as f64;
     let u0 = |k: usize| 4.0 * (b - a) * (s(k) - tmin);
     let x10 = |k: usize| 4.0 * (b - a) * s(k) * (0.5 * s(k) - tmin) + a;
-    let u = pb.variable("u", nh + 1);
-    let x1 = pb.variable("x1", nh + 1);
-    let x2 = pb.variable("x2", nh + 1);
-    let x3 = pb.variable("x3", nh + 1);
+    let u = pb.variable("u", nh + 1)?;
+    let x1 = pb.variable("x1", nh + 1)?;
+    let x2 = pb.variable("x2", nh + 1)?;
+    let x3 = pb.variable("x3", nh + 1)?;
     pb.set_initial(&u, &(1..=nh + 1).map(u0).collect::<Vec<_>>())?;
     pb.set_initial(&x1, &(1..=nh + 1).map(x10).collect::<Vec<_>>())?;
     pb.set_initial(

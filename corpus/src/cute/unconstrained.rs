@@ -12,7 +12,7 @@ pub(crate) fn vars(
     n: usize,
     x0: impl Fn(usize) -> f64,
 ) -> Result<Matrix, BuildError> {
-    let x = pb.variable("x", n);
+    let x = pb.variable("x", n)?;
     pb.set_initial(&x, &(1..=n).map(x0).collect::<Vec<_>>())?;
     Ok(x)
 }

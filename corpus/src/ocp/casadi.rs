@@ -11,10 +11,10 @@ use symx::Expr;
 /// variable vector per state (`pos`, `speed`). n = 3n + 3.
 pub fn race_car(n: usize) -> Result<Problem, BuildError> {
     let mut pb = Problem::new();
-    let pos = pb.variable("pos", n + 1);
-    let speed = pb.variable("speed", n + 1);
-    let u = pb.variable("U", n);
-    let t = pb.scalar_variable("T");
+    let pos = pb.variable("pos", n + 1)?;
+    let speed = pb.variable("speed", n + 1)?;
+    let u = pb.variable("U", n)?;
+    let t = pb.scalar_variable("T")?;
     pb.minimize(t);
     let dt = t / n as f64;
     for k in 0..n {
@@ -48,9 +48,9 @@ fn vdp_variables(
     n: usize,
     controls: usize,
 ) -> Result<[symx::Matrix; 3], BuildError> {
-    let x1 = pb.variable("x1", n + 1);
-    let x2 = pb.variable("x2", n + 1);
-    let u = pb.variable("u", controls);
+    let x1 = pb.variable("x1", n + 1)?;
+    let x2 = pb.variable("x2", n + 1)?;
+    let u = pb.variable("u", controls)?;
     pb.set_bounds(&u, -1.0, 1.0)?;
     pb.set_bounds(&x1, -0.25, f64::INFINITY)?;
     fix(pb, &[x1[0], x2[0]], &[0.0, 1.0])?;

@@ -15,11 +15,11 @@ pub fn rocket(nh: usize) -> Result<Problem, BuildError> {
     let dc = 0.5 * vc * m0 / g0;
     let tmax = tc * g0 * m0;
     let mut pb = Problem::new();
-    let h = pb.variable("h", nh + 1);
-    let v = pb.variable("v", nh + 1);
-    let m = pb.variable("m", nh + 1);
-    let t = pb.variable("T", nh + 1);
-    let step = pb.scalar_variable("step");
+    let h = pb.variable("h", nh + 1)?;
+    let v = pb.variable("v", nh + 1)?;
+    let m = pb.variable("m", nh + 1)?;
+    let t = pb.variable("T", nh + 1)?;
+    let step = pb.scalar_variable("step")?;
     pb.set_bounds(&h, 1.0, f64::INFINITY)?;
     pb.set_bounds(&v, 0.0, f64::INFINITY)?;
     pb.set_bounds(&m, mf, m0)?;
@@ -66,12 +66,12 @@ pub fn glider(nh: usize) -> Result<Problem, BuildError> {
     let (c0, c1, area, rho) = (0.034, 0.069662, 14.0, 1.13);
     let (cl_min, cl_max) = (0.0, 1.4);
     let mut pb = Problem::new();
-    let tf = pb.scalar_variable("t_f");
-    let x = pb.variable("x", nh + 1);
-    let y = pb.variable("y", nh + 1);
-    let vx = pb.variable("vx", nh + 1);
-    let vy = pb.variable("vy", nh + 1);
-    let cl = pb.variable("cL", nh + 1);
+    let tf = pb.scalar_variable("t_f")?;
+    let x = pb.variable("x", nh + 1)?;
+    let y = pb.variable("y", nh + 1)?;
+    let vx = pb.variable("vx", nh + 1)?;
+    let vy = pb.variable("vy", nh + 1)?;
+    let cl = pb.variable("cL", nh + 1)?;
     pb.set_bounds(&[tf], 0.0, f64::INFINITY)?;
     pb.set_bounds(&x, 0.0, f64::INFINITY)?;
     pb.set_bounds(&vx, 0.0, f64::INFINITY)?;
@@ -119,12 +119,12 @@ pub fn glider(nh: usize) -> Result<Problem, BuildError> {
 pub fn steering(nh: usize) -> Result<Problem, BuildError> {
     let a = 100.0;
     let mut pb = Problem::new();
-    let u = pb.variable("u", nh + 1);
-    let x1 = pb.variable("x1", nh + 1);
-    let x2 = pb.variable("x2", nh + 1);
-    let x3 = pb.variable("x3", nh + 1);
-    let x4 = pb.variable("x4", nh + 1);
-    let tf = pb.scalar_variable("tf");
+    let u = pb.variable("u", nh + 1)?;
+    let x1 = pb.variable("x1", nh + 1)?;
+    let x2 = pb.variable("x2", nh + 1)?;
+    let x3 = pb.variable("x3", nh + 1)?;
+    let x4 = pb.variable("x4", nh + 1)?;
+    let tf = pb.scalar_variable("tf")?;
     let half_pi = std::f64::consts::FRAC_PI_2;
     pb.set_bounds(&u, -half_pi, half_pi)?;
     pb.set_bounds(&[tf], 0.0, f64::INFINITY)?;
@@ -152,16 +152,16 @@ pub fn robot(nh: usize) -> Result<Problem, BuildError> {
     let len = 5.0;
     let (rho0, phi0) = (4.5, PI / 4.0);
     let mut pb = Problem::new();
-    let rho = pb.variable("rho", nh + 1);
-    let the = pb.variable("the", nh + 1);
-    let phi = pb.variable("phi", nh + 1);
-    let rho_dot = pb.variable("rho_dot", nh + 1);
-    let the_dot = pb.variable("the_dot", nh + 1);
-    let phi_dot = pb.variable("phi_dot", nh + 1);
-    let u_rho = pb.variable("u_rho", nh + 1);
-    let u_the = pb.variable("u_the", nh + 1);
-    let u_phi = pb.variable("u_phi", nh + 1);
-    let tf = pb.scalar_variable("tf");
+    let rho = pb.variable("rho", nh + 1)?;
+    let the = pb.variable("the", nh + 1)?;
+    let phi = pb.variable("phi", nh + 1)?;
+    let rho_dot = pb.variable("rho_dot", nh + 1)?;
+    let the_dot = pb.variable("the_dot", nh + 1)?;
+    let phi_dot = pb.variable("phi_dot", nh + 1)?;
+    let u_rho = pb.variable("u_rho", nh + 1)?;
+    let u_the = pb.variable("u_the", nh + 1)?;
+    let u_phi = pb.variable("u_phi", nh + 1)?;
+    let tf = pb.scalar_variable("tf")?;
     pb.set_bounds(&rho, 0.0, len)?;
     pb.set_bounds(&the, -PI, PI)?;
     pb.set_bounds(&phi, 0.0, PI)?;
@@ -226,12 +226,12 @@ pub fn catmix(nh: usize) -> Result<Problem, BuildError> {
     let rho: [f64; 3] = [0.11270166537926, 0.5, 0.88729833462074];
     let h = 1.0 / nh as f64;
     let mut pb = Problem::new();
-    let u = pb.variable("u", nh * NC);
-    let v = pb.variable("v", nh * 2);
-    let w = pb.variable("w", nh * NC * 2);
-    let pp = pb.variable("pp", nh * NC * 2);
-    let dpp = pb.variable("Dpp", nh * NC * 2);
-    let ppf = pb.variable("ppf", 2);
+    let u = pb.variable("u", nh * NC)?;
+    let v = pb.variable("v", nh * 2)?;
+    let w = pb.variable("w", nh * NC * 2)?;
+    let pp = pb.variable("pp", nh * NC * 2)?;
+    let dpp = pb.variable("Dpp", nh * NC * 2)?;
+    let ppf = pb.variable("ppf", 2)?;
     pb.set_bounds(&u, 0.0, 1.0)?;
     // COPS starts v, pp and ppf at mod(s, 2): 1 for species 1, 0 for species 2.
     let start = |len: usize| {
@@ -306,10 +306,10 @@ pub fn channel(nh: usize) -> Result<Problem, BuildError> {
     ];
     let h = 1.0 / nh as f64;
     let mut pb = Problem::new();
-    let v = pb.variable("v", nh * ND);
-    let w = pb.variable("w", nh * NC);
-    let uc = pb.variable("uc", nh * NC * ND);
-    let duc = pb.variable("Duc", nh * NC * ND);
+    let v = pb.variable("v", nh * ND)?;
+    let w = pb.variable("w", nh * NC)?;
+    let uc = pb.variable("uc", nh * NC * ND)?;
+    let duc = pb.variable("Duc", nh * NC * ND)?;
     let (iv, iu) = (
         |i: usize, s: usize| ND * i + s,
         |i: usize, j: usize, s: usize| ND * (NC * i + j) + s,
@@ -416,12 +416,12 @@ pub fn pinene(nh: usize) -> Result<Problem, BuildError> {
         None => z[7][s],
     };
     let mut pb = Problem::new();
-    let theta = pb.variable("theta", 5);
+    let theta = pb.variable("theta", 5)?;
     pb.set_bounds(&theta, 0.0, f64::INFINITY)?;
-    let v = pb.variable("v", nh * NE);
-    let w = pb.variable("w", nh * NC * NE);
-    let uc = pb.variable("uc", nh * NC * NE);
-    let duc = pb.variable("Duc", nh * NC * NE);
+    let v = pb.variable("v", nh * NE)?;
+    let w = pb.variable("w", nh * NC * NE)?;
+    let uc = pb.variable("uc", nh * NC * NE)?;
+    let duc = pb.variable("Duc", nh * NC * NE)?;
     let (iv, iw) = (
         |i: usize, s: usize| NE * i + s,
         |i: usize, j: usize, s: usize| NE * (NC * i + j) + s,

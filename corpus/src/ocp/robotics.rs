@@ -24,10 +24,10 @@ fn cartpole_rhs(x: &[Expr], u: Expr) -> Vec<Expr> {
 /// initial guess (positions interpolated linearly, velocities and force zero).
 fn cartpole_states(pb: &mut Problem, n: usize) -> Result<[symx::Matrix; 4], BuildError> {
     let (.., d, dmax, _) = CP;
-    let q1 = pb.variable("q1", n + 1);
-    let q2 = pb.variable("q2", n + 1);
-    let dq1 = pb.variable("dq1", n + 1);
-    let dq2 = pb.variable("dq2", n + 1);
+    let q1 = pb.variable("q1", n + 1)?;
+    let q2 = pb.variable("q2", n + 1)?;
+    let dq1 = pb.variable("dq1", n + 1)?;
+    let dq2 = pb.variable("dq2", n + 1)?;
     pb.set_bounds(&q1, -dmax, dmax)?;
     let s = |k: usize| k as f64 / n as f64;
     pb.set_initial(&q1, &(0..=n).map(|k| d * s(k)).collect::<Vec<_>>())?;
@@ -42,7 +42,7 @@ pub fn cartpole_trap(n: usize) -> Result<Problem, BuildError> {
     let (.., t, _, _, umax) = CP;
     let mut pb = Problem::new();
     let [q1, q2, dq1, dq2] = cartpole_states(&mut pb, n)?;
-    let u = pb.variable("u", n + 1);
+    let u = pb.variable("u", n + 1)?;
     pb.set_bounds(&u, -umax, umax)?;
     let h = t / n as f64;
     let states: [&[Expr]; 4] = [&q1, &q2, &dq1, &dq2];
@@ -63,7 +63,7 @@ pub fn cartpole_rk4(n: usize) -> Result<Problem, BuildError> {
     let (.., t, _, _, umax) = CP;
     let mut pb = Problem::new();
     let [q1, q2, dq1, dq2] = cartpole_states(&mut pb, n)?;
-    let u = pb.variable("u", n);
+    let u = pb.variable("u", n)?;
     pb.set_bounds(&u, -umax, umax)?;
     let h = t / n as f64;
     let states: [&[Expr]; 4] = [&q1, &q2, &dq1, &dq2];
@@ -89,9 +89,12 @@ pub fn quadrotor_rk4(n: usize) -> Result<Problem, BuildError> {
     let (goal, centre, radius) = ([4.0, 2.0], [2.0, 1.1], 0.5);
     let mut pb = Problem::new();
     let names = ["px", "py", "theta", "vx", "vy", "omega"];
-    let states: Vec<symx::Matrix> = names.iter().map(|s| pb.variable(s, n + 1)).collect();
-    let u1 = pb.variable("u1", n);
-    let u2 = pb.variable("u2", n);
+    let states = names
+        .iter()
+        .map(|s| pb.variable(s, n + 1))
+        .collect::<Result<Vec<symx::Matrix>, _>>()?;
+    let u1 = pb.variable("u1", n)?;
+    let u2 = pb.variable("u2", n)?;
     pb.set_bounds(&u1, 0.0, 2.0 * mass * g)?;
     pb.set_bounds(&u2, 0.0, 2.0 * mass * g)?;
     pb.set_initial(&u1, &vec![mass * g / 2.0; n])?;
@@ -143,10 +146,13 @@ pub fn arm2_trap(n: usize) -> Result<Problem, BuildError> {
     let goal = [PI / 2.0, PI / 2.0];
     let mut pb = Problem::new();
     let names = ["q1", "q2", "dq1", "dq2"];
-    let states: Vec<symx::Matrix> = names.iter().map(|s| pb.variable(s, n + 1)).collect();
-    let tau1 = pb.variable("tau1", n + 1);
-    let tau2 = pb.variable("tau2", n + 1);
-    let tf = pb.scalar_variable("tf");
+    let states = names
+        .iter()
+        .map(|s| pb.variable(s, n + 1))
+        .collect::<Result<Vec<symx::Matrix>, _>>()?;
+    let tau1 = pb.variable("tau1", n + 1)?;
+    let tau2 = pb.variable("tau2", n + 1)?;
+    let tf = pb.scalar_variable("tf")?;
     pb.set_bounds(&tau1, -1.0, 1.0)?;
     pb.set_bounds(&tau2, -1.0, 1.0)?;
     pb.set_bounds(&[tf], 0.0, f64::INFINITY)?;
