@@ -215,6 +215,9 @@ fn compare(prefix: &str, got: BTreeMap<String, Record>) {
     );
 }
 
+/// A solve of a compiled problem by one back end.
+type SolveFn = fn(&mut Compiled) -> Result<Solution, SolveError>;
+
 fn solve_ipm(c: &mut Compiled) -> Result<Solution, SolveError> {
     Ipm::new(IpmOptions::default()).solve(c)
 }
@@ -223,7 +226,7 @@ fn solve_sqp(c: &mut Compiled) -> Result<Solution, SolveError> {
     Sqp::new(SqpOptions::default()).solve(c)
 }
 
-fn hs(backend: &str, solve: fn(&mut Compiled) -> Result<Solution, SolveError>) {
+fn hs(backend: &str, solve: SolveFn) {
     let mut got = BTreeMap::new();
     for &(name, build) in SUITE {
         let rec = fresh(move || record_of(harness::run(name, build, solve).result));
@@ -279,7 +282,7 @@ fn mpcc() {
 fn socp() {
     let mut got = BTreeMap::new();
     for &(name, build) in socp_problems::ALL {
-        for (key, solve) in [("ipm", solve_ipm as fn(&mut _) -> _), ("sqp", solve_sqp)] {
+        for (key, solve) in [("ipm", solve_ipm as SolveFn), ("sqp", solve_sqp)] {
             let rec = fresh(move || {
                 let mut c = build().compile().expect("compiles");
                 record_of(solve(&mut c))
@@ -296,7 +299,10 @@ fn race_car() {
         let (sol, _) = race_car::solve(100, IpmOptions::default()).expect("builds and solves");
         record(&sol)
     });
-    compare("race_car/", BTreeMap::from([("race_car/ipm/n100".into(), rec)]));
+    compare(
+        "race_car/",
+        BTreeMap::from([("race_car/ipm/n100".into(), rec)]),
+    );
 }
 
 #[test]

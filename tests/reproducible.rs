@@ -73,9 +73,15 @@ fn check(name: &str, build: fn() -> Built, backend: Backend) {
         let d = s.spawn(|| trace(build, backend));
         (c.join().expect("thread"), d.join().expect("thread"))
     });
-    assert!(!a.iterates.is_empty(), "{name}: the callback saw no iterate");
+    assert!(
+        !a.iterates.is_empty(),
+        "{name}: the callback saw no iterate"
+    );
     for (what, t) in [("same thread", &b), ("thread 1", &c), ("thread 2", &d)] {
-        assert_eq!(a.status, t.status, "{name} {backend:?}: status differs ({what})");
+        assert_eq!(
+            a.status, t.status,
+            "{name} {backend:?}: status differs ({what})"
+        );
         assert_eq!(
             a.iterates.len(),
             t.iterates.len(),

@@ -3,10 +3,9 @@
 //! smooth form `√(‖v‖² + ε²) − t ≤ ε` (ε = 1e-8, an outer approximation: ‖v‖ − t ≤ ε);
 //! the SQP hands affine cones to clarabel as exact second-order cones and linearises the
 //! smooth row of the others.
-use symnlp::{nlp, symx};
+use symnlp::nlp;
 
 use nlp::{Ipm, IpmOptions, NumericNlp, Problem, Solution, Sqp, SqpOptions, Status};
-use symx::Expr;
 
 #[path = "socp/problems.rs"]
 mod problems;

@@ -10,7 +10,7 @@
 //! ```
 use symnlp::nlp;
 
-use nlp::{Sqp, SqpOptions, Status};
+use nlp::{CommonOptions, Sqp, SqpOptions, Status};
 
 #[path = "hs/problems.rs"]
 #[allow(dead_code)]
@@ -57,8 +57,12 @@ const KNOWN_FAILURES: &[(&str, Status, &str)] = &[
 
 fn sqp(name: &'static str, build: fn() -> Built, print_level: u8) -> Run {
     harness::run(name, build, |nlp| {
-        Sqp::new(SqpOptions {
+        let common = CommonOptions {
             print_level,
+            ..CommonOptions::default()
+        };
+        Sqp::new(SqpOptions {
+            common,
             ..SqpOptions::default()
         })
         .solve(nlp)

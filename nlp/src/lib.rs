@@ -4,15 +4,16 @@ pub mod callback;
 pub mod compiled;
 pub mod constraint;
 pub mod error;
+pub mod frontend;
 pub mod ipm;
-pub mod kkt;
-pub mod log;
+pub(crate) mod kkt;
+pub(crate) mod log;
 pub mod mpcc;
 pub mod numeric;
 pub mod option_names;
 pub mod options;
 pub mod problem;
-pub mod scaling;
+pub(crate) mod scaling;
 pub mod solution;
 pub mod sqp;
 
@@ -20,10 +21,11 @@ pub use callback::{IterationCallback, IterationView, PhaseLabel};
 pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
 pub use error::SolveError;
+pub use frontend::{CommonOptions, Solver};
 pub use ipm::Ipm;
 pub use problem::{Block, BuildError, ComplementarityReport, Problem};
 
-pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
+pub use log::{format_summary, format_table};
 pub use mpcc::{
     solve_mpcc, solve_mpcc_with_callback, MpccBackend, MpccError, MpccOptions, MpccPhase,
     MpccSolution,

@@ -55,9 +55,12 @@ pub fn non_affine_cone() -> Problem {
     pb
 }
 
+/// A problem's name and builder.
+pub type Entry = (&'static str, fn() -> Problem);
+
 /// Every problem with its name, in order.
 #[allow(dead_code)]
-pub const ALL: &[(&str, fn() -> Problem)] = &[
+pub const ALL: &[Entry] = &[
     ("unit_disc", unit_disc),
     ("distance_to_a_line", distance_to_a_line),
     ("distance_to_a_plane", distance_to_a_plane),

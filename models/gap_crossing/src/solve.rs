@@ -266,10 +266,10 @@ fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
         println!("\n== {}", solved.name);
     }
     if level >= 5 {
-        print!("{}", nlp::log::format_table(&solved.phase.records));
+        print!("{}", nlp::format_table(&solved.phase.records));
     }
     if level >= 3 {
-        print!("{}", nlp::log::format_summary(&solved.run.solution));
+        print!("{}", nlp::format_summary(&solved.run.solution));
     }
     phases.push(solved.phase);
     Run {

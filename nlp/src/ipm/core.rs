@@ -11,6 +11,7 @@
 use std::time::Instant;
 
 use crate::callback::Observer;
+use crate::frontend::{KktResiduals, Termination};
 use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, probing_mu, tau};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
@@ -157,8 +158,8 @@ pub(crate) struct Core<'p> {
     free_mode: bool,
     kkt_refs: Vec<f64>,
     tiny_count: usize,
-    acceptable_count: usize,
-    last_obj: f64,
+    /// The convergence test's state (acceptable streak, previous objective).
+    termination: Termination,
     setup_in_resto: bool,
     obj_scale: f64,
     g_scale: Vec<f64>,
@@ -352,8 +353,7 @@ impl<'p> Core<'p> {
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
             kkt_refs: Vec::new(),
             tiny_count: 0,
-            acceptable_count: 0,
-            last_obj: f64::INFINITY,
+            termination: Termination::default(),
             setup_in_resto: setup.in_resto,
             obj_scale: setup.obj_scale,
             g_scale: setup.g_scale.clone(),
@@ -1670,28 +1670,14 @@ impl<'p> Core<'p> {
             // ---------------- convergence
             let (e0, eu) = self.nlp_error(0.0, false);
             if !self.setup_in_resto {
-                let o = &self.opts;
-                if e0 <= o.tol
-                    && eu[0] <= o.dual_inf_tol
-                    && eu[1] <= o.constr_viol_tol
-                    && eu[2] <= o.compl_inf_tol
-                {
-                    return self.outcome(Status::SolveSucceeded, "", false);
-                }
-                let obj_change = (self.f - self.last_obj).abs() / self.f.abs().max(1.0);
-                if o.acceptable_iter > 0
-                    && e0 <= o.acceptable_tol
-                    && eu[0] <= o.acceptable_dual_inf_tol
-                    && eu[1] <= o.acceptable_constr_viol_tol
-                    && eu[2] <= o.acceptable_compl_inf_tol
-                    && obj_change <= o.acceptable_obj_change_tol
-                {
-                    self.acceptable_count += 1;
-                    if self.acceptable_count >= o.acceptable_iter {
-                        return self.outcome(Status::SolvedToAcceptableLevel, "", false);
-                    }
-                } else {
-                    self.acceptable_count = 0;
+                let e = KktResiduals {
+                    overall: e0,
+                    dual: eu[0],
+                    primal: eu[1],
+                    compl: eu[2],
+                };
+                if let Some(status) = self.termination.check(&e, self.f, &self.opts.common) {
+                    return self.outcome(status, "", false);
                 }
             } else if e0 <= self.opts.tol {
                 return self.outcome(
@@ -1699,8 +1685,9 @@ impl<'p> Core<'p> {
                     "restoration problem converged",
                     true,
                 );
+            } else {
+                self.termination.set_last_objective(self.f);
             }
-            self.last_obj = self.f;
             if shared.iter >= self.opts.max_iter {
                 return self.outcome(Status::MaximumIterationsExceeded, "", false);
             }
@@ -1783,7 +1770,7 @@ impl<'p> Core<'p> {
                 );
             }
             if self.m == 0 {
-                let status = if self.acceptable_count > 0 {
+                let status = if self.termination.last_was_acceptable() {
                     Status::SolvedToAcceptableLevel
                 } else {
                     Status::SearchDirectionBecomesTooSmall
