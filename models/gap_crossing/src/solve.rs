@@ -23,8 +23,8 @@ use crate::schedule_search::{self, StanceSolver};
 use crate::terrain::{GapTerrain, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
-    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError, Sqp,
-    SqpOptions, Status,
+    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError,
+    Solver, Sqp, SqpOptions, Status,
 };
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -109,15 +109,20 @@ impl Settings {
         }
     }
 
+    /// The chosen back end with its options.
+    pub fn solver(&self) -> Box<dyn Solver> {
+        match self.backend {
+            Backend::Ipm => Box::new(Ipm::new(self.ipm.clone())),
+            Backend::Sqp => Box::new(Sqp::new(self.sqp.clone())),
+        }
+    }
+
     fn solve(
         &self,
         nlp: &mut dyn NumericNlp,
-        callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
-        match self.backend {
-            Backend::Ipm => Ipm::new(self.ipm.clone()).solve_with_callback(nlp, callback),
-            Backend::Sqp => Sqp::new(self.sqp.clone()).solve_with_callback(nlp, callback),
-        }
+        self.solver().solve_with_callback(nlp, &mut callback)
     }
 }
 
