@@ -198,9 +198,9 @@ impl Run {
 }
 
 /// Runs every problem of `suite` (each in a fresh thread, as each `#[test]` runs: symx's
-/// expression arena is per thread, and a problem built after others gets another node
-/// order, hence other sparsity orderings and rounding), prints one JSON line per problem
-/// on stdout and a summary on stderr.
+/// expression arena is per thread; a problem built after others solves bit-identically,
+/// see `tests/reproducible.rs`, but a fresh thread keeps the arena small), prints one
+/// JSON line per problem on stdout and a summary on stderr.
 pub fn summary(suite: &[Entry], run_one: fn(&'static str, fn() -> Built) -> Run) {
     let mut iterations = Vec::new();
     let mut failed = Vec::new();
