@@ -71,10 +71,47 @@ pub(crate) struct Outcome {
     pub resto_converged: bool,
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum LsResult {
-    Accepted,
-    Failed,
+/// How the step of an accepted trial point was made (the log's character after
+/// alpha_pr: lower case for the plain step, upper case for a second-order correction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum StepKind {
+    /// f-type: the switching and Armijo conditions hold; the filter is not augmented.
+    FType { soc: bool },
+    /// h-type: the filter was augmented.
+    HType { soc: bool },
+}
+
+impl StepKind {
+    fn new(ftype: bool, soc: bool) -> StepKind {
+        if ftype {
+            StepKind::FType { soc }
+        } else {
+            StepKind::HType { soc }
+        }
+    }
+
+    fn log_char(self) -> char {
+        match self {
+            StepKind::FType { soc: false } => 'f',
+            StepKind::HType { soc: false } => 'h',
+            StepKind::FType { soc: true } => 'F',
+            StepKind::HType { soc: true } => 'H',
+        }
+    }
+}
+
+/// The outcome of [`Core::line_search`]; `trials` counts the trial step sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum LineSearch {
+    /// A trial point was accepted (and is now the iterate).
+    Accepted {
+        alpha_pr: f64,
+        alpha_du: f64,
+        kind: StepKind,
+        trials: usize,
+    },
+    /// Every step size down to α_min was rejected; `alpha_pr` is the last one tried.
+    Failed { alpha_pr: f64, trials: usize },
 }
 
 pub(crate) struct Core<'p> {
@@ -1406,8 +1443,8 @@ impl<'p> Core<'p> {
     }
 
     /// Backtracking filter line search with second-order corrections. On success the
-    /// trial point is accepted and (alpha_pr, alpha_du, char, ls) returned.
-    fn line_search(&mut self, shared: &mut Shared) -> (LsResult, f64, f64, char, usize) {
+    /// trial point is accepted.
+    fn line_search(&mut self, shared: &mut Shared) -> LineSearch {
         let theta = one_norm(&self.c);
         let phi = self.barrier(&self.w, self.f, self.mu);
         let gpd = self.barrier_dir_deriv(&self.dw);
@@ -1415,11 +1452,13 @@ impl<'p> Core<'p> {
         let alpha_min = self.alpha_min(theta, gpd);
         let mut alpha = alpha_max;
         let mut ls = 0usize;
-        let n = self.n;
         loop {
             // The first trial step is always tried, even below α_min (IPOPT).
             if ls > 0 && !(alpha > alpha_min) {
-                return (LsResult::Failed, alpha, 0.0, ' ', ls);
+                return LineSearch::Failed {
+                    alpha_pr: alpha,
+                    trials: ls,
+                };
             }
             ls += 1;
             for j in 0..self.nw {
@@ -1438,13 +1477,12 @@ impl<'p> Core<'p> {
                         let alpha_du = self.max_step_dual(&self.dzl, &self.dzu, self.tau);
                         self.take_dual_step(alpha_du, false);
                         self.accept_trial();
-                        return (
-                            LsResult::Accepted,
-                            alpha,
+                        return LineSearch::Accepted {
+                            alpha_pr: alpha,
                             alpha_du,
-                            if ftype { 'f' } else { 'h' },
-                            ls,
-                        );
+                            kind: StepKind::new(ftype, false),
+                            trials: ls,
+                        };
                     }
                 } else if alpha == alpha_max
                     && theta_t >= theta
@@ -1491,13 +1529,12 @@ impl<'p> Core<'p> {
                                     self.max_step_dual(&self.dzl_s, &self.dzu_s, self.tau);
                                 self.take_dual_step(alpha_du, true);
                                 self.accept_trial();
-                                return (
-                                    LsResult::Accepted,
-                                    a_soc,
+                                return LineSearch::Accepted {
+                                    alpha_pr: a_soc,
                                     alpha_du,
-                                    if ftype { 'F' } else { 'H' },
-                                    ls,
-                                );
+                                    kind: StepKind::new(ftype, true),
+                                    trials: ls,
+                                };
                             }
                             break;
                         }
@@ -1505,7 +1542,6 @@ impl<'p> Core<'p> {
                     }
                 }
             }
-            let _ = n;
             alpha *= self.opts.alpha_red_factor;
         }
     }
@@ -1731,20 +1767,29 @@ impl<'p> Core<'p> {
                         continue;
                     }
                     self.tiny_count = 0;
-                    let (res, a_pr, a_du, ch, ls) = self.line_search(shared);
-                    if res == LsResult::Accepted {
-                        let (_, eu) = self.errors(0.0, false);
-                        self.record(shared, d_norm, a_du, a_pr, ch, ls, eu[0]);
-                        if self.setup_in_resto && self.nlp.restoration_accepts(&self.w) {
-                            return self.outcome(Status::SolveSucceeded, "", false);
+                    match self.line_search(shared) {
+                        LineSearch::Accepted {
+                            alpha_pr,
+                            alpha_du,
+                            kind,
+                            trials,
+                        } => {
+                            let (_, eu) = self.errors(0.0, false);
+                            let ch = kind.log_char();
+                            self.record(shared, d_norm, alpha_du, alpha_pr, ch, trials, eu[0]);
+                            if self.setup_in_resto && self.nlp.restoration_accepts(&self.w) {
+                                return self.outcome(Status::SolveSucceeded, "", false);
+                            }
+                            continue;
                         }
-                        continue;
+                        LineSearch::Failed { alpha_pr, trials } => {
+                            // The restoration phase's first row reports the failed line
+                            // search (IPOPT: "12r", alpha_pr 'R', and its ls count, one
+                            // more than the trial steps).
+                            shared.iter -= 1;
+                            self.resto_start = Some((alpha_pr, trials + 1));
+                        }
                     }
-                    // The restoration phase's first row reports the failed line search
-                    // (IPOPT: "12r", alpha_pr 'R', and its ls count, one more than the
-                    // trial steps).
-                    shared.iter -= 1;
-                    self.resto_start = Some((a_pr, ls + 1));
                 } else if self.setup_in_resto {
                     return self.outcome(
                         Status::ErrorInStepComputation,
