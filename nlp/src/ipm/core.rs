@@ -13,6 +13,7 @@ use std::time::Instant;
 use crate::callback::Observer;
 use crate::frontend::{KktResiduals, Termination};
 use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, probing_mu, tau};
+use crate::ipm::error::{At, CoreError};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::ipm::restoration;
@@ -261,7 +262,7 @@ impl<'p> Core<'p> {
         nlp: &'p mut dyn IpmProblem,
         opts: &IpmOptions,
         setup: &Setup,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, CoreError> {
         let n = nlp.n();
         let m = nlp.m();
         let mut x_l = vec![0.0; n];
@@ -301,8 +302,7 @@ impl<'p> Core<'p> {
         }
         let has_l: Vec<bool> = wl.iter().map(|v| v.is_finite()).collect();
         let has_u: Vec<bool> = wu.iter().map(|v| v.is_finite()).collect();
-        let kkt = Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())
-            .map_err(|e| format!("KKT setup: {e}"))?;
+        let kkt = Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())?;
         let nnz_j = nlp.jac_g_sparsity().row_idx().len();
         let nnz_h = nlp.hess_l_sparsity().row_idx().len();
         let mut kkt = kkt;
@@ -475,56 +475,75 @@ impl<'p> Core<'p> {
     }
 
     /// Evaluates everything at the current w, y. Err names the callback on NaN/Inf.
-    fn eval_current(&mut self) -> Result<(), String> {
+    fn eval_current(&mut self) -> Result<(), CoreError> {
+        self.eval_all(At::Start)
+    }
+
+    /// f, ∇f, g, J and ∇²L at the current w, y, and the residual c; Err names the first
+    /// non-finite value.
+    fn eval_all(&mut self, at: At) -> Result<(), CoreError> {
+        self.eval_first_order(at)?;
+        self.eval_hessian(at)?;
+        let mut c = std::mem::take(&mut self.c);
+        self.constraint_residual(&self.w, &self.g, &mut c);
+        self.c = c;
+        Ok(())
+    }
+
+    /// f, ∇f, g and J at the current w; Err names the first non-finite value.
+    fn eval_first_order(&mut self, at: At) -> Result<(), CoreError> {
         let n = self.n;
         let x = &self.w[..n];
         self.f = self.nlp.eval_f(x);
         if !self.f.is_finite() {
-            return Err(format!("eval_f returned {} at the starting point", self.f));
+            return Err(CoreError::Objective { value: self.f, at });
         }
         self.nlp.eval_grad_f(x, &mut self.grad);
         if let Some(i) = first_non_finite(&self.grad) {
-            return Err(format!(
-                "eval_grad_f returned {} for variable {i} ('{}') at the starting point",
-                self.grad[i],
-                self.nlp.variable_name(i)
-            ));
+            return Err(CoreError::Gradient {
+                value: self.grad[i],
+                index: i,
+                name: self.nlp.variable_name(i),
+                at,
+            });
         }
         self.nlp.eval_g(x, &mut self.g);
-        if let Some(i) = first_non_finite(&self.g) {
-            return Err(format!(
-                "eval_g returned {} for constraint {i} ('{}') at the starting point",
-                self.g[i],
-                self.nlp.constraint_name(i)
-            ));
-        }
+        self.check_g(at)?;
         self.nlp.eval_jac_g(x, &mut self.jac);
         if let Some(p) = first_non_finite(&self.jac) {
             let pat = self.nlp.jac_g_sparsity();
             let col = (0..n).find(|&j| pat.col_range(j).contains(&p)).unwrap_or(0);
             let row = pat.row_idx()[p];
-            return Err(format!(
-                "eval_jac_g returned {} at row {row} ('{}'), column {col} ('{}') at the starting point",
-                self.jac[p],
-                self.nlp.constraint_name(row),
-                self.nlp.variable_name(col)
-            ));
+            return Err(CoreError::Jacobian {
+                value: self.jac[p],
+                row,
+                row_name: self.nlp.constraint_name(row),
+                col,
+                col_name: self.nlp.variable_name(col),
+                at,
+            });
         }
+        Ok(())
+    }
+
+    /// ∇²L at the current w, y; Err names the first non-finite entry.
+    fn eval_hessian(&mut self, at: At) -> Result<(), CoreError> {
+        let n = self.n;
+        let x = &self.w[..n];
         self.nlp.eval_hess_l(x, 1.0, &self.y, &mut self.hess);
         if let Some(p) = first_non_finite(&self.hess) {
             let pat = self.nlp.hess_l_sparsity();
             let col = (0..n).find(|&j| pat.col_range(j).contains(&p)).unwrap_or(0);
             let row = pat.row_idx()[p];
-            return Err(format!(
-                "eval_hess_l returned {} at entry ({row}, {col}) ('{}', '{}') at the starting point",
-                self.hess[p],
-                self.nlp.variable_name(row),
-                self.nlp.variable_name(col)
-            ));
+            return Err(CoreError::Hessian {
+                value: self.hess[p],
+                row,
+                row_name: self.nlp.variable_name(row),
+                col,
+                col_name: self.nlp.variable_name(col),
+                at,
+            });
         }
-        let mut c = std::mem::take(&mut self.c);
-        self.constraint_residual(&self.w, &self.g, &mut c);
-        self.c = c;
         Ok(())
     }
 
@@ -549,7 +568,20 @@ impl<'p> Core<'p> {
         v
     }
 
-    fn initialize(&mut self, start: Start) -> Result<(), String> {
+    /// Err names the first non-finite entry of g.
+    fn check_g(&self, at: At) -> Result<(), CoreError> {
+        match first_non_finite(&self.g) {
+            Some(i) => Err(CoreError::Constraint {
+                value: self.g[i],
+                index: i,
+                name: self.nlp.constraint_name(i),
+                at,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn initialize(&mut self, start: Start) -> Result<(), CoreError> {
         let n = self.n;
         let mut x0 = vec![0.0; n];
         self.nlp.initial_point(&mut x0);
@@ -583,13 +615,7 @@ impl<'p> Core<'p> {
                 }
                 // Slacks from g(x0).
                 self.nlp.eval_g(&self.w[..n], &mut self.g);
-                if let Some(i) = first_non_finite(&self.g) {
-                    return Err(format!(
-                        "eval_g returned {} for constraint {i} ('{}') at the starting point",
-                        self.g[i],
-                        self.nlp.constraint_name(i)
-                    ));
-                }
+                self.check_g(At::Start)?;
                 for k in 0..self.ni {
                     let gi = self.g[self.row_of_slack[k]];
                     self.w[n + k] = self.push_into_bounds(n + k, gi, sp, sf);
@@ -622,14 +648,7 @@ impl<'p> Core<'p> {
                         if self.m > 0 {
                             self.least_squares_multipliers(self.opts.constr_mult_init_max);
                             // Hessian at the new multipliers.
-                            self.nlp
-                                .eval_hess_l(&self.w[..n], 1.0, &self.y, &mut self.hess);
-                            if !all_finite(&self.hess) {
-                                return Err(
-                                    "eval_hess_l returned a non-finite value at the starting point"
-                                        .into(),
-                                );
-                            }
+                            self.eval_hessian(At::Start)?;
                         }
                     }
                 }
@@ -1683,8 +1702,8 @@ impl<'p> Core<'p> {
     // ------------------------------------------------------------------ main loop
 
     pub fn run(&mut self, shared: &mut Shared, start: Start) -> Outcome {
-        if let Err(msg) = self.initialize(start) {
-            return self.outcome(Status::InvalidNumberDetected, msg, false);
+        if let Err(e) = self.initialize(start) {
+            return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
         }
         let (_, eu) = self.errors(0.0, false);
         match self.resto_start.take() {
@@ -1859,7 +1878,7 @@ impl<'p> Core<'p> {
     /// all reset to 1 if one exceeds `bound_mult_reset_threshold`; the constraint
     /// multipliers are the least-squares estimate if `constr_mult_reset_threshold` > 0 and
     /// it is no larger than that, else 0.
-    pub fn restart_from(&mut self, w: &[f64]) -> Result<(), String> {
+    pub fn restart_from(&mut self, w: &[f64]) -> Result<(), CoreError> {
         let (mu, nw) = (self.mu, self.nw);
         let mut dzl = vec![0.0; nw];
         let mut dzu = vec![0.0; nw];
@@ -1888,31 +1907,14 @@ impl<'p> Core<'p> {
         }
         self.w.copy_from_slice(w);
         self.y.iter_mut().for_each(|v| *v = 0.0);
-        let n = self.n;
-        let x = &self.w[..n];
-        self.f = self.nlp.eval_f(x);
-        self.nlp.eval_grad_f(x, &mut self.grad);
-        self.nlp.eval_g(x, &mut self.g);
-        self.nlp.eval_jac_g(x, &mut self.jac);
-        if !self.f.is_finite()
-            || !all_finite(&self.grad)
-            || !all_finite(&self.g)
-            || !all_finite(&self.jac)
-        {
-            return Err("non-finite evaluation at the restoration result".into());
-        }
+        self.eval_first_order(At::RestorationResult)?;
         let mut c = std::mem::take(&mut self.c);
         self.constraint_residual(&self.w, &self.g, &mut c);
         self.c = c;
         if self.opts.constr_mult_reset_threshold > 0.0 {
             self.least_squares_multipliers(self.opts.constr_mult_reset_threshold);
         }
-        self.nlp
-            .eval_hess_l(&self.w[..n], 1.0, &self.y, &mut self.hess);
-        if !all_finite(&self.hess) {
-            return Err("non-finite Hessian at the restoration result".into());
-        }
-        Ok(())
+        self.eval_hessian(At::RestorationResult)
     }
 
     /// Current Hessian regularisation and δ_w bookkeeping accessors.

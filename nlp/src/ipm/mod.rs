@@ -10,6 +10,7 @@
 
 pub(crate) mod barrier;
 mod core;
+mod error;
 pub(crate) mod filter;
 pub(crate) mod reduced;
 mod restoration;
@@ -193,13 +194,13 @@ impl Ipm {
                 mu_strategy: opts.mu_strategy,
             };
             match Core::new(&mut red, opts, &setup) {
-                Err(msg) => (
+                Err(e) => (
                     Status::InternalError,
                     red.x0.clone(),
                     vec![0.0; m],
                     vec![0.0; n],
                     vec![0.0; n],
-                    msg,
+                    e.to_string(),
                 ),
                 Ok(mut core) => {
                     let out = core.run(&mut shared, start);
