@@ -21,7 +21,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use nlp::{Compiled, Ipm, IpmOptions, Problem, Solution};
+use nlp::{CommonOptions, Compiled, Ipm, IpmOptions, Problem, Solution};
 use solve_problems::{hanging_chain, van_der_pol, CHAIN_SIZES, OCP_SIZES};
 
 type Builder = fn(usize) -> Problem;
@@ -36,7 +36,10 @@ fn solver() -> Ipm {
     // IPOPT's defaults (tol 1e-8), as the reference script, which caps IPOPT at 120 s
     // (`--cap 120`) as well.
     Ipm::new(IpmOptions {
-        max_wall_time: 120.0,
+        common: CommonOptions {
+            max_wall_time: 120.0,
+            ..CommonOptions::default()
+        },
         ..IpmOptions::default()
     })
 }

@@ -8,7 +8,7 @@
 //!
 //! Run: `cargo run --release --example race_car`
 use std::f64::consts::PI;
-use symnlp::nlp::{bounded, Ipm, IpmOptions, Problem, Relation, Solution};
+use symnlp::nlp::{bounded, CommonOptions, Ipm, IpmOptions, Problem, Relation, Solution};
 use symnlp::symx::{Expr, Matrix};
 
 /// Builds the race-car problem with `n` control intervals and solves it with the
@@ -55,7 +55,10 @@ pub fn solve(
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = IpmOptions {
-        print_level: 5,
+        common: CommonOptions {
+            print_level: 5,
+            ..CommonOptions::default()
+        },
         ..IpmOptions::default()
     };
     let (sol, t) = solve(100, options)?;

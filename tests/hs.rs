@@ -21,7 +21,7 @@
 use symnlp::nlp;
 
 use nlp::ipm::Ipm;
-use nlp::IpmOptions;
+use nlp::{CommonOptions, IpmOptions};
 
 #[path = "hs/problems.rs"]
 mod problems;
@@ -83,8 +83,12 @@ fn hs_log() {
         let (name, build) = harness::find(SUITE, &name);
         println!("==== {name}");
         let run = harness::run(name, build, |nlp| {
-            Ipm::new(IpmOptions {
+            let common = CommonOptions {
                 print_level: 5,
+                ..CommonOptions::default()
+            };
+            Ipm::new(IpmOptions {
+                common,
                 ..IpmOptions::default()
             })
             .solve(nlp)

@@ -15,6 +15,7 @@ use symnlp::nlp;
 use nlp::{solve_mpcc, MpccBackend, MpccOptions, MpccSolution};
 
 #[path = "mpcc/problems.rs"]
+#[macro_use]
 mod problems;
 
 use problems::Case;
@@ -64,16 +65,7 @@ macro_rules! mpcc_tests {
     };
 }
 
-mpcc_tests! {
-    two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr2,
-    kth1,
-    kth2,
-    kth3,
-    scholtes5,
-    nash1, dempe, desilva, gauvin, qpec2, scale1, fl_ex1, fl_ex2,
-    lcp_chain,
-    outrata31,
-}
+mpcc_names!(mpcc_tests);
 
 /// One JSON line per case and back end (for docs/performance.md):
 /// `cargo test --release --test mpcc -- --ignored --nocapture mpcc_summary`.

@@ -3,10 +3,12 @@
 //! smooth form `√(‖v‖² + ε²) − t ≤ ε` (ε = 1e-8, an outer approximation: ‖v‖ − t ≤ ε);
 //! the SQP hands affine cones to clarabel as exact second-order cones and linearises the
 //! smooth row of the others.
-use symnlp::{nlp, symx};
+use symnlp::nlp;
 
-use nlp::{Ipm, IpmOptions, NumericNlp, Problem, Relation, Solution, Sqp, SqpOptions, Status};
-use symx::Expr;
+use nlp::{Ipm, IpmOptions, NumericNlp, Problem, Solution, Sqp, SqpOptions, Status};
+
+#[path = "socp/problems.rs"]
+mod problems;
 
 /// Tolerance on the cone residual max(0, ‖v‖ − t) at a solution: the smoothing ε of the
 /// interior-point form plus solver tolerances.
@@ -41,11 +43,7 @@ fn assert_close(what: &str, got: f64, want: f64, tol: f64) {
 /// (−1/√2, −1/√2). (The smooth form shifts it by O(ε): its boundary is at ‖v‖ = √(1 + 2ε).)
 #[test]
 fn unit_disc_linear_objective() {
-    let mut pb = Problem::new();
-    let x = pb.variable("x", 2).unwrap();
-    pb.minimize(x[0] + x[1]);
-    pb.subject_to_cone("disc", &[x[0], x[1]], Expr::constant(1.0))
-        .unwrap();
+    let pb = problems::unit_disc();
     for s in solve_both(&pb, 1) {
         assert_close("objective", s.objective, -std::f64::consts::SQRT_2, 1e-6);
         for &xi in &s.x {
@@ -63,17 +61,7 @@ fn unit_disc_linear_objective() {
 /// with v ≠ 0 there.
 #[test]
 fn distance_to_a_line() {
-    let mut pb = Problem::new();
-    let x = pb.variable("x", 2).unwrap();
-    let t = pb.scalar_variable("t").unwrap();
-    let a = pb.parameter("a", 2).unwrap();
-    pb.set_value(&a, &[1.0, 2.0]).unwrap();
-    pb.set_initial(&[t], &[10.0]).unwrap();
-    pb.minimize(t);
-    pb.subject_to_cone("dist", &[x[0] - a[0], x[1] - a[1]], t)
-        .unwrap();
-    pb.subject_to_named("line", (3.0 * x[0] + 4.0 * x[1]).eq(0.0))
-        .unwrap();
+    let pb = problems::distance_to_a_line();
     for s in solve_both(&pb, 1) {
         assert_close("objective", s.objective, 11.0 / 5.0, 1e-6);
         assert_close("x1", s.x[0], -8.0 / 25.0, 1e-6);
@@ -91,15 +79,7 @@ fn distance_to_a_line() {
 /// = (−1, 0, 1).
 #[test]
 fn distance_to_a_plane() {
-    let mut pb = Problem::new();
-    let x = pb.variable("x", 3).unwrap();
-    let t = pb.scalar_variable("t").unwrap();
-    let a = [1.0, 2.0, 3.0];
-    pb.minimize(t);
-    let v: Vec<Expr> = (0..3).map(|i| x[i] - a[i]).collect();
-    pb.subject_to_cone("dist", &v, t).unwrap();
-    pb.subject_to_named("plane", (x[0] + x[1] + x[2]).eq(0.0))
-        .unwrap();
+    let pb = problems::distance_to_a_plane();
     for s in solve_both(&pb, 1) {
         assert_close("objective", s.objective, 2.0 * 3f64.sqrt(), 1e-6);
         for (i, want) in [-1.0, 0.0, 1.0].into_iter().enumerate() {
@@ -114,11 +94,7 @@ fn distance_to_a_plane() {
 /// is 2 at x = 0: the optimum is −2 at (0, 2).
 #[test]
 fn non_affine_cone() {
-    let mut pb = Problem::new();
-    let x = pb.variable("x", 2).unwrap();
-    pb.minimize(-x[1]);
-    pb.subject_to_cone("bowl", &[x[0], x[1]], 2.0 - x[0].sq())
-        .unwrap();
+    let pb = problems::non_affine_cone();
     assert!(!pb.cones()[0].affine);
     for s in solve_both(&pb, 0) {
         assert_close("objective", s.objective, -2.0, 1e-6);

@@ -10,7 +10,7 @@
 //! ```
 use symnlp::nlp;
 
-use nlp::{Sqp, SqpOptions, Status};
+use nlp::{CommonOptions, Sqp, SqpOptions, Status};
 
 #[path = "hs/problems.rs"]
 #[allow(dead_code)]
@@ -55,32 +55,14 @@ const KNOWN_FAILURES: &[(&str, Status, &str)] = &[
     ),
 ];
 
-/// Problems observed with two outcomes between runs of the same binary: the listed
-/// failure, or a full success. The cause is not isolated yet (suspected: rounding of the
-/// parallel faer factorisation behind the inertia test of the Hessian convexification,
-/// which picks δ and ρ_a). Their tests accept exactly these two outcomes, nothing else.
-const UNSTABLE: &[(&str, Status, &str)] = &[
-    (
-        "hs056",
-        Status::ErrorInStepComputation,
-        "clarabel InsufficientProgress at iteration 7",
-    ),
-    (
-        "hs061",
-        Status::MaximumIterationsExceeded,
-        "line search stalls at f = -121.35",
-    ),
-    (
-        "hs078",
-        Status::SolvedToAcceptableLevel,
-        "final steps cut by the merit test",
-    ),
-];
-
 fn sqp(name: &'static str, build: fn() -> Built, print_level: u8) -> Run {
     harness::run(name, build, |nlp| {
-        Sqp::new(SqpOptions {
+        let common = CommonOptions {
             print_level,
+            ..CommonOptions::default()
+        };
+        Sqp::new(SqpOptions {
+            common,
             ..SqpOptions::default()
         })
         .solve(nlp)
@@ -98,15 +80,6 @@ fn check(name: &'static str, build: fn() -> Built) {
         Err(e) => panic!("{name}: solve error: {e}"),
     };
     let success = run.succeeded(sol);
-    if let Some((_, failure, why)) = UNSTABLE.iter().find(|(n, _, _)| *n == name) {
-        assert!(
-            success || sol.status == *failure,
-            "{name}: unstable case ({why}) has a third outcome: {:?}, f = {}; update UNSTABLE",
-            sol.status,
-            sol.objective
-        );
-        return;
-    }
     if let Some((_, expected, why)) = KNOWN_FAILURES.iter().find(|(n, _, _)| *n == name) {
         // Honest known failure: the current (failing) behaviour, exactly.
         assert_eq!(

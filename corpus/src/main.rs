@@ -171,10 +171,8 @@ fn real_main() -> Result<(), CorpusError> {
                 let inst = corpus::instance(&name)
                     .ok_or_else(|| CorpusError::UnknownInstance(name.clone()))?;
                 let mut compiled = inst.build()?.compile()?;
-                let options = nlp::IpmOptions {
-                    print_level,
-                    ..run::options(max_wall)
-                };
+                let mut options = run::options(max_wall);
+                options.print_level = print_level;
                 let sol = nlp::Ipm::new(options).solve(&mut compiled)?;
                 let d = corpus::diagnose::diagnose(&sol);
                 let line = serde_json::json!({"instance": name, "status": format!("{:?}", sol.status), "diagnosis": d});

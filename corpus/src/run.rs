@@ -47,7 +47,10 @@ pub struct Outcome {
 /// exact Hessian) with a wall-time cap of `max_wall` seconds.
 pub fn options(max_wall: f64) -> IpmOptions {
     IpmOptions {
-        max_wall_time: max_wall,
+        common: nlp::CommonOptions {
+            max_wall_time: max_wall,
+            ..nlp::CommonOptions::default()
+        },
         ..IpmOptions::default()
     }
 }

@@ -10,7 +10,7 @@
 //! The pattern, the AMD ordering and the symbolic factorisation are computed once in
 //! [`Kkt::new`]; every [`Kkt::factorize`] only scatters values through precomputed maps.
 //! When faer's analysis picks the simplicial factorisation, K is stored already permuted
-//! and factorised by [`Simplicial`] (up-looking LDLᵀ with the rows of L precomputed).
+//! and factorised by `Simplicial` (up-looking LDLᵀ with the rows of L precomputed).
 //! faer has no inertia API, so the inertia is counted from the signs of D (Sylvester's law
 //! of inertia). Unpivoted LDLᵀ needs `dc > 0` on every row (see docs/dependencies.md).
 
@@ -68,7 +68,9 @@ pub enum KktError {
     NotFactorized,
 }
 
-/// Which faer numeric factorisation the symbolic analysis selects.
+/// Which faer numeric factorisation the symbolic analysis selects (the solvers use
+/// `Auto`; the forced kinds are compared in the unit tests).
+#[cfg_attr(not(test), allow(dead_code))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum KktFactorization {
     /// Supernodal (dense blocks; fastest when the factor has large dense parts).
@@ -286,24 +288,10 @@ impl Kkt {
         self.n + self.m
     }
 
-    /// Nonzeros of the upper triangle of K.
-    pub fn nnz(&self) -> usize {
-        self.values.len()
-    }
-
-    /// Length of the factor's value array.
-    pub fn factor_len(&self) -> usize {
-        self.l_values.len()
-    }
-
     /// True if faer chose the supernodal factorisation.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn is_supernodal(&self) -> bool {
         matches!(self.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))
-    }
-
-    /// Residual ratio ‖Kx − b‖∞ / (min(‖x‖∞, 10⁶‖b‖∞) + ‖b‖∞) of the last solve (IPOPT's).
-    pub fn last_residual_ratio(&self) -> f64 {
-        self.last_residual_ratio
     }
 
     /// Assembles and factorises K; returns its inertia. `h_vals`/`j_vals` are in the
@@ -495,6 +483,7 @@ impl Kkt {
     }
 
     /// Solves K x = rhs in place with residual-checked iterative refinement.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn solve(&mut self, rhs: &mut [f64]) -> Result<f64, KktError> {
         self.solve_shifted(rhs, None)
     }

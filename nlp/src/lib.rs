@@ -5,9 +5,10 @@ pub mod compiled;
 pub mod constraint;
 pub mod derivative_check;
 pub mod error;
+pub mod frontend;
 pub mod ipm;
-pub mod kkt;
-pub mod log;
+pub(crate) mod kkt;
+pub(crate) mod log;
 pub mod mpcc;
 pub mod numeric;
 pub mod ocp;
@@ -15,7 +16,7 @@ pub mod option_names;
 pub mod options;
 pub mod parameter;
 pub mod problem;
-pub mod scaling;
+pub(crate) mod scaling;
 pub mod sensitivity;
 pub mod solution;
 pub mod sqp;
@@ -25,11 +26,12 @@ pub use compiled::Compiled;
 pub use constraint::{bounded, Constraint, Relation};
 pub use derivative_check::{check_derivatives, DerivativeCheckOptions, DerivativeReport};
 pub use error::SolveError;
+pub use frontend::{CommonOptions, Solver};
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;
 pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};
 
-pub use kkt::{Inertia, Kkt, KktError, KktFactorization};
+pub use log::{format_summary, format_table};
 pub use mpcc::{
     solve_mpcc, solve_mpcc_with_callback, MpccBackend, MpccError, MpccOptions, MpccPhase,
     MpccSolution,

@@ -81,9 +81,3 @@ pub fn format_summary(sol: &Solution) -> String {
     let _ = writeln!(s, "EXIT: {:?}", sol.status);
     s
 }
-
-/// Prints the table and the summary to stdout.
-pub fn print_solution(sol: &Solution) {
-    print!("{}", format_table(&sol.stats.records));
-    print!("{}", format_summary(sol));
-}

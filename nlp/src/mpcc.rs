@@ -35,6 +35,7 @@ use thiserror::Error;
 use crate::callback::{IterationCallback, IterationView, PhaseLabel};
 use crate::constraint::Relation;
 use crate::error::SolveError;
+use crate::frontend::Solver;
 use crate::ipm::Ipm;
 use crate::options::IpmOptions;
 use crate::problem::{BuildError, ComplementarityReport, Problem};
@@ -71,6 +72,16 @@ pub struct MpccOptions {
     pub exact_final_phase: bool,
     /// A pair is biactive when both a and b are within this of zero. Default 1e-6.
     pub biactive_tol: f64,
+}
+
+impl MpccOptions {
+    /// The solver of `backend` with its options.
+    pub fn solver(&self, backend: MpccBackend) -> Box<dyn Solver> {
+        match backend {
+            MpccBackend::Sqp => Box::new(Sqp::new(self.sqp.clone())),
+            MpccBackend::Ipm => Box::new(Ipm::new(self.ipm.clone())),
+        }
+    }
 }
 
 impl Default for MpccOptions {
@@ -130,8 +141,7 @@ pub enum MpccError {
 }
 
 fn run(
-    backend: MpccBackend,
-    o: &MpccOptions,
+    solver: &dyn Solver,
     pb: &Problem,
     x0: Option<&[f64]>,
     callback: Option<&mut IterationCallback<'_>>,
@@ -151,10 +161,7 @@ fn run(
         }
     });
     let cb = labelled.as_mut().map(|f| f as &mut IterationCallback<'_>);
-    Ok(match backend {
-        MpccBackend::Sqp => Sqp::new(o.sqp.clone()).solve_dyn(&mut c, None, cb)?,
-        MpccBackend::Ipm => Ipm::new(o.ipm.clone()).solve_dyn(&mut c, None, cb)?,
-    })
+    Ok(solver.solve_dyn(&mut c, None, cb)?)
 }
 
 fn ok(s: Status) -> bool {
@@ -191,6 +198,7 @@ fn solve(
 ) -> Result<MpccSolution, MpccError> {
     let t = Instant::now();
     let o = options;
+    let solver = o.solver(backend);
     let f = problem.objective();
     let pairs = problem.complementarity_pairs().to_vec();
     let mut phases = Vec::new();
@@ -220,7 +228,13 @@ fn solve(
     let mut best = match backend {
         MpccBackend::Sqp => {
             let phase = label(&phases, "sqp", 0.0);
-            let sol = run(backend, o, problem, None, callback.as_deref_mut(), phase)?;
+            let sol = run(
+                solver.as_ref(),
+                problem,
+                None,
+                callback.as_deref_mut(),
+                phase,
+            )?;
             record(&mut phases, "sqp", 0.0, &sol)?;
             sol
         }
@@ -235,7 +249,7 @@ fn solve(
                 let pb = problem.mpcc_copy(obj, false);
                 let phase = label(&phases, "penalty", pi);
                 let cb = callback.as_deref_mut();
-                let sol = run(backend, o, &pb, x.as_deref(), cb, phase)?;
+                let sol = run(solver.as_ref(), &pb, x.as_deref(), cb, phase)?;
                 let rep = record(&mut phases, "penalty", pi, &sol)?;
                 x = Some(sol.x.clone());
                 if stopped(&sol)
@@ -270,7 +284,7 @@ fn solve(
             pb.subject_to_named(&format!("{name}.branch"), side.eq(0.0))?;
         }
         let phase = label(&phases, "final", 0.0);
-        let sol = run(backend, o, &pb, Some(&best.x), callback, phase)?;
+        let sol = run(solver.as_ref(), &pb, Some(&best.x), callback, phase)?;
         record(&mut phases, "final", 0.0, &sol)?;
         if ok(sol.status) || stopped(&sol) {
             best = sol;

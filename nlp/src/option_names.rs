@@ -46,7 +46,7 @@ pub enum OptionError {
         /// Why, e.g. "expected a number (default 1e-8)".
         reason: String,
     },
-    /// The value has the right type but is out of range ([`NamedOptions::validate`]).
+    /// The value has the right type but is out of range ([`NamedOptions::check`]).
     #[error(transparent)]
     Invalid(#[from] SolveError),
 }

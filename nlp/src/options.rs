@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::SolveError;
+use crate::frontend::CommonOptions;
 
 /// Barrier parameter update strategy (IPOPT `mu_strategy`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -40,37 +41,12 @@ pub enum ScalingMethod {
 
 /// All options of the interior-point method.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(remote = "Self", default)]
 pub struct IpmOptions {
-    // ---------- termination ----------
-    /// Desired relative (scaled) convergence tolerance. Default 1e-8.
-    pub tol: f64,
-    /// Scaling threshold s_max for the NLP error. Default 100.
-    pub s_max: f64,
-    /// Maximum number of iterations (restoration iterations included). Default 3000.
-    pub max_iter: usize,
-    /// Maximum wall-clock time in seconds. Default 1e20.
-    pub max_wall_time: f64,
-    /// Absolute tolerance on (unscaled) dual infeasibility. Default 1.
-    pub dual_inf_tol: f64,
-    /// Absolute tolerance on (unscaled) constraint violation. Default 1e-4.
-    pub constr_viol_tol: f64,
-    /// Absolute tolerance on (unscaled) complementarity. Default 1e-4.
-    pub compl_inf_tol: f64,
-    /// "Acceptable" relative convergence tolerance. Default 1e-6.
-    pub acceptable_tol: f64,
-    /// Number of consecutive acceptable iterates before stopping. Default 15 (0 disables).
-    pub acceptable_iter: usize,
-    /// Acceptable dual infeasibility. Default 1e10.
-    pub acceptable_dual_inf_tol: f64,
-    /// Acceptable constraint violation. Default 1e-2.
-    pub acceptable_constr_viol_tol: f64,
-    /// Acceptable complementarity. Default 1e-2.
-    pub acceptable_compl_inf_tol: f64,
-    /// Acceptable relative objective change between iterations. Default 1e20.
-    pub acceptable_obj_change_tol: f64,
-    /// Iterates with a component larger than this in magnitude are diverging. Default 1e20.
-    pub diverging_iterates_tol: f64,
+    /// Termination, scaling bounds and output, shared with the SQP ([`CommonOptions`];
+    /// its fields read and write as fields of this struct, see the `Deref` impl).
+    #[serde(flatten)]
+    pub common: CommonOptions,
     // ---------- barrier parameter ----------
     /// Barrier parameter update strategy. Default monotone.
     pub mu_strategy: MuStrategy,
@@ -101,10 +77,6 @@ pub struct IpmOptions {
     // ---------- scaling ----------
     /// NLP scaling method. Default gradient-based.
     pub nlp_scaling_method: ScalingMethod,
-    /// Maximum gradient after scaling. Default 100.
-    pub nlp_scaling_max_gradient: f64,
-    /// Minimum scaling factor. Default 1e-8.
-    pub nlp_scaling_min_value: f64,
     /// **Not an IPOPT option.** With gradient-based scaling, an equality row whose
     /// gradient max-norm at x0 is non-zero and below this is scaled *up* so that it
     /// becomes this value (factor at most `nlp_scaling_max_value`); IPOPT only scales
@@ -250,28 +222,14 @@ pub struct IpmOptions {
     pub constr_mult_reset_threshold: f64,
     /// Start with a restoration phase. Default false.
     pub start_with_resto: bool,
-    // ---------- output ----------
-    /// 0: silent; ≥ 3: summary; ≥ 5: iteration table. Default 0.
-    pub print_level: u8,
 }
+
+crate::frontend::strict_options_serde!(IpmOptions);
 
 impl Default for IpmOptions {
     fn default() -> Self {
         Self {
-            tol: 1e-8,
-            s_max: 100.0,
-            max_iter: 3000,
-            max_wall_time: 1e20,
-            dual_inf_tol: 1.0,
-            constr_viol_tol: 1e-4,
-            compl_inf_tol: 1e-4,
-            acceptable_tol: 1e-6,
-            acceptable_iter: 15,
-            acceptable_dual_inf_tol: 1e10,
-            acceptable_constr_viol_tol: 1e-2,
-            acceptable_compl_inf_tol: 1e-2,
-            acceptable_obj_change_tol: 1e20,
-            diverging_iterates_tol: 1e20,
+            common: CommonOptions::default(),
             mu_strategy: MuStrategy::Monotone,
             mu_oracle: MuOracle::Probing,
             mu_init: 0.1,
@@ -286,8 +244,6 @@ impl Default for IpmOptions {
             adaptive_mu_kkterror_red_iters: 4,
             adaptive_mu_monotone_init_factor: 0.8,
             nlp_scaling_method: ScalingMethod::GradientBased,
-            nlp_scaling_max_gradient: 100.0,
-            nlp_scaling_min_value: 1e-8,
             nlp_scaling_min_gradient: 0.5,
             nlp_scaling_max_value: 1e4,
             obj_scaling_factor: 1.0,
@@ -342,7 +298,6 @@ impl Default for IpmOptions {
             bound_mult_reset_threshold: 1e3,
             constr_mult_reset_threshold: 1e3,
             start_with_resto: false,
-            print_level: 0,
         }
     }
 }
@@ -357,6 +312,7 @@ fn bad(field: &'static str, reason: impl Into<String>) -> SolveError {
 impl IpmOptions {
     /// Checks every option; the error names the first bad field.
     pub fn validate(&self) -> Result<(), SolveError> {
+        self.common.validate()?;
         macro_rules! positive {
             ($($f:ident),*) => {$(
                 if !(self.$f > 0.0) || !self.$f.is_finite() {
@@ -379,24 +335,10 @@ impl IpmOptions {
             )*};
         }
         positive!(
-            tol,
-            s_max,
-            max_wall_time,
-            dual_inf_tol,
-            constr_viol_tol,
-            compl_inf_tol,
-            acceptable_tol,
-            acceptable_dual_inf_tol,
-            acceptable_constr_viol_tol,
-            acceptable_compl_inf_tol,
-            acceptable_obj_change_tol,
-            diverging_iterates_tol,
             mu_init,
             mu_max,
             mu_min,
             barrier_tol_factor,
-            nlp_scaling_max_gradient,
-            nlp_scaling_min_value,
             nlp_scaling_max_value,
             obj_scaling_factor,
             bound_mult_init_val,
@@ -506,9 +448,6 @@ impl IpmOptions {
         }
         if !(self.nlp_scaling_max_value >= 1.0) {
             return Err(bad("nlp_scaling_max_value", "must be >= 1"));
-        }
-        if self.acceptable_tol < self.tol {
-            return Err(bad("acceptable_tol", "must be >= tol"));
         }
         Ok(())
     }

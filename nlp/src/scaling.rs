@@ -22,27 +22,6 @@ pub fn gradient_scale_up(grad_max: f64, min_gradient: f64, max_value: f64) -> f6
     }
 }
 
-/// Row scale factors of a CSC Jacobian with `m` rows given its values.
-pub fn jacobian_row_scales(
-    m: usize,
-    jac: &faer::sparse::SymbolicSparseColMat<usize>,
-    values: &[f64],
-    max_gradient: f64,
-    min_value: f64,
-    out: &mut [f64],
-) {
-    let mut row_max = vec![0.0f64; m];
-    for c in 0..jac.ncols() {
-        for p in jac.col_range(c) {
-            let r = jac.row_idx()[p];
-            row_max[r] = row_max[r].max(values[p].abs());
-        }
-    }
-    for (o, g) in out.iter_mut().zip(&row_max) {
-        *o = gradient_scale(*g, max_gradient, min_value);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,8 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Outcome of a solve (IPOPT's return-code vocabulary).
+/// Outcome of a solve (IPOPT's return-code vocabulary). `Display` prints IPOPT's name
+/// of the code (`Solve_Succeeded`). New outcomes may be added: match with a wildcard.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Status {
     /// Converged to the requested tolerances.
     SolveSucceeded,
@@ -35,6 +37,27 @@ pub enum Status {
     NotEnoughDegreesOfFreedom,
     /// An internal error.
     InternalError,
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Status::SolveSucceeded => "Solve_Succeeded",
+            Status::SolvedToAcceptableLevel => "Solved_To_Acceptable_Level",
+            Status::InfeasibleProblemDetected => "Infeasible_Problem_Detected",
+            Status::SearchDirectionBecomesTooSmall => "Search_Direction_Becomes_Too_Small",
+            Status::DivergingIterates => "Diverging_Iterates",
+            Status::UserRequestedStop => "User_Requested_Stop",
+            Status::FeasiblePointFound => "Feasible_Point_Found",
+            Status::MaximumIterationsExceeded => "Maximum_Iterations_Exceeded",
+            Status::RestorationFailed => "Restoration_Failed",
+            Status::ErrorInStepComputation => "Error_In_Step_Computation",
+            Status::MaximumWallTimeExceeded => "Maximum_WallTime_Exceeded",
+            Status::InvalidNumberDetected => "Invalid_Number_Detected",
+            Status::NotEnoughDegreesOfFreedom => "Not_Enough_Degrees_Of_Freedom",
+            Status::InternalError => "Internal_Error",
+        })
+    }
 }
 
 impl Status {
@@ -86,8 +109,9 @@ pub struct IterationRecord {
     pub ls: usize,
 }
 
-/// Counters and timers of a solve.
+/// Counters and timers of a solve (filled by the solvers; fields may be added).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Stats {
     /// Number of iterations (including restoration iterations).
     pub iterations: usize,
@@ -178,5 +202,24 @@ impl Solution {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Status;
+
+    /// The names of IPOPT's `ApplicationReturnStatus` (IpReturnCodes_inc.h, IPOPT 3.14).
+    #[test]
+    fn status_displays_ipopt_names() {
+        assert_eq!(Status::SolveSucceeded.to_string(), "Solve_Succeeded");
+        assert_eq!(
+            Status::MaximumWallTimeExceeded.to_string(),
+            "Maximum_WallTime_Exceeded"
+        );
+        assert_eq!(
+            Status::SearchDirectionBecomesTooSmall.to_string(),
+            "Search_Direction_Becomes_Too_Small"
+        );
     }
 }

@@ -11,7 +11,7 @@
 #[path = "../../benches/common/solve_problems.rs"]
 mod solve_problems;
 
-use nlp::{Ipm, IpmOptions, Solution, Status};
+use nlp::{CommonOptions, Ipm, IpmOptions, Solution, Status};
 use solve_problems::hanging_chain;
 
 /// The discrete catenary with `links` equal links of length ℓ = L/N (L = 2) between
@@ -73,16 +73,20 @@ fn catenary(links: usize) -> (f64, Vec<(f64, f64)>, f64) {
 fn solve(links: usize, print_level: u8) -> (Solution, f64) {
     let mut compiled = hanging_chain(links).compile().expect("compiles");
     let t = std::time::Instant::now();
-    let sol = Ipm::new(IpmOptions {
-        print_level,
-        max_wall_time: std::env::var("CHAIN_CAP")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(300.0),
+    let options = IpmOptions {
+        common: CommonOptions {
+            print_level,
+            max_wall_time: std::env::var("CHAIN_CAP")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(300.0),
+            ..CommonOptions::default()
+        },
         ..IpmOptions::default()
-    })
-    .solve(&mut compiled)
-    .expect("valid problem");
+    };
+    let sol = Ipm::new(options)
+        .solve(&mut compiled)
+        .expect("valid problem");
     (sol, t.elapsed().as_secs_f64())
 }
 

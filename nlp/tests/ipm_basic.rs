@@ -3,14 +3,17 @@
 mod ipm_common;
 
 use ipm_common::{hs071, rosenbrock};
-use nlp::{Ipm, IpmOptions, MuStrategy, Status};
+use nlp::{CommonOptions, Ipm, IpmOptions, MuStrategy, Status};
 
 fn print_opts() -> IpmOptions {
     IpmOptions {
-        print_level: if std::env::var("IPM_PRINT").is_ok() {
-            5
-        } else {
-            0
+        common: CommonOptions {
+            print_level: if std::env::var("IPM_PRINT").is_ok() {
+                5
+            } else {
+                0
+            },
+            ..CommonOptions::default()
         },
         ..IpmOptions::default()
     }

@@ -8,16 +8,19 @@ use std::cell::Cell;
 use std::rc::Rc;
 
 use ipm_common::{hs071, lower, DenseNlp};
-use nlp::{Ipm, IpmOptions, MuStrategy, Solution, SolveError, Status};
+use nlp::{CommonOptions, Ipm, IpmOptions, MuStrategy, Solution, SolveError, Status};
 
 const INF: f64 = f64::INFINITY;
 
 fn opts() -> IpmOptions {
     IpmOptions {
-        print_level: if std::env::var("IPM_PRINT").is_ok() {
-            5
-        } else {
-            0
+        common: CommonOptions {
+            print_level: if std::env::var("IPM_PRINT").is_ok() {
+                5
+            } else {
+                0
+            },
+            ..CommonOptions::default()
         },
         ..IpmOptions::default()
     }
@@ -337,12 +340,9 @@ fn unbounded_problem_diverges() {
 #[test]
 fn max_iter_is_respected() {
     let mut p = hs071();
-    let sol = Ipm::new(IpmOptions {
-        max_iter: 3,
-        ..opts()
-    })
-    .solve(&mut p)
-    .unwrap();
+    let mut o = opts();
+    o.max_iter = 3;
+    let sol = Ipm::new(o).solve(&mut p).unwrap();
     assert_eq!(sol.status, Status::MaximumIterationsExceeded);
     assert_eq!(sol.stats.iterations, 3);
 }
@@ -381,10 +381,8 @@ fn inconsistent_bounds_are_errors() {
 #[test]
 fn invalid_options_and_sizes_are_errors() {
     let mut p = hs071();
-    let bad = IpmOptions {
-        tol: -1.0,
-        ..opts()
-    };
+    let mut bad = opts();
+    bad.tol = -1.0;
     match Ipm::new(bad).solve(&mut p) {
         Err(SolveError::InvalidOption { field, .. }) => assert_eq!(field, "tol"),
         other => panic!("unexpected {other:?}"),
@@ -410,7 +408,7 @@ fn solution_and_options_serialize() {
         assert!((a - b).abs() <= 1e-15 * b.abs().max(1.0));
     }
     assert_eq!(back.stats.records.len(), sol.stats.records.len());
-    let table = nlp::log::format_table(&sol.stats.records);
+    let table = nlp::format_table(&sol.stats.records);
     assert!(table.contains("inf_pr"));
     let o: IpmOptions =
         serde_json::from_str(r#"{"tol": 1e-6, "mu_strategy": "adaptive"}"#).unwrap();

@@ -12,7 +12,10 @@ fn tight() -> Ipm {
     // Re-solves to a KKT error of 1e-12 so that the finite differences (step 1e-4) carry
     // an error of ~1e-12/1e-4 = 1e-8, below the 1e-6 tolerance of the comparisons.
     Ipm::new(IpmOptions {
-        tol: 1e-10,
+        common: nlp::CommonOptions {
+            tol: 1e-10,
+            ..nlp::CommonOptions::default()
+        },
         ..IpmOptions::default()
     })
 }

@@ -7,11 +7,12 @@ use symnlp::nlp::{Compiled, Solution, SolveError, Status};
 
 use crate::problems::Built;
 
-/// Generates `SUITE` (every problem with its name, in order) and one `#[test]` per
-/// problem calling the test file's `check(name, build)`.
-macro_rules! hs_suite {
-    () => {
-        hs_suite! {
+/// Calls macro `$then!` with every problem name of the suite, in order: the one list
+/// of problems, shared by `hs_suite!` (one `#[test]` each) and `hs_list!` (the list
+/// only, for `tests/golden.rs`).
+macro_rules! hs_names {
+    ($then:ident) => {
+        $then! {
             // bounds only
             hs001, hs002, hs003, hs004, hs005, hs025, hs038, hs045, hs110,
             // equality constraints
@@ -24,6 +25,15 @@ macro_rules! hs_suite {
             // mixed equalities and inequalities
             hs071, hs073, hs080, hs081, hs106, hs108, hs114, hs116, hs118,
         }
+    };
+}
+
+/// Generates `SUITE` (every problem with its name, in order) and one `#[test]` per
+/// problem calling the test file's `check(name, build)`.
+#[allow(unused_macros)]
+macro_rules! hs_suite {
+    () => {
+        hs_names!(hs_suite);
     };
     ($($name:ident),* $(,)?) => {
         /// Every problem of the suite with its name, in order.
@@ -38,6 +48,19 @@ macro_rules! hs_suite {
                 }
             )*
         }
+    };
+}
+
+/// Generates `SUITE` only (no tests).
+#[allow(unused_macros)]
+macro_rules! hs_list {
+    () => {
+        hs_names!(hs_list);
+    };
+    ($($name:ident),* $(,)?) => {
+        /// Every problem of the suite with its name, in order.
+        pub const SUITE: &[harness::Entry] =
+            &[$((stringify!($name), problems::$name)),*];
     };
 }
 
@@ -175,9 +198,9 @@ impl Run {
 }
 
 /// Runs every problem of `suite` (each in a fresh thread, as each `#[test]` runs: symx's
-/// expression arena is per thread, and a problem built after others gets another node
-/// order, hence other sparsity orderings and rounding), prints one JSON line per problem
-/// on stdout and a summary on stderr.
+/// expression arena is per thread; a problem built after others solves bit-identically,
+/// see `tests/reproducible.rs`, but a fresh thread keeps the arena small), prints one
+/// JSON line per problem on stdout and a summary on stderr.
 pub fn summary(suite: &[Entry], run_one: fn(&'static str, fn() -> Built) -> Run) {
     let mut iterations = Vec::new();
     let mut failed = Vec::new();

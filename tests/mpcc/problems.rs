@@ -3,6 +3,18 @@ use symnlp::nlp;
 
 use nlp::{MpccBackend, Problem, Relation};
 
+/// Calls macro `$then!` with every case name, in order: the one list of cases, shared
+/// by `tests/mpcc.rs` (one `#[test]` per case and back end) and `tests/golden.rs`.
+macro_rules! mpcc_names {
+    ($then:ident) => {
+        $then! {
+            two_branches, linear_objective, bard1, ralph1, ralph2, scholtes3, jr2, kth1, kth2,
+            kth3, scholtes5, nash1, dempe, desilva, gauvin, qpec2, scale1, fl_ex1, fl_ex2,
+            lcp_chain, outrata31,
+        }
+    };
+}
+
 pub struct Case {
     pub name: &'static str,
     /// Where the formulation and f* come from.

@@ -36,7 +36,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for r in 0..repeat.max(1) {
         let (model, mut compiled) = export::crawl_model(&s)?;
         let mut opts = IpmOptions {
-            print_level: if log && r == 0 { 5 } else { 0 },
+            common: nlp::CommonOptions {
+                print_level: if log && r == 0 { 5 } else { 0 },
+                ..Default::default()
+            },
             ..IpmOptions::default()
         };
         for (k, v) in &opts_kv {

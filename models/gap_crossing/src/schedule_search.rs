@@ -62,8 +62,10 @@ impl StanceSolver {
         let problem = build_stance(s, terrain)?;
         let compiled = problem.compile()?;
         let ipm = Ipm::new(IpmOptions {
-            print_level: 0,
-            max_iter: STANCE_MAX_ITER,
+            common: nlp::CommonOptions {
+                max_iter: STANCE_MAX_ITER,
+                ..Default::default()
+            },
             ..IpmOptions::default()
         });
         Ok(StanceSolver {

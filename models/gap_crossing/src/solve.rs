@@ -30,8 +30,8 @@ use crate::status::{GoalShortfall, PlanStatus};
 use crate::terrain::{self, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
-    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError, Sqp,
-    SqpOptions, Status,
+    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError,
+    Solver, Sqp, SqpOptions, Status,
 };
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -133,15 +133,20 @@ impl Settings {
         }
     }
 
+    /// The chosen back end with its options.
+    pub fn solver(&self) -> Box<dyn Solver> {
+        match self.backend {
+            Backend::Ipm => Box::new(Ipm::new(self.ipm.clone())),
+            Backend::Sqp => Box::new(Sqp::new(self.sqp.clone())),
+        }
+    }
+
     fn solve(
         &self,
         nlp: &mut dyn NumericNlp,
-        callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
+        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
-        match self.backend {
-            Backend::Ipm => Ipm::new(self.ipm.clone()).solve_with_callback(nlp, callback),
-            Backend::Sqp => Sqp::new(self.sqp.clone()).solve_with_callback(nlp, callback),
-        }
+        self.solver().solve_with_callback(nlp, &mut callback)
     }
 }
 
@@ -295,10 +300,10 @@ fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
         println!("\n== {}", solved.name);
     }
     if level >= 5 {
-        print!("{}", nlp::log::format_table(&solved.phase.records));
+        print!("{}", nlp::format_table(&solved.phase.records));
     }
     if level >= 3 {
-        print!("{}", nlp::log::format_summary(&solved.run.solution));
+        print!("{}", nlp::format_summary(&solved.run.solution));
     }
     phases.push(solved.phase);
     Run {

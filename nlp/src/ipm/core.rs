@@ -11,7 +11,9 @@
 use std::time::Instant;
 
 use crate::callback::Observer;
+use crate::frontend::{KktResiduals, Termination};
 use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, probing_mu, tau};
+use crate::ipm::error::{At, CoreError};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::ipm::restoration;
@@ -70,10 +72,47 @@ pub(crate) struct Outcome {
     pub resto_converged: bool,
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum LsResult {
-    Accepted,
-    Failed,
+/// How the step of an accepted trial point was made (the log's character after
+/// alpha_pr: lower case for the plain step, upper case for a second-order correction).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum StepKind {
+    /// f-type: the switching and Armijo conditions hold; the filter is not augmented.
+    FType { soc: bool },
+    /// h-type: the filter was augmented.
+    HType { soc: bool },
+}
+
+impl StepKind {
+    fn new(ftype: bool, soc: bool) -> StepKind {
+        if ftype {
+            StepKind::FType { soc }
+        } else {
+            StepKind::HType { soc }
+        }
+    }
+
+    fn log_char(self) -> char {
+        match self {
+            StepKind::FType { soc: false } => 'f',
+            StepKind::HType { soc: false } => 'h',
+            StepKind::FType { soc: true } => 'F',
+            StepKind::HType { soc: true } => 'H',
+        }
+    }
+}
+
+/// The outcome of [`Core::line_search`]; `trials` counts the trial step sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum LineSearch {
+    /// A trial point was accepted (and is now the iterate).
+    Accepted {
+        alpha_pr: f64,
+        alpha_du: f64,
+        kind: StepKind,
+        trials: usize,
+    },
+    /// Every step size down to α_min was rejected; `alpha_pr` is the last one tried.
+    Failed { alpha_pr: f64, trials: usize },
 }
 
 pub(crate) struct Core<'p> {
@@ -157,8 +196,8 @@ pub(crate) struct Core<'p> {
     free_mode: bool,
     kkt_refs: Vec<f64>,
     tiny_count: usize,
-    acceptable_count: usize,
-    last_obj: f64,
+    /// The convergence test's state (acceptable streak, previous objective).
+    termination: Termination,
     setup_in_resto: bool,
     obj_scale: f64,
     g_scale: Vec<f64>,
@@ -223,7 +262,7 @@ impl<'p> Core<'p> {
         nlp: &'p mut dyn IpmProblem,
         opts: &IpmOptions,
         setup: &Setup,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, CoreError> {
         let n = nlp.n();
         let m = nlp.m();
         let mut x_l = vec![0.0; n];
@@ -263,8 +302,7 @@ impl<'p> Core<'p> {
         }
         let has_l: Vec<bool> = wl.iter().map(|v| v.is_finite()).collect();
         let has_u: Vec<bool> = wu.iter().map(|v| v.is_finite()).collect();
-        let kkt = Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())
-            .map_err(|e| format!("KKT setup: {e}"))?;
+        let kkt = Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())?;
         let nnz_j = nlp.jac_g_sparsity().row_idx().len();
         let nnz_h = nlp.hess_l_sparsity().row_idx().len();
         let mut kkt = kkt;
@@ -352,8 +390,7 @@ impl<'p> Core<'p> {
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
             kkt_refs: Vec::new(),
             tiny_count: 0,
-            acceptable_count: 0,
-            last_obj: f64::INFINITY,
+            termination: Termination::default(),
             setup_in_resto: setup.in_resto,
             obj_scale: setup.obj_scale,
             g_scale: setup.g_scale.clone(),
@@ -438,56 +475,75 @@ impl<'p> Core<'p> {
     }
 
     /// Evaluates everything at the current w, y. Err names the callback on NaN/Inf.
-    fn eval_current(&mut self) -> Result<(), String> {
+    fn eval_current(&mut self) -> Result<(), CoreError> {
+        self.eval_all(At::Start)
+    }
+
+    /// f, ∇f, g, J and ∇²L at the current w, y, and the residual c; Err names the first
+    /// non-finite value.
+    fn eval_all(&mut self, at: At) -> Result<(), CoreError> {
+        self.eval_first_order(at)?;
+        self.eval_hessian(at)?;
+        let mut c = std::mem::take(&mut self.c);
+        self.constraint_residual(&self.w, &self.g, &mut c);
+        self.c = c;
+        Ok(())
+    }
+
+    /// f, ∇f, g and J at the current w; Err names the first non-finite value.
+    fn eval_first_order(&mut self, at: At) -> Result<(), CoreError> {
         let n = self.n;
         let x = &self.w[..n];
         self.f = self.nlp.eval_f(x);
         if !self.f.is_finite() {
-            return Err(format!("eval_f returned {} at the starting point", self.f));
+            return Err(CoreError::Objective { value: self.f, at });
         }
         self.nlp.eval_grad_f(x, &mut self.grad);
         if let Some(i) = first_non_finite(&self.grad) {
-            return Err(format!(
-                "eval_grad_f returned {} for variable {i} ('{}') at the starting point",
-                self.grad[i],
-                self.nlp.variable_name(i)
-            ));
+            return Err(CoreError::Gradient {
+                value: self.grad[i],
+                index: i,
+                name: self.nlp.variable_name(i),
+                at,
+            });
         }
         self.nlp.eval_g(x, &mut self.g);
-        if let Some(i) = first_non_finite(&self.g) {
-            return Err(format!(
-                "eval_g returned {} for constraint {i} ('{}') at the starting point",
-                self.g[i],
-                self.nlp.constraint_name(i)
-            ));
-        }
+        self.check_g(at)?;
         self.nlp.eval_jac_g(x, &mut self.jac);
         if let Some(p) = first_non_finite(&self.jac) {
             let pat = self.nlp.jac_g_sparsity();
             let col = (0..n).find(|&j| pat.col_range(j).contains(&p)).unwrap_or(0);
             let row = pat.row_idx()[p];
-            return Err(format!(
-                "eval_jac_g returned {} at row {row} ('{}'), column {col} ('{}') at the starting point",
-                self.jac[p],
-                self.nlp.constraint_name(row),
-                self.nlp.variable_name(col)
-            ));
+            return Err(CoreError::Jacobian {
+                value: self.jac[p],
+                row,
+                row_name: self.nlp.constraint_name(row),
+                col,
+                col_name: self.nlp.variable_name(col),
+                at,
+            });
         }
+        Ok(())
+    }
+
+    /// ∇²L at the current w, y; Err names the first non-finite entry.
+    fn eval_hessian(&mut self, at: At) -> Result<(), CoreError> {
+        let n = self.n;
+        let x = &self.w[..n];
         self.nlp.eval_hess_l(x, 1.0, &self.y, &mut self.hess);
         if let Some(p) = first_non_finite(&self.hess) {
             let pat = self.nlp.hess_l_sparsity();
             let col = (0..n).find(|&j| pat.col_range(j).contains(&p)).unwrap_or(0);
             let row = pat.row_idx()[p];
-            return Err(format!(
-                "eval_hess_l returned {} at entry ({row}, {col}) ('{}', '{}') at the starting point",
-                self.hess[p],
-                self.nlp.variable_name(row),
-                self.nlp.variable_name(col)
-            ));
+            return Err(CoreError::Hessian {
+                value: self.hess[p],
+                row,
+                row_name: self.nlp.variable_name(row),
+                col,
+                col_name: self.nlp.variable_name(col),
+                at,
+            });
         }
-        let mut c = std::mem::take(&mut self.c);
-        self.constraint_residual(&self.w, &self.g, &mut c);
-        self.c = c;
         Ok(())
     }
 
@@ -512,7 +568,20 @@ impl<'p> Core<'p> {
         v
     }
 
-    fn initialize(&mut self, start: Start) -> Result<(), String> {
+    /// Err names the first non-finite entry of g.
+    fn check_g(&self, at: At) -> Result<(), CoreError> {
+        match first_non_finite(&self.g) {
+            Some(i) => Err(CoreError::Constraint {
+                value: self.g[i],
+                index: i,
+                name: self.nlp.constraint_name(i),
+                at,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn initialize(&mut self, start: Start) -> Result<(), CoreError> {
         let n = self.n;
         let mut x0 = vec![0.0; n];
         self.nlp.initial_point(&mut x0);
@@ -546,13 +615,7 @@ impl<'p> Core<'p> {
                 }
                 // Slacks from g(x0).
                 self.nlp.eval_g(&self.w[..n], &mut self.g);
-                if let Some(i) = first_non_finite(&self.g) {
-                    return Err(format!(
-                        "eval_g returned {} for constraint {i} ('{}') at the starting point",
-                        self.g[i],
-                        self.nlp.constraint_name(i)
-                    ));
-                }
+                self.check_g(At::Start)?;
                 for k in 0..self.ni {
                     let gi = self.g[self.row_of_slack[k]];
                     self.w[n + k] = self.push_into_bounds(n + k, gi, sp, sf);
@@ -585,14 +648,7 @@ impl<'p> Core<'p> {
                         if self.m > 0 {
                             self.least_squares_multipliers(self.opts.constr_mult_init_max);
                             // Hessian at the new multipliers.
-                            self.nlp
-                                .eval_hess_l(&self.w[..n], 1.0, &self.y, &mut self.hess);
-                            if !all_finite(&self.hess) {
-                                return Err(
-                                    "eval_hess_l returned a non-finite value at the starting point"
-                                        .into(),
-                                );
-                            }
+                            self.eval_hessian(At::Start)?;
                         }
                     }
                 }
@@ -1406,8 +1462,8 @@ impl<'p> Core<'p> {
     }
 
     /// Backtracking filter line search with second-order corrections. On success the
-    /// trial point is accepted and (alpha_pr, alpha_du, char, ls) returned.
-    fn line_search(&mut self, shared: &mut Shared) -> (LsResult, f64, f64, char, usize) {
+    /// trial point is accepted.
+    fn line_search(&mut self, shared: &mut Shared) -> LineSearch {
         let theta = one_norm(&self.c);
         let phi = self.barrier(&self.w, self.f, self.mu);
         let gpd = self.barrier_dir_deriv(&self.dw);
@@ -1415,11 +1471,13 @@ impl<'p> Core<'p> {
         let alpha_min = self.alpha_min(theta, gpd);
         let mut alpha = alpha_max;
         let mut ls = 0usize;
-        let n = self.n;
         loop {
             // The first trial step is always tried, even below α_min (IPOPT).
             if ls > 0 && !(alpha > alpha_min) {
-                return (LsResult::Failed, alpha, 0.0, ' ', ls);
+                return LineSearch::Failed {
+                    alpha_pr: alpha,
+                    trials: ls,
+                };
             }
             ls += 1;
             for j in 0..self.nw {
@@ -1438,13 +1496,12 @@ impl<'p> Core<'p> {
                         let alpha_du = self.max_step_dual(&self.dzl, &self.dzu, self.tau);
                         self.take_dual_step(alpha_du, false);
                         self.accept_trial();
-                        return (
-                            LsResult::Accepted,
-                            alpha,
+                        return LineSearch::Accepted {
+                            alpha_pr: alpha,
                             alpha_du,
-                            if ftype { 'f' } else { 'h' },
-                            ls,
-                        );
+                            kind: StepKind::new(ftype, false),
+                            trials: ls,
+                        };
                     }
                 } else if alpha == alpha_max
                     && theta_t >= theta
@@ -1491,13 +1548,12 @@ impl<'p> Core<'p> {
                                     self.max_step_dual(&self.dzl_s, &self.dzu_s, self.tau);
                                 self.take_dual_step(alpha_du, true);
                                 self.accept_trial();
-                                return (
-                                    LsResult::Accepted,
-                                    a_soc,
+                                return LineSearch::Accepted {
+                                    alpha_pr: a_soc,
                                     alpha_du,
-                                    if ftype { 'F' } else { 'H' },
-                                    ls,
-                                );
+                                    kind: StepKind::new(ftype, true),
+                                    trials: ls,
+                                };
                             }
                             break;
                         }
@@ -1505,7 +1561,6 @@ impl<'p> Core<'p> {
                     }
                 }
             }
-            let _ = n;
             alpha *= self.opts.alpha_red_factor;
         }
     }
@@ -1647,8 +1702,8 @@ impl<'p> Core<'p> {
     // ------------------------------------------------------------------ main loop
 
     pub fn run(&mut self, shared: &mut Shared, start: Start) -> Outcome {
-        if let Err(msg) = self.initialize(start) {
-            return self.outcome(Status::InvalidNumberDetected, msg, false);
+        if let Err(e) = self.initialize(start) {
+            return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
         }
         let (_, eu) = self.errors(0.0, false);
         match self.resto_start.take() {
@@ -1670,28 +1725,14 @@ impl<'p> Core<'p> {
             // ---------------- convergence
             let (e0, eu) = self.nlp_error(0.0, false);
             if !self.setup_in_resto {
-                let o = &self.opts;
-                if e0 <= o.tol
-                    && eu[0] <= o.dual_inf_tol
-                    && eu[1] <= o.constr_viol_tol
-                    && eu[2] <= o.compl_inf_tol
-                {
-                    return self.outcome(Status::SolveSucceeded, "", false);
-                }
-                let obj_change = (self.f - self.last_obj).abs() / self.f.abs().max(1.0);
-                if o.acceptable_iter > 0
-                    && e0 <= o.acceptable_tol
-                    && eu[0] <= o.acceptable_dual_inf_tol
-                    && eu[1] <= o.acceptable_constr_viol_tol
-                    && eu[2] <= o.acceptable_compl_inf_tol
-                    && obj_change <= o.acceptable_obj_change_tol
-                {
-                    self.acceptable_count += 1;
-                    if self.acceptable_count >= o.acceptable_iter {
-                        return self.outcome(Status::SolvedToAcceptableLevel, "", false);
-                    }
-                } else {
-                    self.acceptable_count = 0;
+                let e = KktResiduals {
+                    overall: e0,
+                    dual: eu[0],
+                    primal: eu[1],
+                    compl: eu[2],
+                };
+                if let Some(status) = self.termination.check(&e, self.f, &self.opts.common) {
+                    return self.outcome(status, "", false);
                 }
             } else if e0 <= self.opts.tol {
                 return self.outcome(
@@ -1699,8 +1740,9 @@ impl<'p> Core<'p> {
                     "restoration problem converged",
                     true,
                 );
+            } else {
+                self.termination.set_last_objective(self.f);
             }
-            self.last_obj = self.f;
             if shared.iter >= self.opts.max_iter {
                 return self.outcome(Status::MaximumIterationsExceeded, "", false);
             }
@@ -1744,20 +1786,29 @@ impl<'p> Core<'p> {
                         continue;
                     }
                     self.tiny_count = 0;
-                    let (res, a_pr, a_du, ch, ls) = self.line_search(shared);
-                    if res == LsResult::Accepted {
-                        let (_, eu) = self.errors(0.0, false);
-                        self.record(shared, d_norm, a_du, a_pr, ch, ls, eu[0]);
-                        if self.setup_in_resto && self.nlp.restoration_accepts(&self.w) {
-                            return self.outcome(Status::SolveSucceeded, "", false);
+                    match self.line_search(shared) {
+                        LineSearch::Accepted {
+                            alpha_pr,
+                            alpha_du,
+                            kind,
+                            trials,
+                        } => {
+                            let (_, eu) = self.errors(0.0, false);
+                            let ch = kind.log_char();
+                            self.record(shared, d_norm, alpha_du, alpha_pr, ch, trials, eu[0]);
+                            if self.setup_in_resto && self.nlp.restoration_accepts(&self.w) {
+                                return self.outcome(Status::SolveSucceeded, "", false);
+                            }
+                            continue;
                         }
-                        continue;
+                        LineSearch::Failed { alpha_pr, trials } => {
+                            // The restoration phase's first row reports the failed line
+                            // search (IPOPT: "12r", alpha_pr 'R', and its ls count, one
+                            // more than the trial steps).
+                            shared.iter -= 1;
+                            self.resto_start = Some((alpha_pr, trials + 1));
+                        }
                     }
-                    // The restoration phase's first row reports the failed line search
-                    // (IPOPT: "12r", alpha_pr 'R', and its ls count, one more than the
-                    // trial steps).
-                    shared.iter -= 1;
-                    self.resto_start = Some((a_pr, ls + 1));
                 } else if self.setup_in_resto {
                     return self.outcome(
                         Status::ErrorInStepComputation,
@@ -1783,7 +1834,7 @@ impl<'p> Core<'p> {
                 );
             }
             if self.m == 0 {
-                let status = if self.acceptable_count > 0 {
+                let status = if self.termination.last_was_acceptable() {
                     Status::SolvedToAcceptableLevel
                 } else {
                     Status::SearchDirectionBecomesTooSmall
@@ -1827,7 +1878,7 @@ impl<'p> Core<'p> {
     /// all reset to 1 if one exceeds `bound_mult_reset_threshold`; the constraint
     /// multipliers are the least-squares estimate if `constr_mult_reset_threshold` > 0 and
     /// it is no larger than that, else 0.
-    pub fn restart_from(&mut self, w: &[f64]) -> Result<(), String> {
+    pub fn restart_from(&mut self, w: &[f64]) -> Result<(), CoreError> {
         let (mu, nw) = (self.mu, self.nw);
         let mut dzl = vec![0.0; nw];
         let mut dzu = vec![0.0; nw];
@@ -1856,31 +1907,14 @@ impl<'p> Core<'p> {
         }
         self.w.copy_from_slice(w);
         self.y.iter_mut().for_each(|v| *v = 0.0);
-        let n = self.n;
-        let x = &self.w[..n];
-        self.f = self.nlp.eval_f(x);
-        self.nlp.eval_grad_f(x, &mut self.grad);
-        self.nlp.eval_g(x, &mut self.g);
-        self.nlp.eval_jac_g(x, &mut self.jac);
-        if !self.f.is_finite()
-            || !all_finite(&self.grad)
-            || !all_finite(&self.g)
-            || !all_finite(&self.jac)
-        {
-            return Err("non-finite evaluation at the restoration result".into());
-        }
+        self.eval_first_order(At::RestorationResult)?;
         let mut c = std::mem::take(&mut self.c);
         self.constraint_residual(&self.w, &self.g, &mut c);
         self.c = c;
         if self.opts.constr_mult_reset_threshold > 0.0 {
             self.least_squares_multipliers(self.opts.constr_mult_reset_threshold);
         }
-        self.nlp
-            .eval_hess_l(&self.w[..n], 1.0, &self.y, &mut self.hess);
-        if !all_finite(&self.hess) {
-            return Err("non-finite Hessian at the restoration result".into());
-        }
-        Ok(())
+        self.eval_hessian(At::RestorationResult)
     }
 
     /// Current Hessian regularisation and δ_w bookkeeping accessors.

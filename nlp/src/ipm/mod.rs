@@ -1,16 +1,17 @@
 //! Interior-point method: IPOPT's primal-dual barrier algorithm with a filter line search
 //! (Wächter & Biegler, Math. Prog. 106:25–57, 2006).
 //!
-//! Layout: [`reduced`] (fixed variables removed, scaling, evaluation counters),
+//! Layout: `reduced` (fixed variables removed, scaling, evaluation counters),
 //! `core` (iteration, KKT step with inertia correction, line search with second-order
-//! corrections), [`filter`], [`barrier`] (μ updates), `restoration` (ℓ1 restoration
+//! corrections), `filter`, `barrier` (μ updates), `restoration` (ℓ1 restoration
 //! phase solved by the same core).
 
 #![allow(clippy::needless_range_loop)]
 
-pub mod barrier;
+pub(crate) mod barrier;
 mod core;
-pub mod filter;
+mod error;
+pub(crate) mod filter;
 pub(crate) mod reduced;
 mod restoration;
 
@@ -19,6 +20,8 @@ use std::time::Instant;
 
 use crate::callback::{IterationCallback, IterationView, Observer};
 use crate::error::SolveError;
+use crate::frontend::validate::{validate, Validated};
+use crate::frontend::Solver;
 use crate::numeric::NumericNlp;
 use crate::options::{IpmOptions, ScalingMethod};
 use crate::scaling::{gradient_scale, gradient_scale_up};
@@ -34,105 +37,6 @@ pub struct Ipm {
     pub options: IpmOptions,
 }
 
-struct Validated {
-    x_l: Vec<f64>,
-    x_u: Vec<f64>,
-    g_l: Vec<f64>,
-    g_u: Vec<f64>,
-    x0: Vec<f64>,
-}
-
-fn validate(nlp: &dyn NumericNlp, options: &IpmOptions) -> Result<Validated, SolveError> {
-    options.validate()?;
-    let n = nlp.n();
-    let m = nlp.m();
-    let jac = nlp.jac_g_sparsity();
-    if jac.nrows() != m || jac.ncols() != n {
-        return Err(SolveError::WrongSize(format!(
-            "Jacobian pattern is {}x{}, expected {m}x{n}",
-            jac.nrows(),
-            jac.ncols()
-        )));
-    }
-    let hess = nlp.hess_l_sparsity();
-    if hess.nrows() != n || hess.ncols() != n {
-        return Err(SolveError::WrongSize(format!(
-            "Hessian pattern is {}x{}, expected {n}x{n}",
-            hess.nrows(),
-            hess.ncols()
-        )));
-    }
-    for c in 0..n {
-        for &r in hess.row_idx_of_col_raw(c) {
-            if r < c {
-                return Err(SolveError::WrongSize(format!(
-                    "Hessian pattern entry ({r}, {c}) is above the diagonal; give the lower triangle"
-                )));
-            }
-        }
-    }
-    let mut v = Validated {
-        x_l: vec![0.0; n],
-        x_u: vec![0.0; n],
-        g_l: vec![0.0; m],
-        g_u: vec![0.0; m],
-        x0: vec![0.0; n],
-    };
-    nlp.bounds(&mut v.x_l, &mut v.x_u, &mut v.g_l, &mut v.g_u);
-    nlp.initial_point(&mut v.x0);
-    let check = |what: &'static str,
-                 l: &[f64],
-                 u: &[f64],
-                 name: &dyn Fn(usize) -> String|
-     -> Result<(), SolveError> {
-        for i in 0..l.len() {
-            for (value, bad) in [
-                (l[i], l[i].is_nan() || l[i] == f64::INFINITY),
-                (u[i], u[i].is_nan() || u[i] == f64::NEG_INFINITY),
-            ] {
-                if bad {
-                    return Err(SolveError::InvalidBound {
-                        what,
-                        index: i,
-                        name: name(i),
-                        value,
-                    });
-                }
-            }
-            if l[i] > u[i] {
-                return Err(if what == "variable" {
-                    SolveError::InconsistentVariableBounds {
-                        index: i,
-                        name: name(i),
-                        lower: l[i],
-                        upper: u[i],
-                    }
-                } else {
-                    SolveError::InconsistentConstraintBounds {
-                        index: i,
-                        name: name(i),
-                        lower: l[i],
-                        upper: u[i],
-                    }
-                });
-            }
-        }
-        Ok(())
-    };
-    check("variable", &v.x_l, &v.x_u, &|i| nlp.variable_name(i))?;
-    check("constraint", &v.g_l, &v.g_u, &|i| nlp.constraint_name(i))?;
-    for (i, &x) in v.x0.iter().enumerate() {
-        if !x.is_finite() {
-            return Err(SolveError::InvalidInitialPoint {
-                index: i,
-                name: nlp.variable_name(i),
-                value: x,
-            });
-        }
-    }
-    Ok(v)
-}
-
 impl Ipm {
     /// A solver with the given options.
     pub fn new(options: IpmOptions) -> Self {
@@ -141,7 +45,7 @@ impl Ipm {
 
     /// Solves from the problem's initial point.
     pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
-        self.run(nlp, None, None)
+        self.solve_dyn(nlp, None, None)
     }
 
     /// [`Ipm::solve`] with a per-iteration callback (IPOPT's `intermediate_callback`):
@@ -154,7 +58,7 @@ impl Ipm {
         nlp: &mut dyn NumericNlp,
         mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
-        self.run(nlp, None, Some(&mut callback))
+        self.solve_dyn(nlp, None, Some(&mut callback))
     }
 
     /// [`Ipm::solve_warm`] with a per-iteration callback (see [`Ipm::solve_with_callback`]).
@@ -164,21 +68,7 @@ impl Ipm {
         previous: &Solution,
         mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
-        self.check_warm(nlp, previous)?;
-        self.run(nlp, Some(previous), Some(&mut callback))
-    }
-
-    /// The solve behind every entry point, with the callback as a trait object.
-    pub(crate) fn solve_dyn(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        warm: Option<&Solution>,
-        callback: Option<&mut IterationCallback<'_>>,
-    ) -> Result<Solution, SolveError> {
-        if let Some(prev) = warm {
-            self.check_warm(nlp, prev)?;
-        }
-        self.run(nlp, warm, callback)
+        self.solve_dyn(nlp, Some(previous), Some(&mut callback))
     }
 
     /// Warm start from a previous solution (IPOPT's `warm_start_init_point = yes`): x, λ,
@@ -189,22 +79,7 @@ impl Ipm {
         nlp: &mut dyn NumericNlp,
         previous: &Solution,
     ) -> Result<Solution, SolveError> {
-        self.check_warm(nlp, previous)?;
-        self.run(nlp, Some(previous), None)
-    }
-
-    fn check_warm(&self, nlp: &dyn NumericNlp, previous: &Solution) -> Result<(), SolveError> {
-        previous.check_warm_start(nlp.n(), nlp.m())?;
-        for (i, &x) in previous.x.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(SolveError::InvalidInitialPoint {
-                    index: i,
-                    name: nlp.variable_name(i),
-                    value: x,
-                });
-            }
-        }
-        Ok(())
+        self.solve_dyn(nlp, Some(previous), None)
     }
 
     fn run(
@@ -215,10 +90,8 @@ impl Ipm {
     ) -> Result<Solution, SolveError> {
         let start_time = Instant::now();
         let opts = &self.options;
-        let mut v = validate(nlp, opts)?;
-        if let Some(prev) = warm {
-            v.x0.copy_from_slice(&prev.x);
-        }
+        opts.validate()?;
+        let v = validate(nlp, warm)?;
         let observer = callback.map(|cb| {
             let clamp = opts
                 .honor_original_bounds
@@ -321,13 +194,13 @@ impl Ipm {
                 mu_strategy: opts.mu_strategy,
             };
             match Core::new(&mut red, opts, &setup) {
-                Err(msg) => (
+                Err(e) => (
                     Status::InternalError,
                     red.x0.clone(),
                     vec![0.0; m],
                     vec![0.0; n],
                     vec![0.0; n],
-                    msg,
+                    e.to_string(),
                 ),
                 Ok(mut core) => {
                     let out = core.run(&mut shared, start);
@@ -375,6 +248,21 @@ impl Ipm {
             }
         }
         Ok(sol)
+    }
+}
+
+impl Solver for Ipm {
+    fn name(&self) -> &'static str {
+        "ipm"
+    }
+
+    fn solve_dyn(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        warm: Option<&Solution>,
+        callback: Option<&mut IterationCallback<'_>>,
+    ) -> Result<Solution, SolveError> {
+        self.run(nlp, warm, callback)
     }
 }
 

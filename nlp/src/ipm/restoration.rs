@@ -368,14 +368,14 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         inner_opts.start_with_resto = false;
         let mut inner = match Core::new(&mut resto, &inner_opts, &setup) {
             Ok(c) => c,
-            Err(msg) => {
+            Err(e) => {
                 return Err(Outcome {
                     status: Status::RestorationFailed,
                     w: core.w.clone(),
                     y: core.y.clone(),
                     zl: core.zl.clone(),
                     zu: core.zu.clone(),
-                    message: msg,
+                    message: e.to_string(),
                     resto_converged: false,
                 })
             }
@@ -408,8 +408,8 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
     };
     match outcome.status {
         Status::SolveSucceeded => {
-            if let Err(msg) = core.restart_from(&w_o) {
-                return Err(fail(core, Status::RestorationFailed, msg));
+            if let Err(e) = core.restart_from(&w_o) {
+                return Err(fail(core, Status::RestorationFailed, e.to_string()));
             }
             if outcome.resto_converged {
                 // The restoration problem converged: a minimiser of the infeasibility.
@@ -432,22 +432,33 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
             }
             Ok(())
         }
+        // The solve ends at the restoration's point (for a user stop: the iterate the
+        // callback saw); a failed evaluation there is reported in the message.
         Status::MaximumIterationsExceeded | Status::MaximumWallTimeExceeded => {
-            let _ = core.restart_from(&w_o);
-            Err(fail(core, outcome.status, outcome.message))
+            let message = restart_message(core, &w_o, outcome.message);
+            Err(fail(core, outcome.status, message))
         }
         Status::UserRequestedStop => {
-            // The callback saw the restoration iterate: return its x.
-            let _ = core.restart_from(&w_o);
-            Err(fail(core, outcome.status, outcome.message))
+            let message = restart_message(core, &w_o, outcome.message);
+            Err(fail(core, outcome.status, message))
         }
         Status::InvalidNumberDetected => {
             Err(fail(core, Status::RestorationFailed, outcome.message))
         }
         _ => {
-            let _ = core.restart_from(&w_o);
-            Err(fail(core, Status::RestorationFailed, outcome.message))
+            let message = restart_message(core, &w_o, outcome.message);
+            Err(fail(core, Status::RestorationFailed, message))
         }
+    }
+}
+
+/// Moves the outer core to the restoration's point `w_o`; the message of the ending
+/// solve, with the evaluation failure there appended if there was one.
+fn restart_message(core: &mut Core<'_>, w_o: &[f64], message: String) -> String {
+    match core.restart_from(w_o) {
+        Ok(()) => message,
+        Err(e) if message.is_empty() => e.to_string(),
+        Err(e) => format!("{message}; {e}"),
     }
 }
 

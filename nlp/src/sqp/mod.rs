@@ -3,17 +3,17 @@
 //!
 //! Each iteration at x_k (with multipliers λ_k):
 //! 1. **Hessian.** B = ∇²L(x_k, λ_k) + δI + ρ_a·(J_AᵀJ_A + I_b) over the strongly active
-//!    rows and bounds A ([`active_sets`]): δ is chosen for positive definiteness on the
+//!    rows and bounds A (`active_sets`): δ is chosen for positive definiteness on the
 //!    null space of the active constraints and ρ_a as small as makes B itself positive
-//!    definite (inertia tests with a faer LDLᵀ, [`Convexify`]): clarabel needs a convex
+//!    definite (inertia tests with a faer LDLᵀ, `Convexify`): clarabel needs a convex
 //!    QP. Alternatively damped BFGS ([`HessianApproximation`]).
-//! 2. **QP** ([`qp`]): the elastic subproblem min ½dᵀBd + ∇fᵀd + ρΣe over the linearised
+//! 2. **QP** (`qp`): the elastic subproblem min ½dᵀBd + ∇fᵀd + ρΣe over the linearised
 //!    constraints relaxed by elastic variables e ≥ 0, the bounds, and affine second-order
 //!    cones. It is always feasible. When e ≠ 0 (linearisation inconsistent, "elastic
 //!    mode"), ρ grows by `penalty_increase` and the QP is solved again, up to
 //!    `penalty_max`; past that the step minimises the linearised ℓ1 infeasibility.
 //!    Without elastic variables or cones in use, clarabel's solution is then *polished*
-//!    ([`polish`], option `qp_polish`): the equality QP on its active set, solved exactly
+//!    (`polish`, option `qp_polish`): the equality QP on its active set, solved exactly
 //!    with the faer LDLᵀ, replaces it when that is a KKT point of the QP.
 //! 3. **Line search** on the merit φ(x) = f(x) + Σ w_i·viol_i(x) (individual weights
 //!    w_i ∈ [|λ_i|, ρ], Powell 1978; w_i = ρ is the classical ℓ1 merit) with Armijo's test
@@ -44,6 +44,8 @@ use faer::sparse::SymbolicSparseColMat;
 
 use crate::callback::{IterationCallback, IterationView, Observer};
 use crate::error::SolveError;
+use crate::frontend::validate::validate;
+use crate::frontend::{KktResiduals, Solver, Termination};
 use crate::kkt::Kkt;
 use crate::numeric::{AffineCone, NumericNlp};
 use crate::scaling::gradient_scale;
@@ -131,6 +133,21 @@ impl Scaled<'_> {
         self.nlp.eval_hess_l(x, self.obj_scale, &l, out);
         self.counters.hess_l += 1;
         self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+}
+
+impl Solver for Sqp {
+    fn name(&self) -> &'static str {
+        "sqp"
+    }
+
+    fn solve_dyn(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        warm: Option<&Solution>,
+        callback: Option<&mut IterationCallback<'_>>,
+    ) -> Result<Solution, SolveError> {
+        self.run(nlp, warm, callback)
     }
 }
 
@@ -257,7 +274,7 @@ impl Sqp {
 
     /// Solves from the problem's initial point.
     pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
-        self.run(nlp, None, None)
+        self.solve_dyn(nlp, None, None)
     }
 
     /// [`Sqp::solve`] with a per-iteration callback, as
@@ -269,7 +286,7 @@ impl Sqp {
         nlp: &mut dyn NumericNlp,
         mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
-        self.run(nlp, None, Some(&mut callback))
+        self.solve_dyn(nlp, None, Some(&mut callback))
     }
 
     /// [`Sqp::solve_warm`] with a per-iteration callback (see [`Sqp::solve_with_callback`]).
@@ -279,21 +296,7 @@ impl Sqp {
         previous: &Solution,
         mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
-        previous.check_warm_start(nlp.n(), nlp.m())?;
-        self.run(nlp, Some(previous), Some(&mut callback))
-    }
-
-    /// The solve behind every entry point, with the callback as a trait object.
-    pub(crate) fn solve_dyn(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        warm: Option<&Solution>,
-        callback: Option<&mut IterationCallback<'_>>,
-    ) -> Result<Solution, SolveError> {
-        if let Some(prev) = warm {
-            prev.check_warm_start(nlp.n(), nlp.m())?;
-        }
-        self.run(nlp, warm, callback)
+        self.solve_dyn(nlp, Some(previous), Some(&mut callback))
     }
 
     /// Starts from a previous solution's x and multipliers (λ, z_L, z_U): with a good
@@ -303,8 +306,7 @@ impl Sqp {
         nlp: &mut dyn NumericNlp,
         previous: &Solution,
     ) -> Result<Solution, SolveError> {
-        previous.check_warm_start(nlp.n(), nlp.m())?;
-        self.run(nlp, Some(previous), None)
+        self.solve_dyn(nlp, Some(previous), None)
     }
 
     fn run(
@@ -316,106 +318,27 @@ impl Sqp {
         let start = Instant::now();
         let o = &self.options;
         o.validate()?;
+        let v = validate(nlp, warm)?;
         let n = nlp.n();
         let m = nlp.m();
         let jp = nlp.jac_g_sparsity().clone();
         let hp = nlp.hess_l_sparsity().clone();
-        if jp.nrows() != m || jp.ncols() != n {
-            return Err(SolveError::WrongSize(format!(
-                "Jacobian pattern is {}x{}, expected {m}x{n}",
-                jp.nrows(),
-                jp.ncols()
-            )));
-        }
-        if hp.nrows() != n || hp.ncols() != n {
-            return Err(SolveError::WrongSize(format!(
-                "Hessian pattern is {}x{}, expected {n}x{n}",
-                hp.nrows(),
-                hp.ncols()
-            )));
-        }
         let cones: Vec<AffineCone> = nlp.affine_cones().to_vec();
         let cp = nlp.cone_jac_sparsity().cloned();
         let n_cone = cones.iter().map(|c| c.offset + c.dim).max().unwrap_or(0);
+        let mut cone_row = vec![false; m];
+        for c in &cones {
+            cone_row[c.row] = true;
+        }
         let mut geo = Geometry {
-            x_l: vec![0.0; n],
-            x_u: vec![0.0; n],
-            g_l: vec![0.0; m],
-            g_u: vec![0.0; m],
-            cone_row: vec![false; m],
+            x_l: v.x_l,
+            x_u: v.x_u,
+            g_l: v.g_l,
+            g_u: v.g_u,
+            cone_row,
             cones: cones.clone(),
         };
-        nlp.bounds(&mut geo.x_l, &mut geo.x_u, &mut geo.g_l, &mut geo.g_u);
-        for c in &cones {
-            if c.row >= m {
-                return Err(SolveError::WrongSize(format!(
-                    "cone row {} out of range (m = {m})",
-                    c.row
-                )));
-            }
-            geo.cone_row[c.row] = true;
-        }
-        let name_v = |i: usize| nlp.variable_name(i);
-        for j in 0..n {
-            let (l, u) = (geo.x_l[j], geo.x_u[j]);
-            if l.is_nan() || u.is_nan() || l == f64::INFINITY || u == f64::NEG_INFINITY {
-                return Err(SolveError::InvalidBound {
-                    what: "variable",
-                    index: j,
-                    name: name_v(j),
-                    value: if l.is_nan() || l == f64::INFINITY {
-                        l
-                    } else {
-                        u
-                    },
-                });
-            }
-            if l > u {
-                return Err(SolveError::InconsistentVariableBounds {
-                    index: j,
-                    name: name_v(j),
-                    lower: l,
-                    upper: u,
-                });
-            }
-        }
-        for i in 0..m {
-            let (l, u) = (geo.g_l[i], geo.g_u[i]);
-            if l.is_nan() || u.is_nan() || l == f64::INFINITY || u == f64::NEG_INFINITY {
-                return Err(SolveError::InvalidBound {
-                    what: "constraint",
-                    index: i,
-                    name: nlp.constraint_name(i),
-                    value: if l.is_nan() || l == f64::INFINITY {
-                        l
-                    } else {
-                        u
-                    },
-                });
-            }
-            if l > u {
-                return Err(SolveError::InconsistentConstraintBounds {
-                    index: i,
-                    name: nlp.constraint_name(i),
-                    lower: l,
-                    upper: u,
-                });
-            }
-        }
-        let mut x = vec![0.0; n];
-        nlp.initial_point(&mut x);
-        if let Some(p) = warm {
-            x.copy_from_slice(&p.x);
-        }
-        for (j, v) in x.iter().enumerate() {
-            if !v.is_finite() {
-                return Err(SolveError::InvalidInitialPoint {
-                    index: j,
-                    name: nlp.variable_name(j),
-                    value: *v,
-                });
-            }
-        }
+        let mut x = v.x0;
         for j in 0..n {
             x[j] = x[j].clamp(geo.x_l[j], geo.x_u[j]);
         }
@@ -519,7 +442,7 @@ impl Sqp {
         let mut rho = o.penalty_init;
         let mut merit_w = vec![0.0f64; m];
         let mut delta_last = 0.0f64;
-        let mut acceptable = 0usize;
+        let mut termination = Termination::default();
         let status;
         let mut message = String::new();
         let mut record = IterationRecord {
@@ -585,27 +508,20 @@ impl Sqp {
                 }
             }
             let unscaled_pr = unscaled_violation(&geo, &sc.g_scale, &x, &g, &cone);
-            if have_mult
-                && err.scaled <= o.tol
-                && unscaled_du <= o.dual_inf_tol
-                && unscaled_pr <= o.constr_viol_tol
-                && err.compl / sc.obj_scale <= o.compl_inf_tol
-            {
-                status = Status::SolveSucceeded;
+            // Without multipliers (a cold start's iteration 0) the dual error is not
+            // measured: no test, and the streak of acceptable iterates restarts.
+            let residuals = KktResiduals {
+                overall: err.scaled,
+                dual: unscaled_du,
+                primal: unscaled_pr,
+                compl: err.compl / sc.obj_scale,
+            };
+            if !have_mult {
+                termination = Termination::default();
+                termination.set_last_objective(f);
+            } else if let Some(s) = termination.check(&residuals, f, &o.common) {
+                status = s;
                 break;
-            }
-            if have_mult
-                && o.acceptable_iter > 0
-                && err.scaled <= o.acceptable_tol
-                && unscaled_pr <= o.acceptable_constr_viol_tol
-            {
-                acceptable += 1;
-                if acceptable >= o.acceptable_iter {
-                    status = Status::SolvedToAcceptableLevel;
-                    break;
-                }
-            } else {
-                acceptable = 0;
             }
             if iter >= o.max_iter {
                 status = Status::MaximumIterationsExceeded;

@@ -7,13 +7,14 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::SolveError;
+use crate::frontend::CommonOptions;
 
 /// How the QP Hessian `B` is obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum HessianApproximation {
     /// The exact Lagrangian Hessian, shifted by δ·I until it is positive definite (δ is
-    /// found by trial factorisations with [`Kkt`](crate::Kkt) and counting the inertia,
+    /// found by trial factorisations of the KKT matrix (faer LDLᵀ) and counting the inertia,
     /// as IPOPT's inertia correction does). Default.
     Exact,
     /// Damped BFGS (Powell 1978) on a dense n×n matrix: for small problems or when
@@ -23,38 +24,15 @@ pub enum HessianApproximation {
 
 /// All options of the SQP method.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(remote = "Self", default)]
 pub struct SqpOptions {
-    // ---------- termination (same meaning as IpmOptions) ----------
-    /// Desired relative (scaled) convergence tolerance on the KKT error. Default 1e-8.
-    pub tol: f64,
-    /// Scaling threshold s_max for the NLP error. Default 100.
-    pub s_max: f64,
-    /// Maximum number of SQP iterations. Default 3000.
-    pub max_iter: usize,
-    /// Maximum wall-clock time in seconds. Default 1e20.
-    pub max_wall_time: f64,
-    /// Absolute tolerance on (unscaled) dual infeasibility. Default 1.
-    pub dual_inf_tol: f64,
-    /// Absolute tolerance on (unscaled) constraint violation. Default 1e-4.
-    pub constr_viol_tol: f64,
-    /// Absolute tolerance on (unscaled) complementarity. Default 1e-4.
-    pub compl_inf_tol: f64,
-    /// "Acceptable" relative convergence tolerance. Default 1e-6.
-    pub acceptable_tol: f64,
-    /// Number of consecutive acceptable iterates before stopping. Default 15 (0 disables).
-    pub acceptable_iter: usize,
-    /// Acceptable constraint violation. Default 1e-2.
-    pub acceptable_constr_viol_tol: f64,
-    /// Iterates with a component larger than this in magnitude are diverging. Default 1e20.
-    pub diverging_iterates_tol: f64,
-    // ---------- scaling (as IpmOptions) ----------
+    /// Termination, scaling bounds and output, the same options as the interior-point
+    /// method's ([`CommonOptions`]; its fields read and write as fields of this struct).
+    #[serde(flatten)]
+    pub common: CommonOptions,
+    // ---------- scaling ----------
     /// Gradient-based scaling of objective and constraints at the start. Default true.
     pub gradient_scaling: bool,
-    /// Maximum gradient after scaling. Default 100.
-    pub nlp_scaling_max_gradient: f64,
-    /// Minimum scaling factor. Default 1e-8.
-    pub nlp_scaling_min_value: f64,
     // ---------- Hessian ----------
     /// Exact (shifted) Hessian or damped BFGS. Default exact.
     pub hessian_approximation: HessianApproximation,
@@ -106,27 +84,15 @@ pub struct SqpOptions {
     /// problem; on reduced Hessians with curvatures far apart its step error stalled the
     /// SQP (docs/performance.md, "SQP on the flagship"). Default true.
     pub qp_polish: bool,
-    /// Print level: 0 silent, ≥ 5 iteration table, ≥ 3 summary. Default 0.
-    pub print_level: u8,
 }
+
+crate::frontend::strict_options_serde!(SqpOptions);
 
 impl Default for SqpOptions {
     fn default() -> Self {
         SqpOptions {
-            tol: 1e-8,
-            s_max: 100.0,
-            max_iter: 3000,
-            max_wall_time: 1e20,
-            dual_inf_tol: 1.0,
-            constr_viol_tol: 1e-4,
-            compl_inf_tol: 1e-4,
-            acceptable_tol: 1e-6,
-            acceptable_iter: 15,
-            acceptable_constr_viol_tol: 1e-2,
-            diverging_iterates_tol: 1e20,
+            common: CommonOptions::default(),
             gradient_scaling: true,
-            nlp_scaling_max_gradient: 100.0,
-            nlp_scaling_min_value: 1e-8,
             hessian_approximation: HessianApproximation::Exact,
             first_hessian_shift: 1e-4,
             min_hessian_shift: 1e-20,
@@ -145,7 +111,6 @@ impl Default for SqpOptions {
             qp_max_iter: 200,
             elastic_tol: 1e-8,
             qp_polish: true,
-            print_level: 0,
         }
     }
 }
@@ -160,6 +125,7 @@ fn bad(field: &'static str, reason: impl Into<String>) -> SolveError {
 impl SqpOptions {
     /// Checks every option; the error names the first bad field.
     pub fn validate(&self) -> Result<(), SolveError> {
+        self.common.validate()?;
         macro_rules! positive {
             ($($f:ident),*) => {$(
                 if self.$f.is_nan() || self.$f <= 0.0 || !self.$f.is_finite() {
@@ -175,17 +141,6 @@ impl SqpOptions {
             )*};
         }
         positive!(
-            tol,
-            s_max,
-            max_wall_time,
-            dual_inf_tol,
-            constr_viol_tol,
-            compl_inf_tol,
-            acceptable_tol,
-            acceptable_constr_viol_tol,
-            diverging_iterates_tol,
-            nlp_scaling_max_gradient,
-            nlp_scaling_min_value,
             first_hessian_shift,
             min_hessian_shift,
             max_hessian_shift,
@@ -220,9 +175,6 @@ impl SqpOptions {
                 "first_hessian_shift",
                 "need min_hessian_shift <= first_hessian_shift <= max_hessian_shift",
             ));
-        }
-        if self.max_iter == 0 {
-            return Err(bad("max_iter", "must be at least 1"));
         }
         if self.qp_max_iter == 0 {
             return Err(bad("qp_max_iter", "must be at least 1"));

@@ -1,0 +1,20 @@
+//! What the two back ends ([`Ipm`](crate::Ipm), [`Sqp`](crate::Sqp)) share in front of
+//! and behind their iterations:
+//!
+//! - [`common_options`]: [`CommonOptions`], the options with one meaning in both;
+//! - `validate`: one check of the problem handed to a solver (sizes, the Hessian's
+//!   lower triangle, cone rows, bounds, starting point);
+//! - `termination`: the KKT error of an iterate (`KktResiduals`) and one
+//!   convergence test (`tol` and the `acceptable_*` options);
+//! - [`solver`]: the [`Solver`] trait both implement, through which drivers
+//!   ([`solve_mpcc`](crate::solve_mpcc), the planner) dispatch.
+
+pub mod common_options;
+pub mod solver;
+pub(crate) mod termination;
+pub(crate) mod validate;
+
+pub(crate) use common_options::strict_options_serde;
+pub use common_options::CommonOptions;
+pub use solver::Solver;
+pub(crate) use termination::{KktResiduals, Termination};
