@@ -14,7 +14,7 @@
 //!
 //! with `F` the variables not at an active bound. `∇²ₓₚL` and `∂g/∂p` are derived
 //! symbolically from the [`Problem`] and compiled once. The system is factorised by
-//! [`crate::kkt::Kkt`] with the rows and columns of `B` and of the inactive rows replaced by
+//! the crate-internal KKT factorisation (`kkt::Kkt`) with the rows and columns of `B` and of the inactive rows replaced by
 //! identity blocks, a small regularisation on the active rows that iterative refinement
 //! removes, and an inertia check (`n` positive, `m` negative eigenvalues) that fails when
 //! the reduced Hessian is not positive definite or the active Jacobian is rank deficient.
