@@ -154,7 +154,10 @@ fn exported_text_is_the_compiled_problem() {
         // Printing and parsing keep every operation and constant (Debug-formatted f64
         // round-trips exactly), so the values agree to the last bits of rounding.
         let err = export::verify(&dump).expect("parses");
-        assert!(err <= 1e-12 * (1.0 + dump.f0.abs()), "{name}: {err}");
+        assert!(
+            err <= 1e-12 * (1.0 + dump.problem.f0.abs()),
+            "{name}: {err}"
+        );
     }
 }
 

@@ -57,14 +57,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = Instant::now();
     let d: NlpDump = export::dump(&s, &model, &mut compiled);
     let dump_s = t.elapsed().as_secs_f64();
-    let v = export::verify(&d)?;
-    let tol = 1e-9 * (1.0 + d.f0.abs());
+    let v = d.problem.verify()?;
+    let tol = 1e-9 * (1.0 + d.problem.f0.abs());
     if v.objective_error > tol || v.constraint_error > 1e-9 {
         return Err(format!("parsed expressions disagree with the compiled problem: {v:?}").into());
     }
     eprintln!(
         "n {} m {}, f(x0) = {:.12e}; parse-back check: |Δf| {:.1e}, max |Δg| {:.1e}",
-        d.n, d.m, d.f0, v.objective_error, v.constraint_error
+        d.problem.n, d.problem.m, d.problem.f0, v.objective_error, v.constraint_error
     );
     let mut value = serde_json::to_value(&d)?;
     value["verification"] = serde_json::to_value(v)?;
