@@ -176,3 +176,54 @@ fn two_link_arm_minimum_time_matches_ipopt() {
     let gap = simulation_gap(&two_link_arm::problem().unwrap(), &t);
     assert!(gap < 1e-3, "simulation gap {gap}");
 }
+
+/// Largest relative objective difference and largest state/control difference of two
+/// solutions of the same NLP.
+fn differences(a: &Trajectory, b: &Trajectory) -> (f64, f64) {
+    let rel = ((a.objective - b.objective) / a.objective).abs();
+    let max = |x: &[Vec<f64>], y: &[Vec<f64>]| {
+        x.iter()
+            .flatten()
+            .zip(y.iter().flatten())
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max)
+    };
+    (
+        rel,
+        max(&a.states, &b.states).max(max(&a.controls, &b.controls)),
+    )
+}
+
+/// The call-node route (dynamics as a compiled function, one call of the compiled RK4
+/// interval per interval) is the same NLP as the inlined transcription: the derivatives
+/// are the same numbers up to summation order, so the interior point takes the same steps.
+/// Tolerance 1e-10: rounding differences of O(1e-16) per evaluation, amplified by at most
+/// the ~10–30 Newton steps of the solve (measured 2026-11-25: objectives 0 to 1.2e-16
+/// relative, states and controls ≤ 3.6e-16).
+#[test]
+fn call_nodes_give_the_inlined_optimum() {
+    use symnlp::nlp::ocp::{ButcherTableau, Method};
+    let inlined = vdp_multiple_shooting::solve_with(20, IpmOptions::default(), false).unwrap();
+    let calls = vdp_multiple_shooting::solve_with(20, IpmOptions::default(), true).unwrap();
+    // Dynamics function without step calls: four calls of f per RK4 step.
+    let ocp = vdp_multiple_shooting::van_der_pol_with_calls().unwrap();
+    let tr = ocp
+        .transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 4), 20)
+        .unwrap();
+    let f_calls = solve_ipm(&tr);
+    for (name, t) in [("vdp step calls", &calls), ("vdp f calls", &f_calls)] {
+        let (rel, dx) = differences(&inlined, t);
+        eprintln!("{name}: objective {rel:.1e} relative, states/controls {dx:.1e}");
+        assert!(rel <= 1e-10 && dx <= 1e-8, "{name}: {rel:e} {dx:e}");
+    }
+    let q_inlined = solve_ipm(&quadrotor::transcription(20).unwrap());
+    let q_calls = solve_ipm(&quadrotor::transcription_with_calls(20).unwrap());
+    let (rel, dx) = differences(&q_inlined, &q_calls);
+    eprintln!("quadrotor: objective {rel:.1e} relative, states/controls {dx:.1e}");
+    assert!(rel <= 1e-10 && dx <= 1e-8, "quadrotor: {rel:e} {dx:e}");
+    assert_matches_ipopt("quadrotor (calls)", q_calls.objective, 0.08009187934345072);
+    // The call version's constraints are calls of the compiled interval, not RK4 expressions.
+    let tr = quadrotor::transcription_with_calls(3).unwrap();
+    let g = tr.problem().constraint_expressions();
+    assert!(g.iter().any(|e| e.to_string().contains("rk4_interval(")));
+}
