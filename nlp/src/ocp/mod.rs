@@ -88,7 +88,7 @@ pub struct Dynamics {
 
 enum DynamicsKind {
     Closure(StageVector),
-    Function(symx::Function),
+    Function(Box<symx::Function>),
 }
 
 impl Dynamics {
@@ -124,14 +124,14 @@ impl Dynamics {
             });
         }
         Ok(Dynamics {
-            f: DynamicsKind::Function(f),
+            f: DynamicsKind::Function(Box::new(f)),
         })
     }
 
     /// The compiled function, if the dynamics was given as one.
     pub fn function(&self) -> Option<&symx::Function> {
         match &self.f {
-            DynamicsKind::Function(f) => Some(f),
+            DynamicsKind::Function(f) => Some(f.as_ref()),
             DynamicsKind::Closure(_) => None,
         }
     }
