@@ -7,10 +7,16 @@
 //! `benches/reference/ocp_examples.py` solves the identical NLP with IPOPT;
 //! `tests/ocp_examples.rs` compares.
 //!
-//! Run: `cargo run --release --example quadrotor`
+//! With `--calls`, the call-node route: `Method::multiple_shooting_with_calls` compiles one
+//! RK4 interval once and calls it at every interval — the same NLP and iterates with a
+//! graph that holds the dynamics once (19× fewer nodes, 23× less peak heap at N = 1000:
+//! `docs/performance.md`). `problem_with(true)` gives the dynamics as a compiled
+//! `symx::Function` instead (`Ocp::set_dynamics_function`), also the same NLP.
+//!
+//! Run: `cargo run --release --example quadrotor [-- --calls]`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Transcription};
-use symnlp::symx::{Expr, Matrix};
+use symnlp::symx::{Expr, Function, Matrix};
 
 const MASS: f64 = 0.468;
 const ARM: f64 = 0.225;
@@ -44,11 +50,29 @@ fn dynamics(x: &Matrix, u: &Matrix) -> Matrix {
 
 /// The optimal control problem (no transcription yet).
 pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
+    problem_with(false)
+}
+
+/// The optimal control problem; with `dynamics_function`, the dynamics is compiled once as
+/// `f(x, u, p) -> ẋ` and called (`Ocp::set_dynamics_function`) instead of a closure.
+pub fn problem_with(dynamics_function: bool) -> Result<Ocp, Box<dyn std::error::Error>> {
     let states = [
         "x", "y", "z", "vx", "vy", "vz", "roll", "pitch", "yaw", "wx", "wy", "wz",
     ];
     let mut ocp = Ocp::new(&states, &["F1", "F2", "F3", "F4"]);
-    ocp.set_dynamics(|x, u, _p| dynamics(x, u));
+    if dynamics_function {
+        let (x, u) = (Matrix::sym_vec("x", 12), Matrix::sym_vec("u", 4));
+        let p = Matrix::sym_vec("p", 0);
+        let xdot = dynamics(&x, &u);
+        let f = Function::named(
+            "quadrotor",
+            &[("x", &x), ("u", &u), ("p", &p)],
+            &[("xdot", &xdot)],
+        )?;
+        ocp.set_dynamics_function(f)?;
+    } else {
+        ocp.set_dynamics(|x, u, _p| dynamics(x, u));
+    }
     ocp.set_stage_cost(|_x, u, _p| u.iter().map(|&f| (f - HOVER).sq()).sum());
     ocp.set_horizon(Horizon::Fixed(2.0))?;
     let (inf, tilt) = (f64::INFINITY, PI / 4.0);
@@ -72,8 +96,21 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     Ok(ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), n)?)
 }
 
+/// The same NLP through call nodes: one call per interval of the RK4 step compiled once
+/// (the dynamics closure is inlined into that one step, which keeps the evaluation work
+/// that of the inlined version; see `docs/ocp.md`, "Call nodes").
+pub fn transcription_with_calls(n: usize) -> Result<Transcription, Box<dyn std::error::Error>> {
+    let ocp = problem()?;
+    let method = Method::multiple_shooting_with_calls(ButcherTableau::rk4(), 1);
+    Ok(ocp.transcribe(&method, n)?)
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let tr = transcription(20)?;
+    let tr = if std::env::args().any(|a| a == "--calls") {
+        transcription_with_calls(20)?
+    } else {
+        transcription(20)?
+    };
     let mut compiled = tr.compile()?;
     let sol = symnlp::nlp::Ipm::default().solve(&mut compiled)?;
     let traj = tr.trajectory(&sol)?;

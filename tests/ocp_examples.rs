@@ -176,3 +176,195 @@ fn two_link_arm_minimum_time_matches_ipopt() {
     let gap = simulation_gap(&two_link_arm::problem().unwrap(), &t);
     assert!(gap < 1e-3, "simulation gap {gap}");
 }
+
+/// Largest relative objective difference and largest state/control difference of two
+/// solutions of the same NLP.
+fn differences(a: &Trajectory, b: &Trajectory) -> (f64, f64) {
+    let rel = ((a.objective - b.objective) / a.objective).abs();
+    let max = |x: &[Vec<f64>], y: &[Vec<f64>]| {
+        x.iter()
+            .flatten()
+            .zip(y.iter().flatten())
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max)
+    };
+    (
+        rel,
+        max(&a.states, &b.states).max(max(&a.controls, &b.controls)),
+    )
+}
+
+/// The call-node route (dynamics as a compiled function, one call of the compiled RK4
+/// interval per interval) is the same NLP as the inlined transcription: the derivatives
+/// are the same numbers up to summation order, so the interior point takes the same steps.
+/// Tolerance 1e-10: rounding differences of O(1e-16) per evaluation, amplified by at most
+/// the ~10–30 Newton steps of the solve (measured 2026-11-25: objectives 0 to 6.9e-16
+/// relative, states and controls ≤ 4.4e-16).
+#[test]
+fn call_nodes_give_the_inlined_optimum() {
+    use symnlp::nlp::ocp::{ButcherTableau, Method};
+    let inlined = vdp_multiple_shooting::solve_with(20, IpmOptions::default(), false).unwrap();
+    let calls = vdp_multiple_shooting::solve_with(20, IpmOptions::default(), true).unwrap();
+    // Dynamics function without step calls: four calls of f per RK4 step.
+    let ocp = vdp_multiple_shooting::van_der_pol_with_calls().unwrap();
+    let tr = ocp
+        .transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 4), 20)
+        .unwrap();
+    let f_calls = solve_ipm(&tr);
+    for (name, t) in [("vdp step calls", &calls), ("vdp f calls", &f_calls)] {
+        let (rel, dx) = differences(&inlined, t);
+        eprintln!("{name}: objective {rel:.1e} relative, states/controls {dx:.1e}");
+        assert!(rel <= 1e-10 && dx <= 1e-8, "{name}: {rel:e} {dx:e}");
+    }
+    let q_inlined = solve_ipm(&quadrotor::transcription(20).unwrap());
+    let q_calls = solve_ipm(&quadrotor::transcription_with_calls(20).unwrap());
+    let both = quadrotor::problem_with(true)
+        .unwrap()
+        .transcribe(
+            &Method::multiple_shooting_with_calls(ButcherTableau::rk4(), 1),
+            20,
+        )
+        .unwrap();
+    let q_both = solve_ipm(&both);
+    for (name, t) in [
+        ("quadrotor step calls", &q_calls),
+        ("quadrotor f + step calls", &q_both),
+    ] {
+        let (rel, dx) = differences(&q_inlined, t);
+        eprintln!("{name}: objective {rel:.1e} relative, states/controls {dx:.1e}");
+        assert!(rel <= 1e-10 && dx <= 1e-8, "{name}: {rel:e} {dx:e}");
+    }
+    assert_matches_ipopt("quadrotor (calls)", q_calls.objective, 0.08009187934345072);
+    // The call version's constraints are calls of the compiled interval, not RK4 expressions.
+    let tr = quadrotor::transcription_with_calls(3).unwrap();
+    let g = tr.problem().constraint_expressions();
+    assert!(g.iter().any(|e| e.to_string().contains("rk4_interval(")));
+}
+
+/// Heap use of the measuring thread: a counting global allocator that, while `ACTIVE` is
+/// set on a thread, adds that thread's allocations and subtracts its deallocations and
+/// keeps the peak (the graph is thread-local, so a build on a fresh thread is counted
+/// whole; allocations of other threads are not counted).
+mod heap {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+
+    pub struct Counting;
+
+    thread_local! {
+        pub static ACTIVE: Cell<bool> = const { Cell::new(false) };
+        static LIVE: Cell<isize> = const { Cell::new(0) };
+        static PEAK: Cell<isize> = const { Cell::new(0) };
+    }
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            if ACTIVE.with(Cell::get) {
+                let live = LIVE.with(|l| {
+                    l.set(l.get() + layout.size() as isize);
+                    l.get()
+                });
+                PEAK.with(|p| p.set(p.get().max(live)));
+            }
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            if ACTIVE.with(Cell::get) {
+                LIVE.with(|l| l.set(l.get() - layout.size() as isize));
+            }
+            unsafe { System.dealloc(ptr, layout) }
+        }
+    }
+
+    /// Runs `f` counting; returns its result and the peak of live bytes allocated by it.
+    pub fn peak_during<R>(f: impl FnOnce() -> R) -> (R, usize) {
+        LIVE.with(|l| l.set(0));
+        PEAK.with(|p| p.set(0));
+        ACTIVE.with(|a| a.set(true));
+        let r = f();
+        ACTIVE.with(|a| a.set(false));
+        (r, PEAK.with(Cell::get).max(0) as usize)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: heap::Counting = heap::Counting;
+
+/// Sizes of one transcription of the quadrotor at N intervals, built and compiled on a
+/// fresh thread (so the thread-local graph starts empty).
+#[derive(Debug)]
+struct Sizes {
+    nodes_after_transcription: usize,
+    nodes_after_compilation: usize,
+    peak_heap_bytes: usize,
+    /// Tape instructions of ∂g/∂w and of the Lagrangian Hessian, and instructions
+    /// executed per evaluation (callees' tapes included).
+    jac_instructions: (usize, usize),
+    hess_instructions: (usize, usize),
+}
+
+fn quadrotor_sizes(n: usize, dynamics_function: bool, step_calls: bool) -> Sizes {
+    use symnlp::nlp::ocp::{ButcherTableau, Method};
+    std::thread::spawn(move || {
+        let ((tr, nodes_t, compiled), peak) = heap::peak_during(|| {
+            let ocp = quadrotor::problem_with(dynamics_function).unwrap();
+            let method = match step_calls {
+                true => Method::multiple_shooting_with_calls(ButcherTableau::rk4(), 1),
+                false => Method::multiple_shooting(ButcherTableau::rk4(), 1),
+            };
+            let tr = ocp.transcribe(&method, n).unwrap();
+            let nodes_t = symnlp::symx::node_count();
+            let compiled = tr.compile().unwrap();
+            (tr, nodes_t, compiled)
+        });
+        let nodes_c = symnlp::symx::node_count();
+        drop(compiled);
+        // The derivative functions exactly as Compiled::new (nlp/src/compiled.rs) builds
+        // them; on the same graph, so the expressions are the compiled problem's.
+        use symnlp::symx::{jacobian, lagrangian_hessian, Expr, Function, Matrix};
+        let pb = tr.problem();
+        let (x, p, g) = (pb.variables(), pb.parameters(), pb.constraint_expressions());
+        let jac = jacobian(&g, x).unwrap();
+        let sigma = Expr::sym("obj_factor");
+        let lambda = Matrix::sym_vec("lambda", g.len());
+        let hess = lagrangian_hessian(pb.objective(), &g, x, sigma, &lambda).unwrap();
+        let jac_fn = Function::new(&[x, p], &[jac.values()]).unwrap();
+        let hess_fn = Function::new(&[x, p, &[sigma], &lambda], &[hess.values()]).unwrap();
+        let count = |f: &Function| (f.instruction_count(), f.executed_instruction_count());
+        Sizes {
+            nodes_after_transcription: nodes_t,
+            nodes_after_compilation: nodes_c,
+            peak_heap_bytes: peak,
+            jac_instructions: count(&jac_fn),
+            hess_instructions: count(&hess_fn),
+        }
+    })
+    .join()
+    .unwrap()
+}
+
+/// Issue 13's size target: with call nodes, the quadrotor OCP at N = 1000 (RK4 multiple
+/// shooting through the Ocp helper) builds and compiles with at least 5× fewer graph nodes
+/// and 5× less peak heap than inlined (the figures of docs/performance.md come from this
+/// test's output: `cargo test --release --test ocp_examples quadrotor_sizes -- --nocapture`).
+/// Sizes are deterministic; times are not measured here.
+#[test]
+fn quadrotor_sizes_with_calls_vs_inlined() {
+    const N: usize = 1000;
+    let inlined = quadrotor_sizes(N, false, false);
+    let calls = quadrotor_sizes(N, false, true);
+    let f_calls = quadrotor_sizes(N, true, false);
+    let both = quadrotor_sizes(N, true, true);
+    eprintln!("N = {N}\ninlined: {inlined:?}\nstep calls: {calls:?}");
+    eprintln!("f calls: {f_calls:?}\nboth: {both:?}");
+    assert!(inlined.nodes_after_compilation >= 5 * calls.nodes_after_compilation);
+    assert!(inlined.peak_heap_bytes >= 5 * calls.peak_heap_bytes);
+    assert!(inlined.hess_instructions.0 >= 5 * calls.hess_instructions.0);
+    // With the closure inlined into the one compiled step, the work per evaluation stays
+    // within 1.5× of the inlined version (measured 1.09× for ∂g/∂w, 1.25× for the Hessian).
+    assert!(2 * calls.jac_instructions.1 <= 3 * inlined.jac_instructions.1);
+    assert!(2 * calls.hess_instructions.1 <= 3 * inlined.hess_instructions.1);
+    // A dynamics function alone is called 4× per interval: fewer nodes, not 5× fewer.
+    assert!(f_calls.nodes_after_compilation < inlined.nodes_after_compilation);
+    assert!(both.nodes_after_compilation * 5 <= inlined.nodes_after_compilation);
+}

@@ -7,10 +7,12 @@
 //! options, and reads a [`Solution`](crate::Solution) back as a [`Trajectory`]
 //! (time grid, states, controls; serde-serialisable). See `docs/ocp.md`.
 //!
-//! Functions of the model are Rust closures of expressions given once. Each transcription
-//! calls them through one place per kind ([`Dynamics::eval`] for the dynamics), so the
-//! inlined expressions can later become calls of one compiled function without changing
-//! this API.
+//! Functions of the model are Rust closures of expressions given once; the dynamics may
+//! instead be a compiled [`symx::Function`] ([`Ocp::set_dynamics_function`]), which every
+//! transcription then calls without inlining (one call node per evaluation, the dynamics
+//! held once). Each transcription evaluates the dynamics through [`Dynamics::eval`].
+//! Multiple shooting can also compile one interval's integration as a function and call
+//! it once per interval ([`Method::multiple_shooting_with_calls`]).
 mod butcher;
 mod collocation;
 mod trajectory;
@@ -78,21 +80,83 @@ type TerminalFn = Box<dyn Fn(&Matrix, &Matrix, Expr) -> Expr>;
 /// normalised time follow a later `set_horizon`).
 type GuessFn = Box<dyn Fn(f64, f64) -> Vec<f64>>;
 
-/// The dynamics `ẋ = f(x, u, p)`, given once.
+/// The dynamics `ẋ = f(x, u, p)`, given once: a closure of expressions (inlined where it
+/// is evaluated) or a compiled function (called where it is evaluated).
 pub struct Dynamics {
-    f: StageVector,
+    f: DynamicsKind,
+}
+
+enum DynamicsKind {
+    Closure(StageVector),
+    Function(Box<symx::Function>),
 }
 
 impl Dynamics {
     /// Dynamics from a closure of expressions: `f(x, u, p)` with `x`, `u`, `p` column
     /// vectors of the sizes the [`Ocp`] declares, returning `ẋ` (as many entries as `x`).
     pub fn new(f: impl Fn(&Matrix, &Matrix, &Matrix) -> Matrix + 'static) -> Self {
-        Dynamics { f: Box::new(f) }
+        Dynamics {
+            f: DynamicsKind::Closure(Box::new(f)),
+        }
+    }
+
+    /// Dynamics from a compiled function with three inputs `(x, u, p)` and one output `ẋ`
+    /// as long as `x`; [`Dynamics::eval`] calls it ([`symx::Function::apply`]) instead of
+    /// inlining its expressions. The input sizes are checked against the [`Ocp`] when it
+    /// is set ([`Ocp::set_dynamics_function`]) and when evaluated.
+    pub fn from_function(f: symx::Function) -> Result<Self, OcpError> {
+        let n_in = f.input_sizes().len();
+        let n_out = f.output_sizes().len();
+        if n_in != 3 || n_out != 1 {
+            return Err(OcpError::Invalid {
+                what: format!("dynamics function '{}'", f.name()),
+                why: format!("needs inputs (x, u, p) and one output ẋ, has {n_in} inputs and {n_out} outputs"),
+            });
+        }
+        if f.output_sizes()[0] != f.input_sizes()[0] {
+            return Err(OcpError::Size {
+                what: format!(
+                    "output ẋ of dynamics function '{}' (as long as x)",
+                    f.name()
+                ),
+                expected: f.input_sizes()[0],
+                got: f.output_sizes()[0],
+            });
+        }
+        Ok(Dynamics {
+            f: DynamicsKind::Function(Box::new(f)),
+        })
+    }
+
+    /// The compiled function, if the dynamics was given as one.
+    pub fn function(&self) -> Option<&symx::Function> {
+        match &self.f {
+            DynamicsKind::Function(f) => Some(f.as_ref()),
+            DynamicsKind::Closure(_) => None,
+        }
     }
 
     /// `ẋ` at `(x, u, p)`; every transcription evaluates the dynamics through this call.
-    pub fn eval(&self, x: &Matrix, u: &Matrix, p: &Matrix) -> Matrix {
-        (self.f)(x, u, p)
+    /// A compiled function is called (one call node); an error names an input of the
+    /// wrong length.
+    pub fn eval(&self, x: &Matrix, u: &Matrix, p: &Matrix) -> Result<Matrix, OcpError> {
+        match &self.f {
+            DynamicsKind::Closure(f) => Ok(f(x, u, p)),
+            DynamicsKind::Function(f) => {
+                for ((name, arg), &n) in ["x", "u", "p"].iter().zip([x, u, p]).zip(f.input_sizes())
+                {
+                    if arg.len() != n {
+                        return Err(OcpError::Size {
+                            what: format!("input {name} of dynamics function '{}'", f.name()),
+                            expected: n,
+                            got: arg.len(),
+                        });
+                    }
+                }
+                let out = f.apply(&[x, u, p])?;
+                Ok(Matrix::from_vec(out.into_iter().next().unwrap_or_default()))
+            }
+        }
     }
 }
 
@@ -200,13 +264,17 @@ impl Ocp {
     }
 
     /// The dynamics compiled as a numeric function `(x, u, p) ↦ ẋ` (three inputs, one
-    /// output), e.g. to simulate a solution's controls or to plot the vector field.
+    /// output), e.g. to simulate a solution's controls or to plot the vector field. For
+    /// dynamics given as a function, that function (its sizes checked).
     pub fn dynamics_function(&self) -> Result<symx::Function, OcpError> {
         let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
         let x = Matrix::sym_vec("x", self.nx());
         let u = Matrix::sym_vec("u", self.nu());
         let p = Matrix::sym_vec("p", self.np());
-        let f = dynamics.eval(&x, &u, &p);
+        let f = dynamics.eval(&x, &u, &p)?;
+        if let Some(f) = dynamics.function() {
+            return Ok(f.clone());
+        }
         if f.len() != self.nx() {
             return Err(OcpError::Size {
                 what: "dynamics output".into(),
@@ -217,9 +285,49 @@ impl Ocp {
         Ok(symx::Function::new(&[&x, &u, &p], &[&f])?)
     }
 
-    /// Sets the dynamics `ẋ = f(x, u, p)`.
+    /// Sets the dynamics `ẋ = f(x, u, p)` as a closure of expressions (inlined wherever the
+    /// transcription evaluates it).
     pub fn set_dynamics(&mut self, f: impl Fn(&Matrix, &Matrix, &Matrix) -> Matrix + 'static) {
         self.dynamics = Some(Dynamics::new(f));
+    }
+
+    /// Sets the dynamics as a compiled function `f(x, u, p) -> ẋ` (three inputs of lengths
+    /// `nx`, `nu`, `np`, one output of length `nx`), which the transcription calls without
+    /// inlining: the transcribed problem holds the dynamics once, however many intervals.
+    /// The lengths of `x` and `u` are checked here, that of `p` when transcribing (parameters
+    /// may be added later).
+    ///
+    /// ```
+    /// use nlp::ocp::{Method, Ocp};
+    /// use symx::{Function, Matrix};
+    /// // ẋ = −x + u, compiled once.
+    /// let (x, u, p) = (Matrix::sym_vec("x", 1), Matrix::sym_vec("u", 1), Matrix::sym_vec("p", 0));
+    /// let f = Function::named("f", &[("x", &x), ("u", &u), ("p", &p)], &[("xdot", &[u[0] - x[0]])]).unwrap();
+    /// let mut ocp = Ocp::new(&["x"], &["u"]);
+    /// ocp.set_dynamics_function(f).unwrap();
+    /// ocp.set_stage_cost(|x, u, _| x[0].sq() + u[0].sq());
+    /// ocp.set_initial_state(&[1.0]).unwrap();
+    /// let tr = ocp.transcribe(&Method::collocation(nlp::ocp::CollocationPoints::Radau, 3).unwrap(), 50).unwrap();
+    /// // 50 intervals × 3 collocation points = 150 calls of the one function f.
+    /// assert!(tr.problem().constraint_expressions()[0].to_string().contains("f("));
+    /// ```
+    pub fn set_dynamics_function(&mut self, f: symx::Function) -> Result<(), OcpError> {
+        let d = Dynamics::from_function(f)?;
+        let f = d.function().expect("just built from a function");
+        for (name, n, want) in [
+            ("x", f.input_sizes()[0], self.nx()),
+            ("u", f.input_sizes()[1], self.nu()),
+        ] {
+            if n != want {
+                return Err(OcpError::Size {
+                    what: format!("input {name} of dynamics function '{}'", f.name()),
+                    expected: want,
+                    got: n,
+                });
+            }
+        }
+        self.dynamics = Some(d);
+        Ok(())
     }
 
     /// Sets the final time: fixed `T > 0`, or free with `0 ≤ lower ≤ guess ≤ upper` and a

@@ -19,6 +19,11 @@ pub enum Method {
         tableau: ButcherTableau,
         /// Steps per interval (M ≥ 1).
         steps: usize,
+        /// Compile one interval's integration (all `steps` steps and the cost quadrature)
+        /// once as a function of `(x, u, p, h)` and call it at every interval (one call node
+        /// each) instead of writing its expressions N times. Same problem, same iterates
+        /// (to rounding); a far smaller graph and tape for large N.
+        step_calls: bool,
     },
     /// Direct collocation: the state is a polynomial on each interval, its values at the
     /// collocation points are variables (named `Xc`), and the dynamics hold at those
@@ -29,7 +34,22 @@ pub enum Method {
 impl Method {
     /// Multiple shooting with `steps` steps of `tableau` per interval.
     pub fn multiple_shooting(tableau: ButcherTableau, steps: usize) -> Method {
-        Method::MultipleShooting { tableau, steps }
+        Method::MultipleShooting {
+            tableau,
+            steps,
+            step_calls: false,
+        }
+    }
+
+    /// Multiple shooting whose interval integration is compiled once as a function of
+    /// `(x, u, p, h)` and called once per interval (see
+    /// [`Method::MultipleShooting::step_calls`]).
+    pub fn multiple_shooting_with_calls(tableau: ButcherTableau, steps: usize) -> Method {
+        Method::MultipleShooting {
+            tableau,
+            steps,
+            step_calls: true,
+        }
     }
 
     /// Direct collocation with `degree` points of the given family.
@@ -109,7 +129,7 @@ impl Ocp {
         let p = Matrix::from_vec(p_all);
         let col = |m: &Matrix, k: usize| m.column(k).map_err(OcpError::from);
         // The closures are checked once on the first stage (their shapes do not change).
-        let f0 = dynamics.eval(&col(&x, 0)?, &col(&u, 0)?, &p);
+        let f0 = dynamics.eval(&col(&x, 0)?, &col(&u, 0)?, &p)?;
         if f0.len() != nx {
             return Err(OcpError::Size {
                 what: "dynamics output".into(),
@@ -140,9 +160,15 @@ impl Ocp {
             h,
         };
         let (mut cost, xc, tau) = match method {
-            Method::MultipleShooting { tableau, steps } => {
-                (stage.shooting(&mut pb, tableau, *steps)?, None, vec![0.0])
-            }
+            Method::MultipleShooting {
+                tableau,
+                steps,
+                step_calls,
+            } => (
+                stage.shooting(&mut pb, tableau, *steps, *step_calls)?,
+                None,
+                vec![0.0],
+            ),
             Method::Collocation(c) => {
                 let (cost, xc) = stage.collocation(&mut pb, c)?;
                 (cost, Some(xc), c.tau.clone())
@@ -243,34 +269,95 @@ impl Stage<'_> {
         pb: &mut Problem,
         tableau: &ButcherTableau,
         steps: usize,
+        step_calls: bool,
     ) -> Result<Expr, OcpError> {
-        let nx = self.ocp.nx();
         let n = self.u.ncols();
+        let step = if step_calls {
+            Some(self.step_function(tableau, steps)?)
+        } else {
+            None
+        };
         let mut cost = Expr::zero();
         let mut gaps = Vec::with_capacity(n);
         for k in 0..n {
-            let uk = self.u.column(k)?;
-            let rhs = |z: &Matrix| -> Matrix {
-                let xs = Matrix::from_vec(z[..nx].to_vec());
-                let mut dz: Vec<Expr> = self.dynamics().eval(&xs, &uk, self.p).to_vec();
-                if let Some(l) = &self.ocp.stage_cost {
-                    dz.push(l(&xs, &uk, self.p));
+            let (xk, uk) = (self.x.column(k)?, self.u.column(k)?);
+            let (x_end, q) = match &step {
+                Some(f) => {
+                    let mut out = f.apply(&[&xk, &uk, self.p, &[self.h]])?.into_iter();
+                    let x_end = Matrix::from_vec(out.next().unwrap_or_default());
+                    (x_end, out.next().map(|q| q[0]))
                 }
-                Matrix::from_vec(dz)
+                None => self.integrate(tableau, steps, &xk, &uk, self.p, self.h)?,
             };
-            let mut z0: Vec<Expr> = self.x.column(k)?.to_vec();
-            if self.ocp.stage_cost.is_some() {
-                z0.push(Expr::zero());
+            if let Some(q) = q {
+                cost += q;
             }
-            let z_end = tableau.integrate(&rhs, &Matrix::from_vec(z0), self.h, steps);
-            if self.ocp.stage_cost.is_some() {
-                cost += z_end[nx];
-            }
-            let x_end = Matrix::from_vec(z_end[..nx].to_vec());
             gaps.push(self.x.column(k + 1)?.eq(&x_end));
         }
         pb.subject_to_named("continuity", Constraint::all(gaps))?;
         Ok(cost)
+    }
+
+    /// One interval's integration compiled as `F(x, u, p, h) = (x(h), q(h))`, `q` the
+    /// Lagrange cost's quadrature state (only with a stage cost).
+    fn step_function(
+        &self,
+        tableau: &ButcherTableau,
+        steps: usize,
+    ) -> Result<symx::Function, OcpError> {
+        let x = Matrix::sym_vec("x", self.ocp.nx());
+        let u = Matrix::sym_vec("u", self.ocp.nu());
+        let p = Matrix::sym_vec("p", self.ocp.np());
+        let h = Expr::sym("h");
+        let (x_end, q) = self.integrate(tableau, steps, &x, &u, &p, h)?;
+        let q: Vec<Expr> = q.into_iter().collect();
+        let mut outputs: Vec<(&str, &[Expr])> = vec![("xf", &x_end)];
+        if !q.is_empty() {
+            outputs.push(("qf", &q));
+        }
+        let inputs: [(&str, &[Expr]); 4] = [("x", &x), ("u", &u), ("p", &p), ("h", &[h])];
+        let name = format!("{}_interval", tableau.name());
+        Ok(symx::Function::named(&name, &inputs, &outputs)?)
+    }
+
+    /// `steps` steps of `tableau` over `h` from `x` with control `u`: the end state and,
+    /// with a stage cost, its integral (a quadrature state started at 0).
+    fn integrate(
+        &self,
+        tableau: &ButcherTableau,
+        steps: usize,
+        x: &Matrix,
+        u: &Matrix,
+        p: &Matrix,
+        h: Expr,
+    ) -> Result<(Matrix, Option<Expr>), OcpError> {
+        let nx = self.ocp.nx();
+        // The tableau takes an infallible right-hand side: a failure is kept and returned.
+        let failure = std::cell::RefCell::new(None);
+        let rhs = |z: &Matrix| -> Matrix {
+            let xs = Matrix::from_vec(z[..nx].to_vec());
+            let mut dz: Vec<Expr> = match self.dynamics().eval(&xs, u, p) {
+                Ok(f) => f.to_vec(),
+                Err(e) => {
+                    failure.borrow_mut().get_or_insert(e);
+                    vec![Expr::zero(); nx]
+                }
+            };
+            if let Some(l) = &self.ocp.stage_cost {
+                dz.push(l(&xs, u, p));
+            }
+            Matrix::from_vec(dz)
+        };
+        let mut z0: Vec<Expr> = x.to_vec();
+        if self.ocp.stage_cost.is_some() {
+            z0.push(Expr::zero());
+        }
+        let z_end = tableau.integrate(&rhs, &Matrix::from_vec(z0), h, steps);
+        if let Some(e) = failure.into_inner() {
+            return Err(e);
+        }
+        let q = self.ocp.stage_cost.as_ref().map(|_| z_end[nx]);
+        Ok((Matrix::from_vec(z_end[..nx].to_vec()), q))
     }
 
     /// Collocation and continuity constraints; returns the Lagrange cost by quadrature
@@ -296,7 +383,7 @@ impl Stage<'_> {
                 for r in 1..=d {
                     xp = xp + c.c[r][j] * &pts[r - 1];
                 }
-                let fj = self.dynamics().eval(&pts[j - 1], &uk, self.p);
+                let fj = self.dynamics().eval(&pts[j - 1], &uk, self.p)?;
                 colloc.push((&(self.h * &fj - xp)).eq(0.0));
                 if let Some(l) = &self.ocp.stage_cost {
                     cost += c.b[j] * l(&pts[j - 1], &uk, self.p) * self.h;
