@@ -768,3 +768,46 @@ pub fn status_name(status: Status) -> &'static str {
         _ => "failed",
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(iter: usize, alpha_pr: f64, restoration: bool) -> IterationRecord {
+        IterationRecord {
+            iter,
+            restoration,
+            objective: 0.0,
+            inf_pr: 0.0,
+            inf_du: 0.0,
+            mu: 1e-6,
+            d_norm: 1.0,
+            regularization: 0.0,
+            alpha_du: 1.0,
+            alpha_pr,
+            alpha_pr_char: 'h',
+            ls: 15,
+        }
+    }
+
+    /// The guard trips on the `STALL_ITERATIONS`-th consecutive short step, not before;
+    /// a full step or a restoration row restarts the count; the initial row (step 0)
+    /// does not count.
+    #[test]
+    fn stall_guard_counts_consecutive_short_steps() {
+        let mut g = StallGuard::default();
+        assert!(!g.stalled(&row(0, 0.0, false)));
+        for k in 1..STALL_ITERATIONS {
+            assert!(!g.stalled(&row(k, 6e-5, false)), "tripped after {k}");
+        }
+        assert!(!g.stalled(&row(STALL_ITERATIONS, 1.0, false)));
+        for k in 1..STALL_ITERATIONS {
+            assert!(!g.stalled(&row(100 + k, 6e-5, false)));
+        }
+        assert!(!g.stalled(&row(200, 6e-5, true)));
+        for k in 1..STALL_ITERATIONS {
+            assert!(!g.stalled(&row(300 + k, STALL_STEP / 2.0, false)));
+        }
+        assert!(g.stalled(&row(400, STALL_STEP / 2.0, false)));
+    }
+}
