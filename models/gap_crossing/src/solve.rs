@@ -11,10 +11,14 @@
 //!      same heuristic with that order, on a second thread alongside 1;
 //!   3. the crossing search ([`crate::crossing`], [`CROSSING_ROUNDS`] rounds) from the
 //!      better of 1 and 2, which the crawl gait also runs after its solve; then
-//!   4. the schedule search ([`crate::schedule_search`]) from its result:
-//!      adjacent swaps of the schedule whose exact per-stance evaluation lowers the
-//!      cost, each round re-solved with every variable free from the improved plan,
-//!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
+//!   4. the schedule search ([`crate::schedule_search`]) from each of 1 and 2: the
+//!      cheapest schedule in a band of foothold counts around the current one (exact
+//!      per-stance evaluation), each round re-solved with every variable free from the
+//!      improved plan, until nothing improves or [`SEARCH_ROUNDS`] rounds have run; a
+//!      re-solve that stalls ([`STALL_ITERATIONS`]) counts as failed.
+//!
+//!   Every model is built on a fresh thread, so that its symx arena is empty and freed
+//!   after the solve (`in_fresh_arena`).
 //!
 //!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
