@@ -11,10 +11,14 @@
 //!      same heuristic with that order, on a second thread alongside 1;
 //!   3. the crossing search ([`crate::crossing`], [`CROSSING_ROUNDS`] rounds) from the
 //!      better of 1 and 2, which the crawl gait also runs after its solve; then
-//!   4. the schedule search ([`crate::schedule_search`]) from its result:
-//!      adjacent swaps of the schedule whose exact per-stance evaluation lowers the
-//!      cost, each round re-solved with every variable free from the improved plan,
-//!      until no swap improves or [`SEARCH_ROUNDS`] rounds have run.
+//!   4. the schedule search ([`crate::schedule_search`]) from each of 1 and 2: the
+//!      cheapest schedule in a band of foothold counts around the current one (exact
+//!      per-stance evaluation), each round re-solved with every variable free from the
+//!      improved plan, until nothing improves or [`SEARCH_ROUNDS`] rounds have run; a
+//!      re-solve that stalls ([`STALL_ITERATIONS`]) counts as failed.
+//!
+//!   Every model is built on a fresh thread, so that its symx arena is empty and freed
+//!   after the solve (`in_fresh_arena`).
 //!
 //!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
@@ -53,6 +57,16 @@ pub const SEARCH_MU_INIT: f64 = 1e-6;
 /// (90 of the run's 117 s of CPU) without converging. Past this limit the candidate
 /// counts as failed and the planner keeps what it has.
 pub const SEARCH_MAX_ITER: usize = 200;
+
+/// A warm re-solve (schedule search, reference without (10)) whose primal step stays
+/// below [`STALL_STEP`] for this many iterations in a row (outside restoration) is
+/// stopped and counts as failed: at n_step 1000 the pair plan's first re-solve jammed at
+/// iteration 18 (α_pr ≈ 6e-5 after 15 backtracks, inf_pr 8.3e-4 unchanged) and ran to
+/// [`SEARCH_MAX_ITER`], half of the run's CPU time.
+pub const STALL_ITERATIONS: usize = 10;
+
+/// The primal step size below which an iteration counts toward [`STALL_ITERATIONS`].
+pub const STALL_STEP: f64 = 1e-2;
 
 /// Bound push (absolute and relative, variables and slacks) of the schedule search's
 /// re-solves (default 1e-2, which moves a foot on a keep-out edge by 2 cm).
@@ -147,6 +161,25 @@ impl Settings {
         mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
     ) -> Result<Solution, SolveError> {
         self.solver().solve_with_callback(nlp, &mut callback)
+    }
+}
+
+/// Counts the consecutive iterations of a solve whose primal step is below
+/// [`STALL_STEP`] ([`STALL_ITERATIONS`] in a row: stalled).
+#[derive(Default)]
+struct StallGuard {
+    run: usize,
+}
+
+impl StallGuard {
+    /// Whether the solve has stalled, after the iteration `r`.
+    fn stalled(&mut self, r: &IterationRecord) -> bool {
+        if r.iter > 0 && !r.restoration && r.alpha_pr < STALL_STEP {
+            self.run += 1;
+        } else {
+            self.run = 0;
+        }
+        self.run >= STALL_ITERATIONS
     }
 }
 
@@ -253,11 +286,27 @@ struct Solved {
 /// printed by [`record`], from the iteration records.
 fn solve_scheduled(
     s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    schedule: &[Foot],
+    guess: &[f64],
+    settings: &Settings,
+    name: &str,
+    stop_on_stall: bool,
+) -> Result<Solved, PlanningError> {
+    in_fresh_arena(|| {
+        solve_scheduled_here(s, terrain, schedule, guess, settings, name, stop_on_stall)
+    })
+}
+
+/// [`solve_scheduled`] on the calling thread's expression arena.
+fn solve_scheduled_here(
+    s: &Scenario,
     terrain: &dyn Terrain,
     schedule: &[Foot],
     guess: &[f64],
     settings: &Settings,
     name: &str,
+    stop_on_stall: bool,
 ) -> Result<Solved, PlanningError> {
     let formulation = Formulation::Scheduled(schedule.to_vec());
     let model = model::build(s, terrain, &formulation, guess)?;
@@ -266,9 +315,14 @@ fn solve_scheduled(
     let mut residuals = Vec::new();
     let mut quiet = settings.clone();
     quiet.set_print_level(0);
+    let mut guard = StallGuard::default();
     let solution = quiet.solve(&mut compiled, |v| {
         residuals.push(probe.at(v.x()));
-        ControlFlow::Continue(())
+        if stop_on_stall && guard.stalled(v.record()) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
     })?;
     let flat = model.problem.evaluate(&model.layout, &solution.x)?;
     let phase = Phase {
@@ -289,6 +343,18 @@ fn solve_scheduled(
             phase: 0,
         },
         phase,
+    })
+}
+
+/// Runs `f` on a new thread, so that the models it builds go to a fresh, empty symx
+/// expression arena (arenas are per thread and only grow), freed when it returns. At
+/// n_step 1000 each build adds 1.8 million nodes; built on the same thread, the searches'
+/// and the reference's builds worked in an arena (and hash-consing table) of up to 5.5
+/// million nodes, and the memory of every earlier model stayed allocated.
+fn in_fresh_arena<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    std::thread::scope(|scope| match scope.spawn(f).join() {
+        Ok(r) => r,
+        Err(panic) => std::panic::resume_unwind(panic),
     })
 }
 
@@ -315,14 +381,14 @@ fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
 /// [`solve_scheduled`] then [`record`].
 fn run(
     s: &Scenario,
-    terrain: &dyn Terrain,
+    terrain: &(dyn Terrain + Sync),
     schedule: &[Foot],
     guess: &[f64],
     settings: &Settings,
     phases: &mut Vec<Phase>,
     name: &str,
 ) -> Result<Run, PlanningError> {
-    let solved = solve_scheduled(s, terrain, schedule, guess, settings, name)?;
+    let solved = solve_scheduled(s, terrain, schedule, guess, settings, name, false)?;
     Ok(record(solved, settings, phases))
 }
 
@@ -465,6 +531,7 @@ fn free_gait(
                 &guess,
                 settings,
                 "free gait: crawl schedule",
+                false,
             )
         },
         || {
@@ -477,6 +544,7 @@ fn free_gait(
                 &guess,
                 &candidate,
                 "free gait: biped-pair schedule",
+                false,
             )
         },
     );
@@ -537,7 +605,7 @@ fn pair_run_or(crawl: Run, pair: Run) -> Run {
 /// `from` failed.
 fn search_from(
     s: &Scenario,
-    terrain: &dyn Terrain,
+    terrain: &(dyn Terrain + Sync),
     candidate: &Settings,
     from: &Run,
     label: &str,
@@ -568,6 +636,7 @@ fn search_from(
                 if proposal.changed == 1 { "" } else { "s" },
                 proposal.evaluated
             ),
+            true,
         )?;
         let improved = next.run.beats(best);
         out.push(next);
@@ -588,6 +657,16 @@ fn search_from(
 /// a certified bound. `None` when the solve does not succeed.
 pub fn objective_without_10(
     s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    plan: &[f64],
+    settings: &Settings,
+) -> Result<Option<f64>, PlanningError> {
+    in_fresh_arena(|| objective_without_10_here(s, terrain, plan, settings))
+}
+
+/// [`objective_without_10`] on the calling thread's expression arena.
+fn objective_without_10_here(
+    s: &Scenario,
     terrain: &dyn Terrain,
     plan: &[f64],
     settings: &Settings,
@@ -597,7 +676,14 @@ pub fn objective_without_10(
     compiled.set_value(model::PENALTY, &[0.0])?;
     let mut quiet = settings.capped();
     quiet.set_print_level(0);
-    let solution = quiet.solve(&mut compiled, |_| ControlFlow::Continue(()))?;
+    let mut guard = StallGuard::default();
+    let solution = quiet.solve(&mut compiled, |v| {
+        if guard.stalled(v.record()) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })?;
     if !solution.status.is_success() {
         return Ok(None);
     }
@@ -651,6 +737,7 @@ fn crossing_search(
                         c.foot,
                         c.transition + 1
                     ),
+                    false,
                 )
             })
             .collect();
@@ -683,5 +770,48 @@ pub fn status_name(status: Status) -> &'static str {
         Status::DivergingIterates => "diverging_iterates",
         Status::InvalidNumberDetected => "invalid_number_detected",
         _ => "failed",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(iter: usize, alpha_pr: f64, restoration: bool) -> IterationRecord {
+        IterationRecord {
+            iter,
+            restoration,
+            objective: 0.0,
+            inf_pr: 0.0,
+            inf_du: 0.0,
+            mu: 1e-6,
+            d_norm: 1.0,
+            regularization: 0.0,
+            alpha_du: 1.0,
+            alpha_pr,
+            alpha_pr_char: 'h',
+            ls: 15,
+        }
+    }
+
+    /// The guard trips on the `STALL_ITERATIONS`-th consecutive short step, not before;
+    /// a full step or a restoration row restarts the count; the initial row (step 0)
+    /// does not count.
+    #[test]
+    fn stall_guard_counts_consecutive_short_steps() {
+        let mut g = StallGuard::default();
+        assert!(!g.stalled(&row(0, 0.0, false)));
+        for k in 1..STALL_ITERATIONS {
+            assert!(!g.stalled(&row(k, 6e-5, false)), "tripped after {k}");
+        }
+        assert!(!g.stalled(&row(STALL_ITERATIONS, 1.0, false)));
+        for k in 1..STALL_ITERATIONS {
+            assert!(!g.stalled(&row(100 + k, 6e-5, false)));
+        }
+        assert!(!g.stalled(&row(200, 6e-5, true)));
+        for k in 1..STALL_ITERATIONS {
+            assert!(!g.stalled(&row(300 + k, STALL_STEP / 2.0, false)));
+        }
+        assert!(g.stalled(&row(400, STALL_STEP / 2.0, false)));
     }
 }
