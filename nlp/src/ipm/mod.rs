@@ -108,38 +108,7 @@ impl Ipm {
         let n = red.free.len();
         let m = red.rows.len();
         let n_eq = red.g_l.iter().zip(&red.g_u).filter(|(l, u)| l == u).count();
-        // Scaling at the starting point.
-        if opts.nlp_scaling_method == ScalingMethod::GradientBased && n > 0 {
-            let x0 = red.x0.clone();
-            let gmax = red.unscaled_grad_max(&x0);
-            red.obj_scale = opts.obj_scaling_factor
-                * gradient_scale(
-                    gmax,
-                    opts.nlp_scaling_max_gradient,
-                    opts.nlp_scaling_min_value,
-                );
-            if m > 0 {
-                let mut rmax = vec![0.0; m];
-                red.unscaled_jac_row_max(&x0, &mut rmax);
-                for k in 0..m {
-                    red.g_scale[k] = gradient_scale(
-                        rmax[k],
-                        opts.nlp_scaling_max_gradient,
-                        opts.nlp_scaling_min_value,
-                    );
-                    // Upward scaling: equality rows only (see nlp_scaling_min_gradient).
-                    if red.g_l[k] == red.g_u[k] {
-                        red.g_scale[k] *= gradient_scale_up(
-                            rmax[k],
-                            opts.nlp_scaling_min_gradient,
-                            opts.nlp_scaling_max_value,
-                        );
-                    }
-                }
-            }
-        } else {
-            red.obj_scale = opts.obj_scaling_factor;
-        }
+        scale_at_start(&mut red, opts);
         let (status, w, y, zl, zu, message) = if n == 0 {
             // Everything fixed: nothing to optimise; feasibility is checked below.
             (
@@ -366,5 +335,43 @@ fn finish(
         compl,
         message,
         stats: Stats::default(),
+    }
+}
+
+/// IPOPT's gradient-based scaling at the starting point (or the fixed objective factor):
+/// sets the reduced problem's objective and row scale factors.
+fn scale_at_start(red: &mut Reduced<'_>, opts: &IpmOptions) {
+    let n = red.free.len();
+    let m = red.rows.len();
+    if opts.nlp_scaling_method == ScalingMethod::GradientBased && n > 0 {
+        let x0 = red.x0.clone();
+        let gmax = red.unscaled_grad_max(&x0);
+        red.obj_scale = opts.obj_scaling_factor
+            * gradient_scale(
+                gmax,
+                opts.nlp_scaling_max_gradient,
+                opts.nlp_scaling_min_value,
+            );
+        if m > 0 {
+            let mut rmax = vec![0.0; m];
+            red.unscaled_jac_row_max(&x0, &mut rmax);
+            for k in 0..m {
+                red.g_scale[k] = gradient_scale(
+                    rmax[k],
+                    opts.nlp_scaling_max_gradient,
+                    opts.nlp_scaling_min_value,
+                );
+                // Upward scaling: equality rows only (see nlp_scaling_min_gradient).
+                if red.g_l[k] == red.g_u[k] {
+                    red.g_scale[k] *= gradient_scale_up(
+                        rmax[k],
+                        opts.nlp_scaling_min_gradient,
+                        opts.nlp_scaling_max_value,
+                    );
+                }
+            }
+        }
+    } else {
+        red.obj_scale = opts.obj_scaling_factor;
     }
 }

@@ -208,91 +208,44 @@ impl IpmProblem for Resto<'_> {
 /// Runs a restoration phase from the outer core's current iterate. On success the outer
 /// core continues from the restored point; otherwise the final outcome is returned.
 pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Outcome> {
-    let (n, m, ni) = (core.n, core.m, core.ni);
-    let opts = core.opts.clone();
-    let mu = core.mu.max(inf_norm(&core.c));
+    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let opts = core.options().clone();
+    let mu = core.mu().max(inf_norm(&core.iterate().c));
     let rho = opts.resto_penalty_parameter;
     // Initial p, n (IPOPT's closed form: c − p + n = 0, complementarity μ).
     let mut pv = vec![0.0; m];
     let mut nv = vec![0.0; m];
     for i in 0..m {
-        let c = core.c[i];
+        let c = core.iterate().c[i];
         let a = (mu - rho * c) / (2.0 * rho);
         let nn = a + (a * a + mu * c / (2.0 * rho)).sqrt();
         nv[i] = nn.max(1e-300);
         pv[i] = (c + nn).max(1e-300);
     }
-    let xr: Vec<f64> = core.w[..n].to_vec();
+    let xr: Vec<f64> = core.iterate().w[..n].to_vec();
     let dr2: Vec<f64> = xr
         .iter()
         .map(|x| (1.0f64).min(1.0 / x.abs()).powi(2))
         .collect();
     // Patterns.
-    let jac_o = core.nlp.jac_g_sparsity().clone();
+    let jac_o = core.problem().jac_g_sparsity().clone();
     let nnz_j_orig = jac_o.row_idx().len();
-    let (jac, hess, hmap, hdiag) = {
-        let mut cp: Vec<usize> = jac_o.col_ptr()[..=n].to_vec();
-        let mut ri: Vec<usize> = Vec::with_capacity(nnz_j_orig + 2 * m);
-        for j in 0..n {
-            ri.extend(jac_o.row_idx_of_col_raw(j).iter().copied());
-        }
-        // Compact in case the original pattern had gaps.
-        cp.clear();
-        cp.push(0);
-        let mut acc = 0;
-        for j in 0..n {
-            acc += jac_o.row_idx_of_col_raw(j).len();
-            cp.push(acc);
-        }
-        for i in 0..m {
-            ri.push(i);
-            cp.push(ri.len());
-        }
-        for i in 0..m {
-            ri.push(i);
-            cp.push(ri.len());
-        }
-        let jac = SymbolicSparseColMat::new_checked(m, n + 2 * m, cp, None, ri);
-        let h_o = core.nlp.hess_l_sparsity();
-        let mut hcp = vec![0usize];
-        let mut hri = Vec::new();
-        let mut hmap = vec![0usize; h_o.row_idx().len()];
-        let mut hdiag = vec![0usize; n];
-        for j in 0..n {
-            let mut rows: Vec<usize> = h_o.row_idx_of_col_raw(j).to_vec();
-            rows.push(j);
-            rows.sort_unstable();
-            rows.dedup();
-            let base = hri.len();
-            for p in h_o.col_range(j) {
-                let r = h_o.row_idx()[p];
-                hmap[p] = base + rows.binary_search(&r).unwrap_or(0);
-            }
-            hdiag[j] = base + rows.binary_search(&j).unwrap_or(0);
-            hri.extend(rows);
-            hcp.push(hri.len());
-        }
-        for _ in 0..2 * m {
-            hcp.push(hri.len());
-        }
-        let hess = SymbolicSparseColMat::new_checked(n + 2 * m, n + 2 * m, hcp, None, hri);
-        (jac, hess, hmap, hdiag)
-    };
-    let hbuf_len = core.nlp.hess_l_sparsity().row_idx().len();
+    let (jac, hess, hmap, hdiag) = resto_patterns(&jac_o, core.problem().hess_l_sparsity(), n, m);
+    let hbuf_len = core.problem().hess_l_sparsity().row_idx().len();
     let mut x_l = vec![0.0; n + 2 * m];
     let mut x_u = vec![f64::INFINITY; n + 2 * m];
-    x_l[..n].copy_from_slice(&core.wl[..n]);
-    x_u[..n].copy_from_slice(&core.wu[..n]);
+    x_l[..n].copy_from_slice(&core.layout().wl[..n]);
+    x_u[..n].copy_from_slice(&core.layout().wu[..n]);
     let mut g_l = vec![0.0; m];
     let mut g_u = vec![0.0; m];
     for i in 0..m {
-        let k = core.slack_of_row[i];
+        let k = core.layout().slack_of_row[i];
         if k == usize::MAX {
-            g_l[i] = core.g_eq[i];
-            g_u[i] = core.g_eq[i];
+            g_l[i] = core.layout().g_eq[i];
+            g_u[i] = core.layout().g_eq[i];
         } else {
-            g_l[i] = core.wl[n + k];
-            g_u[i] = core.wu[n + k];
+            g_l[i] = core.layout().wl[n + k];
+            g_u[i] = core.layout().wu[n + k];
         }
     }
     let mut x0 = xr.clone();
@@ -301,22 +254,25 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
     // Full inner iterate: w = [x, p, n, s].
     let nwi = n + 2 * m + ni;
     let mut w = x0.clone();
-    w.extend_from_slice(&core.w[n..]);
+    w.extend_from_slice(&core.iterate().w[n..]);
     let mut zl = vec![0.0; nwi];
     let mut zu = vec![0.0; nwi];
     for j in 0..n {
-        zl[j] = core.zl[j].min(rho);
-        zu[j] = core.zu[j].min(rho);
+        zl[j] = core.iterate().zl[j].min(rho);
+        zu[j] = core.iterate().zu[j].min(rho);
     }
     for i in 0..m {
         zl[n + i] = mu / pv[i];
         zl[n + m + i] = mu / nv[i];
     }
     for k in 0..ni {
-        zl[n + 2 * m + k] = core.zl[n + k].min(rho);
-        zu[n + 2 * m + k] = core.zu[n + k].min(rho);
+        zl[n + 2 * m + k] = core.iterate().zl[n + k].min(rho);
+        zu[n + 2 * m + k] = core.iterate().zu[n + k].min(rho);
     }
     let theta_max = core.theta_max();
+    // IPOPT's first 'r' row reports the failed line search of the outer iteration
+    // (alpha_pr, 'R', ls).
+    let resto_start = core.take_resto_start();
     let resto = Resto {
         n,
         m,
@@ -335,23 +291,23 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         g_u,
         x0,
         hbuf: vec![0.0; hbuf_len],
-        slack_of_row: core.slack_of_row.clone(),
-        g_eq: core.g_eq.clone(),
-        wl: core.wl.clone(),
-        wu: core.wu.clone(),
-        has_l: core.has_l.clone(),
-        has_u: core.has_u.clone(),
+        slack_of_row: core.layout().slack_of_row.clone(),
+        g_eq: core.layout().g_eq.clone(),
+        wl: core.layout().wl.clone(),
+        wu: core.layout().wu.clone(),
+        has_l: core.layout().has_l.clone(),
+        has_u: core.layout().has_u.clone(),
         kappa_d: opts.kappa_d,
-        mu_outer: core.mu,
-        filter: core.filter.clone(),
-        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.c))
+        mu_outer: core.mu(),
+        filter: core.filter().clone(),
+        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.iterate().c))
             .max(opts.tol.min(opts.constr_viol_tol)),
         theta_max,
         gbuf: vec![0.0; m],
         wbuf: vec![0.0; n + ni],
         obj_scale: core.obj_scale(),
         g_scale: core.g_scale().to_vec(),
-        outer: &mut *core.nlp,
+        outer: core.problem_mut(),
     };
     let mut resto = resto;
     let setup = Setup {
@@ -368,21 +324,9 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         inner_opts.start_with_resto = false;
         let mut inner = match Core::new(&mut resto, &inner_opts, &setup) {
             Ok(c) => c,
-            Err(e) => {
-                return Err(Outcome {
-                    status: Status::RestorationFailed,
-                    w: core.w.clone(),
-                    y: core.y.clone(),
-                    zl: core.zl.clone(),
-                    zu: core.zu.clone(),
-                    message: e.to_string(),
-                    resto_converged: false,
-                })
-            }
+            Err(e) => return Err(core.outcome(Status::RestorationFailed, e.to_string(), false)),
         };
-        // IPOPT's first 'r' row reports the failed line search of the outer iteration
-        // (alpha_pr, 'R', ls).
-        inner.resto_start = core.resto_start.take();
+        inner.set_resto_start(resto_start);
         inner.run(
             shared,
             Start::Exact {
@@ -397,28 +341,32 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
     // Map the inner point back: x = w[..n], s = w[n+2m..].
     let mut w_o = outcome.w[..n].to_vec();
     w_o.extend_from_slice(&outcome.w[n + 2 * m..]);
-    let fail = |core: &Core<'_>, status: Status, msg: String| Outcome {
-        status,
-        w: core.w.clone(),
-        y: core.y.clone(),
-        zl: core.zl.clone(),
-        zu: core.zu.clone(),
-        message: msg,
-        resto_converged: false,
-    };
+    continue_after(core, outcome, &w_o, opts.constr_viol_tol)
+}
+
+/// The outer core after a restoration phase that ended with `outcome` at the point `w_o`
+/// (original x and s): Ok to continue from `w_o`, or the final outcome of the solve.
+fn continue_after(
+    core: &mut Core<'_>,
+    outcome: Outcome,
+    w_o: &[f64],
+    constr_viol_tol: f64,
+) -> Result<(), Outcome> {
+    let fail = |core: &Core<'_>, status: Status, msg: String| core.outcome(status, msg, false);
     match outcome.status {
         Status::SolveSucceeded => {
-            if let Err(e) = core.restart_from(&w_o) {
+            if let Err(e) = core.restart_from(w_o) {
                 return Err(fail(core, Status::RestorationFailed, e.to_string()));
             }
             if outcome.resto_converged {
                 // The restoration problem converged: a minimiser of the infeasibility.
                 let viol = core
+                    .iterate()
                     .c
                     .iter()
                     .zip(core_g_scale(core))
                     .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s));
-                if viol > opts.constr_viol_tol {
+                if viol > constr_viol_tol {
                     return Err(fail(
                         core,
                         Status::InfeasibleProblemDetected,
@@ -428,28 +376,93 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
                     ));
                 }
                 // Feasible but not acceptable to the filter: restart the filter.
-                core.filter.reset();
+                core.reset_filter();
             }
             Ok(())
         }
         // The solve ends at the restoration's point (for a user stop: the iterate the
         // callback saw); a failed evaluation there is reported in the message.
         Status::MaximumIterationsExceeded | Status::MaximumWallTimeExceeded => {
-            let message = restart_message(core, &w_o, outcome.message);
+            let message = restart_message(core, w_o, outcome.message);
             Err(fail(core, outcome.status, message))
         }
         Status::UserRequestedStop => {
-            let message = restart_message(core, &w_o, outcome.message);
+            let message = restart_message(core, w_o, outcome.message);
             Err(fail(core, outcome.status, message))
         }
         Status::InvalidNumberDetected => {
             Err(fail(core, Status::RestorationFailed, outcome.message))
         }
         _ => {
-            let message = restart_message(core, &w_o, outcome.message);
+            let message = restart_message(core, w_o, outcome.message);
             Err(fail(core, Status::RestorationFailed, message))
         }
     }
+}
+
+/// (Jacobian pattern, Hessian pattern, hmap, hdiag) of the restoration problem.
+type RestoPatterns = (
+    SymbolicSparseColMat<usize>,
+    SymbolicSparseColMat<usize>,
+    Vec<usize>,
+    Vec<usize>,
+);
+
+/// The restoration problem's sparsity patterns from the original Jacobian `jac_o` and
+/// Hessian `h_o` (n variables, m rows): J_R = [J, −I, I] and the Hessian with every
+/// diagonal entry of x present; `hmap` maps each original Hessian entry to its position,
+/// `hdiag` gives the diagonal entry of each x column.
+fn resto_patterns(
+    jac_o: &SymbolicSparseColMat<usize>,
+    h_o: &SymbolicSparseColMat<usize>,
+    n: usize,
+    m: usize,
+) -> RestoPatterns {
+    let mut cp: Vec<usize> = jac_o.col_ptr()[..=n].to_vec();
+    let mut ri: Vec<usize> = Vec::with_capacity(jac_o.row_idx().len() + 2 * m);
+    for j in 0..n {
+        ri.extend(jac_o.row_idx_of_col_raw(j).iter().copied());
+    }
+    // Compact in case the original pattern had gaps.
+    cp.clear();
+    cp.push(0);
+    let mut acc = 0;
+    for j in 0..n {
+        acc += jac_o.row_idx_of_col_raw(j).len();
+        cp.push(acc);
+    }
+    for i in 0..m {
+        ri.push(i);
+        cp.push(ri.len());
+    }
+    for i in 0..m {
+        ri.push(i);
+        cp.push(ri.len());
+    }
+    let jac = SymbolicSparseColMat::new_checked(m, n + 2 * m, cp, None, ri);
+    let mut hcp = vec![0usize];
+    let mut hri = Vec::new();
+    let mut hmap = vec![0usize; h_o.row_idx().len()];
+    let mut hdiag = vec![0usize; n];
+    for j in 0..n {
+        let mut rows: Vec<usize> = h_o.row_idx_of_col_raw(j).to_vec();
+        rows.push(j);
+        rows.sort_unstable();
+        rows.dedup();
+        let base = hri.len();
+        for p in h_o.col_range(j) {
+            let r = h_o.row_idx()[p];
+            hmap[p] = base + rows.binary_search(&r).unwrap_or(0);
+        }
+        hdiag[j] = base + rows.binary_search(&j).unwrap_or(0);
+        hri.extend(rows);
+        hcp.push(hri.len());
+    }
+    for _ in 0..2 * m {
+        hcp.push(hri.len());
+    }
+    let hess = SymbolicSparseColMat::new_checked(n + 2 * m, n + 2 * m, hcp, None, hri);
+    (jac, hess, hmap, hdiag)
 }
 
 /// Moves the outer core to the restoration's point `w_o`; the message of the ending

@@ -20,7 +20,9 @@
 //! (presolve off, zero dropping off, so the symbolic factorisation is kept).
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use clarabel::solver::{
+    DefaultSettings, DefaultSolver, IPSolver, SolverError, SolverStatus, SupportedConeT,
+};
 use faer::sparse::SymbolicSparseColMat;
 
 /// What a QP row stands for (to read multipliers back and to fill `b`).
@@ -53,6 +55,15 @@ enum Src {
     ConeJac(usize, f64),
     /// A constant.
     Const(f64),
+}
+
+/// Why a QP could not be set up (a QP that was set up but not solved reports its
+/// status in [`QpResult::status`] instead).
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum QpError {
+    /// clarabel rejected the QP data or settings.
+    #[error("{0}")]
+    Setup(#[from] SolverError),
 }
 
 /// Numeric data of one QP (scaled problem).
@@ -509,7 +520,7 @@ impl Qp {
         }
     }
 
-    fn build(&mut self) -> Result<(), String> {
+    fn build(&mut self) -> Result<(), QpError> {
         let ncols = self.q.len();
         let p = CscMatrix::new(
             ncols,
@@ -525,15 +536,14 @@ impl Qp {
             self.a_rowval.clone(),
             self.a_vals.clone(),
         );
-        let s = DefaultSolver::new(&p, &self.q, &a, &self.b, &self.cones, self.settings())
-            .map_err(|e| e.to_string())?;
+        let s = DefaultSolver::new(&p, &self.q, &a, &self.b, &self.cones, self.settings())?;
         self.solver = Some(s);
         Ok(())
     }
 
     /// Solves the QP for `data`: reuses the clarabel solver with new values when it
     /// exists, rebuilding it (fresh equilibration) if that fails to converge.
-    pub fn solve(&mut self, data: &QpData) -> Result<QpResult, String> {
+    pub fn solve(&mut self, data: &QpData) -> Result<QpResult, QpError> {
         self.fill(data);
         self.run(true)
     }
@@ -550,12 +560,12 @@ impl Qp {
         g_l: &[f64],
         g_u: &[f64],
         cone: &[f64],
-    ) -> Result<QpResult, String> {
+    ) -> Result<QpResult, QpError> {
         self.fill_b(x, x_l, x_u, g, g_l, g_u, cone);
         self.run(false)
     }
 
-    fn run(&mut self, all: bool) -> Result<QpResult, String> {
+    fn run(&mut self, all: bool) -> Result<QpResult, QpError> {
         let mut fresh = false;
         match self.solver.as_mut() {
             None => {

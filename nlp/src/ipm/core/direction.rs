@@ -1,0 +1,205 @@
+//! The search direction: solving the factorised KKT system for (Δw, Δy, Δz_L, Δz_U), and
+//! the fraction-to-the-boundary step sizes.
+
+#![allow(
+    clippy::needless_range_loop,
+    clippy::neg_cmp_op_on_partial_ord,
+    clippy::too_many_arguments
+)]
+
+use std::time::Instant;
+
+use super::*;
+
+/// A primal-dual direction.
+pub(super) struct Direction {
+    pub(super) dw: Vec<f64>,
+    pub(super) dy: Vec<f64>,
+    pub(super) dzl: Vec<f64>,
+    pub(super) dzu: Vec<f64>,
+}
+
+impl Direction {
+    pub(super) fn new(nw: usize, m: usize) -> Direction {
+        Direction {
+            dw: vec![0.0; nw],
+            dy: vec![0.0; m],
+            dzl: vec![0.0; nw],
+            dzu: vec![0.0; nw],
+        }
+    }
+}
+
+impl Core<'_> {
+    /// Solves for the direction with complementarity target `mu_t`; `soc` replaces the
+    /// primal residual c by the given vector. Writes into (dw, dy, dzl, dzu) or the SOC
+    /// buffers.
+    pub(super) fn solve_direction(&mut self, shared: &mut Shared, mu_t: f64, soc: bool) -> bool {
+        let (n, m) = (self.lay.n, self.lay.m);
+        let mut work = std::mem::take(&mut self.kw.work_nw);
+        self.at_times(&self.it.jac, &self.it.y, &mut work);
+        let kd = self.opts.kappa_d * mu_t;
+        // rhs_w = −(∇f + Aᵀy) + μ/(w−wl) − μ/(wu−w) ∓ κ_d μ
+        for j in 0..self.lay.nw {
+            let gj = if j < n { self.it.grad[j] } else { 0.0 };
+            let mut r = -(gj + work[j]);
+            if self.lay.has_l[j] {
+                r += mu_t / (self.it.w[j] - self.lay.wl[j]);
+                if !self.lay.has_u[j] {
+                    r -= kd;
+                }
+            }
+            if self.lay.has_u[j] {
+                r -= mu_t / (self.lay.wu[j] - self.it.w[j]);
+                if !self.lay.has_l[j] {
+                    r += kd;
+                }
+            }
+            if j < n {
+                self.kw.rhs[j] = r;
+            } else {
+                self.kw.rhs_s[j - n] = r;
+            }
+        }
+        self.kw.work_nw = work;
+        for i in 0..m {
+            let ci = if soc { self.c_soc[i] } else { self.it.c[i] };
+            let k = self.lay.slack_of_row[i];
+            self.kw.rhs[n + i] = if k == usize::MAX {
+                -ci
+            } else {
+                -ci + self.kw.rhs_s[k] / self.kw.ds[k]
+            };
+        }
+        // Refine against the system without the static regularisation.
+        let t = Instant::now();
+        self.kw.rhs_copy.copy_from_slice(&self.kw.rhs);
+        let mut res = self
+            .kw
+            .kkt
+            .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift));
+        if self.pert.delta_c == 0.0 && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
+            // The system without the static regularisation is (numerically) singular:
+            // a rank-deficient Jacobian of the equality rows with inconsistent
+            // linearised constraints. Take IPOPT's regularised step: refactorise with
+            // δ_c = 1e-8·μ^¼ and solve that system. After three such iterations in a
+            // row, δ_c is applied from the start (IPOPT's "Jacobian degenerate").
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            self.pert.singular_iters += 1;
+            if self.pert.singular_iters >= 3 {
+                self.pert.jac_degenerate = true;
+            }
+            self.pert.delta_c = Perturbation::delta_cd(&self.opts, self.mu);
+            let dw = self.pert.delta_w;
+            let ok = matches!(self.factor_kkt(shared, dw),
+                Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
+            if !ok {
+                // Should not happen (δ_c does not change the inertia); fall back to
+                // the statically regularised system as it is.
+                self.pert.delta_c = 0.0;
+                if self.factor_kkt(shared, dw).is_err() {
+                    return false;
+                }
+            }
+            let t = Instant::now();
+            self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
+            res = self
+                .kw
+                .kkt
+                .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift));
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            let mut dw = self.pert.delta_w;
+            while ok && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
+                // Still singular (singular reduced Hessian): IPOPT increases δ_w.
+                dw = self.pert.next_delta_w(&self.opts, dw);
+                if dw > self.opts.max_hessian_perturbation {
+                    return false;
+                }
+                match self.factor_kkt(shared, dw) {
+                    Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
+                    Ok(_) => continue,
+                    Err(_) => continue,
+                }
+                self.pert.delta_w = dw;
+                self.pert.delta_w_last = dw;
+                let t = Instant::now();
+                self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
+                res = self
+                    .kw
+                    .kkt
+                    .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift));
+                shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            }
+        } else {
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            if self.pert.delta_c == 0.0 && !soc {
+                self.pert.singular_iters = 0;
+            }
+        }
+        if res.is_err() {
+            return false;
+        }
+        let (dw, dy, dzl, dzu) = if soc {
+            (
+                &mut self.dir_soc.dw,
+                &mut self.dir_soc.dy,
+                &mut self.dir_soc.dzl,
+                &mut self.dir_soc.dzu,
+            )
+        } else {
+            (
+                &mut self.dir.dw,
+                &mut self.dir.dy,
+                &mut self.dir.dzl,
+                &mut self.dir.dzu,
+            )
+        };
+        dw[..n].copy_from_slice(&self.kw.rhs[..n]);
+        dy.copy_from_slice(&self.kw.rhs[n..]);
+        for k in 0..self.lay.ni {
+            let i = self.lay.row_of_slack[k];
+            dw[n + k] = (self.kw.rhs_s[k] + dy[i]) / self.kw.ds[k];
+        }
+        for j in 0..self.lay.nw {
+            if self.lay.has_l[j] {
+                let s = self.it.w[j] - self.lay.wl[j];
+                dzl[j] = mu_t / s - self.it.zl[j] - self.it.zl[j] / s * dw[j];
+            } else {
+                dzl[j] = 0.0;
+            }
+            if self.lay.has_u[j] {
+                let s = self.lay.wu[j] - self.it.w[j];
+                dzu[j] = mu_t / s - self.it.zu[j] + self.it.zu[j] / s * dw[j];
+            } else {
+                dzu[j] = 0.0;
+            }
+        }
+        all_finite(dw) && all_finite(dy)
+    }
+
+    pub(super) fn max_step_primal(&self, dw: &[f64], tau: f64) -> f64 {
+        let mut a: f64 = 1.0;
+        for j in 0..self.lay.nw {
+            if dw[j] < 0.0 && self.lay.has_l[j] {
+                a = a.min(tau * (self.it.w[j] - self.lay.wl[j]) / -dw[j]);
+            }
+            if dw[j] > 0.0 && self.lay.has_u[j] {
+                a = a.min(tau * (self.lay.wu[j] - self.it.w[j]) / dw[j]);
+            }
+        }
+        a
+    }
+
+    pub(super) fn max_step_dual(&self, dzl: &[f64], dzu: &[f64], tau: f64) -> f64 {
+        let mut a: f64 = 1.0;
+        for j in 0..self.lay.nw {
+            if self.lay.has_l[j] && dzl[j] < 0.0 {
+                a = a.min(tau * self.it.zl[j] / -dzl[j]);
+            }
+            if self.lay.has_u[j] && dzu[j] < 0.0 {
+                a = a.min(tau * self.it.zu[j] / -dzu[j]);
+            }
+        }
+        a
+    }
+}

@@ -1,0 +1,306 @@
+//! The KKT work: assembly and factorisation of the primal-dual system, its static
+//! regularisation, and the least-squares multiplier estimate.
+
+#![allow(
+    clippy::needless_range_loop,
+    clippy::neg_cmp_op_on_partial_ord,
+    clippy::too_many_arguments
+)]
+
+use std::time::Instant;
+
+use super::*;
+
+/// Assembly and factorisation workspace of the KKT system.
+pub(super) struct KktWork {
+    pub(super) kkt: Kkt,
+    /// Diagonal added to the Hessian block (Σ_x + δ_w + static regularisation).
+    pub(super) kdx: Vec<f64>,
+    /// Diagonal of the constraint block (−δ_c, regularisation or 1/Σ_s).
+    pub(super) kdc: Vec<f64>,
+    pub(super) rhs: Vec<f64>,
+    pub(super) rhs_s: Vec<f64>,
+    pub(super) rhs_copy: Vec<f64>,
+    /// Σ_s + δ_w of each slack.
+    pub(super) ds: Vec<f64>,
+    /// The static regularisations in the last factorised matrix, with the sign that
+    /// removes them in iterative refinement (set by `factor_kkt`).
+    pub(super) shift: Vec<f64>,
+    /// Static regularisation of each equality row (see `update_eq_reg`).
+    pub(super) eq_reg: Vec<f64>,
+    /// The regularisation of the current factorisation (see `step_eq_reg`).
+    pub(super) eq_reg_step: Vec<f64>,
+    /// Position of the diagonal entry of each Hessian column (usize::MAX: none).
+    pub(super) hess_diag: Vec<usize>,
+    pub(super) hzero: Vec<f64>,
+    pub(super) work_nw: Vec<f64>,
+}
+
+impl Core<'_> {
+    // ------------------------------------------------------------------ linear algebra
+
+    /// Static regularisation of the equality rows, relative to each row's scale:
+    /// kkt_static_regularization · clamp(max_j J_ij², 1e-3, 1). An absolute 1e-8 would swamp
+    /// the Schur complement J H⁻¹ Jᵀ of a Jacobian with small entries (hanging chain
+    /// with 500 links: entries 0.008, smallest σ(J)² ≈ 2.5e-9), refinement could not
+    /// remove it, and the step would be regularised for nothing. The floor 1e-3 was
+    /// chosen by measurement on the chain (50 … 5000 links: 7, 8, 19 iterations; with no
+    /// floor the 5000-link chain fails, an absolute 1e-8 fails at 500 links).
+    pub(super) fn update_eq_reg(&mut self) {
+        let reg = self.opts.kkt_static_regularization;
+        let mut rmax = std::mem::take(&mut self.kw.eq_reg);
+        rmax.fill(0.0);
+        let jp = self.nlp.jac_g_sparsity();
+        let ri = jp.row_idx();
+        for (p, &v) in self.it.jac.iter().enumerate() {
+            let r = &mut rmax[ri[p]];
+            *r = r.max(v.abs());
+        }
+        for r in rmax.iter_mut() {
+            *r = if *r > 0.0 && r.is_finite() {
+                reg * (*r * *r).clamp(1e-3, 1.0)
+            } else {
+                reg
+            };
+        }
+        self.kw.eq_reg = rmax;
+    }
+
+    /// The static regularisation of the equality rows for this factorisation. With
+    /// δ_w = 0 it is `eq_reg` lowered, row by row, to kkt_static_regularization ×
+    /// Σ_j J_ij² / |D_jj| where that is smaller (D the diagonal of W + Σ + the static
+    /// Hessian regularisation, so the sum estimates the row's Schur complement
+    /// J D⁻¹ Jᵀ), but not below 1e-3 × `eq_reg`. The hanging chain needs it: with 50 000
+    /// links (rows scaled up to gradient 0.8) the Schur diagonal is ≈ 1e-4 against
+    /// `eq_reg` = 6.4e-9, and its smooth modes are (π/N)² ≈ 4e-9 times smaller still,
+    /// so refinement could not remove `eq_reg` and the solve did not converge (40 s);
+    /// with the lowering it takes 8 iterations. The 1e-3 bound: without it (or with
+    /// 1e-6) the Wächter–Biegler example of nlp/tests/ipm_mechanisms.rs ends its
+    /// restoration at a point of local infeasibility (1e-4 … 1e-2 pass). With δ_w > 0
+    /// (inertia correction) `eq_reg` is kept: lowering it there too took the 5000-link
+    /// chain 14 iterations (IPOPT's count) instead of 11.
+    pub(super) fn step_eq_reg(&mut self, delta_w: f64) {
+        let mut out = std::mem::take(&mut self.kw.eq_reg_step);
+        if delta_w == 0.0 {
+            let reg = self.opts.kkt_static_regularization;
+            out.fill(0.0);
+            let jp = self.nlp.jac_g_sparsity();
+            let ri = jp.row_idx();
+            for j in 0..self.lay.n {
+                let hd = self.kw.hess_diag[j];
+                let h = if hd == usize::MAX {
+                    0.0
+                } else {
+                    self.it.hess[hd]
+                };
+                let d = (h + self.kw.kdx[j]).abs();
+                if d > 0.0 {
+                    for p in jp.col_range(j) {
+                        out[ri[p]] += self.it.jac[p] * self.it.jac[p] / d;
+                    }
+                }
+            }
+            for (o, &e) in out.iter_mut().zip(&self.kw.eq_reg) {
+                let r = reg * *o;
+                *o = if r > 0.0 && r.is_finite() {
+                    r.min(e).max(1e-3 * e)
+                } else {
+                    e
+                };
+            }
+        } else {
+            out.copy_from_slice(&self.kw.eq_reg);
+        }
+        self.kw.eq_reg_step = out;
+    }
+
+    /// Assembles the KKT matrix for the current iterate with Hessian perturbation
+    /// `delta_w` and Jacobian perturbation `self.pert.delta_c` (the static regularisation
+    /// `kkt_static_regularization` on equality rows when δ_c = 0) and factorises it.
+    pub(super) fn factor_kkt(
+        &mut self,
+        shared: &mut Shared,
+        delta_w: f64,
+    ) -> Result<crate::kkt::Inertia, crate::kkt::KktError> {
+        let (n, m) = (self.lay.n, self.lay.m);
+        // The static Hessian regularisation only keeps exact zero pivots away while
+        // δ_w = 0; a real δ_w > 0 does that itself.
+        let x_reg = if delta_w == 0.0 {
+            self.opts.kkt_static_hessian_regularization
+        } else {
+            0.0
+        };
+        for j in 0..n {
+            let mut sig = 0.0;
+            if self.lay.has_l[j] {
+                sig += self.it.zl[j] / (self.it.w[j] - self.lay.wl[j]);
+            }
+            if self.lay.has_u[j] {
+                sig += self.it.zu[j] / (self.lay.wu[j] - self.it.w[j]);
+            }
+            self.kw.kdx[j] = sig + delta_w + x_reg;
+        }
+        self.step_eq_reg(delta_w);
+        self.kw.shift[..n].fill(-x_reg);
+        for i in 0..m {
+            self.kw.shift[n + i] =
+                if self.lay.slack_of_row[i] == usize::MAX && self.pert.delta_c == 0.0 {
+                    self.kw.eq_reg_step[i]
+                } else {
+                    0.0
+                };
+        }
+        for k in 0..self.lay.ni {
+            let j = n + k;
+            let mut sig = 0.0;
+            if self.lay.has_l[j] {
+                sig += self.it.zl[j] / (self.it.w[j] - self.lay.wl[j]);
+            }
+            if self.lay.has_u[j] {
+                sig += self.it.zu[j] / (self.lay.wu[j] - self.it.w[j]);
+            }
+            self.kw.ds[k] = (sig + delta_w).max(1e-300);
+        }
+        for i in 0..m {
+            let k = self.lay.slack_of_row[i];
+            // Equality rows carry δ_c, or the static regularisation that faer's
+            // unpivoted LDLᵀ needs (removed again by iterative refinement); inequality
+            // rows already carry 1/(Σ_s + δ_w) > 0 from the eliminated slack, plus δ_c.
+            self.kw.kdc[i] = if k == usize::MAX {
+                if self.pert.delta_c > 0.0 {
+                    self.pert.delta_c
+                } else {
+                    self.kw.eq_reg_step[i]
+                }
+            } else {
+                self.pert.delta_c + 1.0 / self.kw.ds[k]
+            };
+        }
+        let t = Instant::now();
+        let res = self
+            .kw
+            .kkt
+            .factorize(&self.it.hess, &self.kw.kdx, &self.it.jac, &self.kw.kdc);
+        shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+        shared.stats.n_factorizations += 1;
+        res
+    }
+
+    /// y = argmin ‖∇f + Aᵀy − z_L + z_U‖₂ (IPOPT's least-squares estimate), set to 0 if
+    /// larger than `max_norm` (max-norm) or not computable.
+    pub(crate) fn least_squares_multipliers(&mut self, max_norm: f64) {
+        let (n, m) = (self.lay.n, self.lay.m);
+        if m == 0 {
+            return;
+        }
+        let xreg = self.opts.kkt_static_hessian_regularization;
+        self.kw.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
+        self.update_eq_reg();
+        // The static regularisation of the equality rows, 1e-2 × the step's: the
+        // Schur complement here is J Jᵀ, whose smallest eigenvalue on a long chain is
+        // far below its diagonal (≈ (π/N)² × it), so a regularisation relative to the
+        // diagonal perturbs the smooth part of y and can trip the singularity test
+        // below (y = 0). Measured: 1× fails the hanging chain with 50 000 links (rows
+        // scaled up to gradient 0.8 by nlp_scaling_min_gradient; not solved in 40 s),
+        // 1e-2× solves it in 8 iterations; 1e-6× (chosen before the row scaling, for the
+        // unscaled 5000-link chain) changed hs027 from 54 to 77 iterations through
+        // round-off alone (the path of hs027 is long and sensitive).
+        let ls_reg = 1e-2;
+        for i in 0..m {
+            self.kw.kdc[i] = if self.lay.slack_of_row[i] == usize::MAX {
+                ls_reg * self.kw.eq_reg[i]
+            } else {
+                1.0
+            };
+        }
+        // rhs: [−(∇f − z_L + z_U)_x ; −(rhs_s/1) contribution]; with W = I, Σ_s = 1.
+        for j in 0..n {
+            self.kw.rhs[j] = -(self.it.grad[j] - self.it.zl[j] + self.it.zu[j]);
+        }
+        for i in 0..m {
+            let k = self.lay.slack_of_row[i];
+            self.kw.rhs[n + i] = if k == usize::MAX {
+                0.0
+            } else {
+                // s-row: ds − y_i = r_s := z_L − z_U; row i: J dx − ds = 0
+                // ⇒ J dx − y_i = r_s.
+                self.it.zl[n + k] - self.it.zu[n + k]
+            };
+        }
+        // IPOPT computes these multipliers with an unregularised factorisation and sets
+        // them to zero when the linear solver reports the system singular (a
+        // rank-deficient Jacobian of the equality rows). The static regularisation δ_s
+        // hides that singularity from faer, so detect it from the determinant instead:
+        // det K(δ) = det(−δI − J Jᵀ) on the equality rows, and multiplying δ by 10 multiplies
+        // |det K| by about 10 per (numerically) zero singular value of J.
+        let n_eq = self
+            .lay
+            .slack_of_row
+            .iter()
+            .filter(|&&k| k == usize::MAX)
+            .count();
+        let mut singular = false;
+        if n_eq > 0 && self.opts.kkt_static_regularization > 0.0 {
+            for i in 0..m {
+                if self.lay.slack_of_row[i] == usize::MAX {
+                    self.kw.kdc[i] = 10.0 * ls_reg * self.kw.eq_reg[i];
+                }
+            }
+            if self
+                .kw
+                .kkt
+                .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
+                .is_ok()
+            {
+                let ld10 = self.kw.kkt.log_abs_det();
+                for i in 0..m {
+                    if self.lay.slack_of_row[i] == usize::MAX {
+                        self.kw.kdc[i] = ls_reg * self.kw.eq_reg[i];
+                    }
+                }
+                if self
+                    .kw
+                    .kkt
+                    .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
+                    .is_ok()
+                {
+                    singular = (ld10 - self.kw.kkt.log_abs_det()) / std::f64::consts::LN_10 > 0.5;
+                }
+            }
+            for i in 0..m {
+                if self.lay.slack_of_row[i] == usize::MAX {
+                    self.kw.kdc[i] = ls_reg * self.kw.eq_reg[i];
+                }
+            }
+        }
+        for j in 0..n {
+            self.kw.shift[j] = -xreg;
+        }
+        for i in 0..m {
+            self.kw.shift[n + i] = if self.lay.slack_of_row[i] == usize::MAX {
+                ls_reg * self.kw.eq_reg[i]
+            } else {
+                0.0
+            };
+        }
+        let ok = !singular
+            && self
+                .kw
+                .kkt
+                .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
+                .is_ok()
+            && self
+                .kw
+                .kkt
+                .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift))
+                .is_ok();
+        if ok {
+            let ymax = inf_norm(&self.kw.rhs[n..]);
+            if ymax <= max_norm && ymax.is_finite() {
+                self.it.y.copy_from_slice(&self.kw.rhs[n..]);
+                return;
+            }
+        }
+        self.it.y.iter_mut().for_each(|v| *v = 0.0);
+    }
+}

@@ -1,0 +1,156 @@
+//! Error measures (IPOPT's scaled optimality error) and the barrier function.
+
+#![allow(
+    clippy::needless_range_loop,
+    clippy::neg_cmp_op_on_partial_ord,
+    clippy::too_many_arguments
+)]
+
+use super::*;
+
+impl Core<'_> {
+    // ------------------------------------------------------------------ error measures
+
+    /// (scaled dual infeasibility, primal infeasibility, complementarity at μ_t) with or
+    /// without the κ_d damping term, max-norms. Also returns unscaled versions.
+    pub(super) fn errors(&mut self, mu_t: f64, damping: bool) -> ([f64; 3], [f64; 3]) {
+        let n = self.lay.n;
+        let mut work = std::mem::take(&mut self.kw.work_nw);
+        self.at_times(&self.it.jac, &self.it.y, &mut work);
+        let kd = if damping {
+            self.opts.kappa_d * mu_t
+        } else {
+            0.0
+        };
+        let mut dual: f64 = 0.0;
+        let mut dual_u: f64 = 0.0;
+        let mut compl: f64 = 0.0;
+        for j in 0..self.lay.nw {
+            let gj = if j < n { self.it.grad[j] } else { 0.0 };
+            let mut r = gj + work[j] - self.it.zl[j] + self.it.zu[j];
+            if self.lay.has_l[j] && !self.lay.has_u[j] {
+                r += kd;
+            } else if self.lay.has_u[j] && !self.lay.has_l[j] {
+                r -= kd;
+            }
+            dual = dual.max(r.abs());
+            let unscale = if j < n {
+                1.0 / self.obj_scale
+            } else {
+                self.g_scale[self.lay.row_of_slack[j - n]] / self.obj_scale
+            };
+            dual_u = dual_u.max(r.abs() * unscale);
+            if self.lay.has_l[j] {
+                compl = compl.max(((self.it.w[j] - self.lay.wl[j]) * self.it.zl[j] - mu_t).abs());
+            }
+            if self.lay.has_u[j] {
+                compl = compl.max(((self.lay.wu[j] - self.it.w[j]) * self.it.zu[j] - mu_t).abs());
+            }
+        }
+        self.kw.work_nw = work;
+        let primal = inf_norm(&self.it.c);
+        let primal_u = self
+            .it
+            .c
+            .iter()
+            .zip(&self.g_scale)
+            .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s));
+        (
+            [dual, primal, compl],
+            [dual_u, primal_u, compl / self.obj_scale],
+        )
+    }
+
+    /// IPOPT's scaled optimality error E_μ.
+    pub(super) fn nlp_error(&mut self, mu_t: f64, damping: bool) -> (f64, [f64; 3]) {
+        let (e, eu) = self.errors(mu_t, damping);
+        let s_max = self.opts.s_max;
+        let mut nz = 0usize;
+        let mut zsum = 0.0;
+        for j in 0..self.lay.nw {
+            if self.lay.has_l[j] {
+                nz += 1;
+                zsum += self.it.zl[j].abs();
+            }
+            if self.lay.has_u[j] {
+                nz += 1;
+                zsum += self.it.zu[j].abs();
+            }
+        }
+        let ysum = one_norm(&self.it.y);
+        let sd = if self.lay.m + nz > 0 {
+            (s_max.max((ysum + zsum) / (self.lay.m + nz) as f64)) / s_max
+        } else {
+            1.0
+        };
+        let sc = if nz > 0 {
+            (s_max.max(zsum / nz as f64)) / s_max
+        } else {
+            1.0
+        };
+        ((e[0] / sd).max(e[1]).max(e[2] / sc), eu)
+    }
+
+    pub(super) fn avg_compl(&self, w: &[f64], zl: &[f64], zu: &[f64]) -> (f64, f64) {
+        let mut sum = 0.0;
+        let mut cnt = 0usize;
+        let mut mn = f64::INFINITY;
+        for j in 0..self.lay.nw {
+            if self.lay.has_l[j] {
+                let v = (w[j] - self.lay.wl[j]) * zl[j];
+                sum += v;
+                cnt += 1;
+                mn = mn.min(v);
+            }
+            if self.lay.has_u[j] {
+                let v = (self.lay.wu[j] - w[j]) * zu[j];
+                sum += v;
+                cnt += 1;
+                mn = mn.min(v);
+            }
+        }
+        if cnt == 0 {
+            (0.0, 0.0)
+        } else {
+            (sum / cnt as f64, mn)
+        }
+    }
+
+    // ------------------------------------------------------------------ barrier function
+
+    pub(super) fn barrier(&self, w: &[f64], f: f64, mu: f64) -> f64 {
+        barrier_value(
+            w,
+            f,
+            mu,
+            self.opts.kappa_d,
+            &self.lay.wl,
+            &self.lay.wu,
+            &self.lay.has_l,
+            &self.lay.has_u,
+        )
+    }
+
+    pub(super) fn barrier_dir_deriv(&self, dw: &[f64]) -> f64 {
+        let mu = self.mu;
+        let kd = self.opts.kappa_d * mu;
+        let mut d = 0.0;
+        for j in 0..self.lay.nw {
+            let mut gj = if j < self.lay.n { self.it.grad[j] } else { 0.0 };
+            if self.lay.has_l[j] {
+                gj -= mu / (self.it.w[j] - self.lay.wl[j]);
+                if !self.lay.has_u[j] {
+                    gj += kd;
+                }
+            }
+            if self.lay.has_u[j] {
+                gj += mu / (self.lay.wu[j] - self.it.w[j]);
+                if !self.lay.has_l[j] {
+                    gj -= kd;
+                }
+            }
+            d += gj * dw[j];
+        }
+        d
+    }
+}

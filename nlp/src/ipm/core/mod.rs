@@ -1,0 +1,689 @@
+//! The primal-dual interior-point iteration (Wächter & Biegler 2006) on a problem in the
+//! form seen through [`IpmProblem`]: inequality rows get slacks s (g(x) − s = 0,
+//! g_l ≤ s ≤ g_u) and the primal vector is w = [x; s].
+
+#![allow(
+    clippy::needless_range_loop,
+    clippy::neg_cmp_op_on_partial_ord,
+    clippy::too_many_arguments
+)]
+
+use std::time::Instant;
+
+use crate::callback::Observer;
+use crate::frontend::{KktResiduals, Termination};
+use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, probing_mu, tau};
+use crate::ipm::error::{At, CoreError};
+use crate::ipm::filter::Filter;
+use crate::ipm::reduced::IpmProblem;
+use crate::ipm::restoration;
+use crate::kkt::Kkt;
+use crate::options::{IpmOptions, MuOracle, MuStrategy};
+use crate::solution::{IterationRecord, Stats, Status};
+
+mod direction;
+mod init;
+mod iterate;
+mod kkt_work;
+mod line_search;
+mod measures;
+mod mu;
+mod perturbation;
+
+use direction::Direction;
+pub(crate) use iterate::Iterate;
+use iterate::Trial;
+use kkt_work::KktWork;
+use line_search::LineSearch;
+use perturbation::Perturbation;
+
+/// State shared by the outer loop and nested restoration loops.
+pub(crate) struct Shared<'c> {
+    pub stats: Stats,
+    pub start: Instant,
+    pub iter: usize,
+    /// The user's iteration callback, called by `record`.
+    pub observer: Option<Observer<'c>>,
+}
+
+/// How to start the iteration.
+pub(crate) enum Start {
+    /// Push x0 into the bounds, least-squares y, bound multipliers = bound_mult_init_val.
+    Cold,
+    /// Warm start: x0 from the problem, given y and z (length n); warm-start pushes.
+    Warm {
+        y: Vec<f64>,
+        zl: Vec<f64>,
+        zu: Vec<f64>,
+    },
+    /// Exact full iterate (restoration): w = [x; s], y, z for all of w.
+    Exact {
+        w: Vec<f64>,
+        y: Vec<f64>,
+        zl: Vec<f64>,
+        zu: Vec<f64>,
+    },
+}
+
+/// Parameters of one run of the core.
+pub(crate) struct Setup {
+    pub mu_init: f64,
+    pub bound_relax_factor: f64,
+    pub in_resto: bool,
+    pub obj_scale: f64,
+    pub g_scale: Vec<f64>,
+    pub mu_strategy: MuStrategy,
+}
+
+/// Result of a run.
+pub(crate) struct Outcome {
+    pub status: Status,
+    pub w: Vec<f64>,
+    pub y: Vec<f64>,
+    pub zl: Vec<f64>,
+    pub zu: Vec<f64>,
+    pub message: String,
+    /// For restoration: the inner problem converged (optimal) rather than being stopped
+    /// by the acceptance hook.
+    pub resto_converged: bool,
+}
+/// How the primal vector w = [x; s] is laid out and bounded: fixed for a run.
+#[derive(Clone)]
+pub(crate) struct Layout {
+    pub(crate) n: usize,
+    pub(crate) m: usize,
+    /// Number of inequality rows (slacks).
+    pub(crate) ni: usize,
+    /// n + ni.
+    pub(crate) nw: usize,
+    /// row → slack index (usize::MAX for equality rows).
+    pub(crate) slack_of_row: Vec<usize>,
+    /// slack index → row.
+    pub(crate) row_of_slack: Vec<usize>,
+    /// Right-hand side of equality rows.
+    pub(crate) g_eq: Vec<f64>,
+    pub(crate) wl: Vec<f64>,
+    pub(crate) wu: Vec<f64>,
+    pub(crate) has_l: Vec<bool>,
+    pub(crate) has_u: Vec<bool>,
+}
+
+/// Counters of the main loop.
+#[derive(Default)]
+struct Counters {
+    /// Tiny steps in a row.
+    tiny_count: usize,
+    /// Restoration phases entered.
+    resto_calls: usize,
+}
+
+/// The interior-point iteration: its named parts and the barrier and filter state.
+pub(crate) struct Core<'p> {
+    nlp: &'p mut dyn IpmProblem,
+    opts: IpmOptions,
+    lay: Layout,
+    /// The current iterate.
+    it: Iterate,
+    /// The line search's trial point.
+    trial: Trial,
+    /// The Newton direction.
+    dir: Direction,
+    /// The second-order correction's direction.
+    dir_soc: Direction,
+    /// The second-order correction's constraint residual.
+    c_soc: Vec<f64>,
+    kw: KktWork,
+    pert: Perturbation,
+    count: Counters,
+    // barrier and globalisation state
+    mu: f64,
+    tau: f64,
+    filter: Filter,
+    theta_min: f64,
+    theta_max: f64,
+    free_mode: bool,
+    kkt_refs: Vec<f64>,
+    /// The convergence test's state (acceptable streak, previous objective).
+    termination: Termination,
+    setup_in_resto: bool,
+    obj_scale: f64,
+    g_scale: Vec<f64>,
+    mu_strategy: MuStrategy,
+    /// The outer iteration's failed line search (alpha_pr, ls) that starts a restoration
+    /// phase; shown in the restoration's first log row as IPOPT does ("12r … 4.8e-7R 22").
+    resto_start: Option<(f64, usize)>,
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |a, &b| a.max(b.abs()))
+}
+
+fn one_norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x.abs()).sum()
+}
+
+fn all_finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn first_non_finite(v: &[f64]) -> Option<usize> {
+    v.iter().position(|x| !x.is_finite())
+}
+
+/// φ_μ(w) = f − μ Σ ln(slack) + κ_d μ Σ slack (one-sided bounds only).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn barrier_value(
+    w: &[f64],
+    f: f64,
+    mu: f64,
+    kappa_d: f64,
+    wl: &[f64],
+    wu: &[f64],
+    has_l: &[bool],
+    has_u: &[bool],
+) -> f64 {
+    let kd = kappa_d * mu;
+    let mut phi = f;
+    for j in 0..w.len() {
+        if has_l[j] {
+            let s = w[j] - wl[j];
+            phi -= mu * s.ln();
+            if !has_u[j] {
+                phi += kd * s;
+            }
+        }
+        if has_u[j] {
+            let s = wu[j] - w[j];
+            phi -= mu * s.ln();
+            if !has_l[j] {
+                phi += kd * s;
+            }
+        }
+    }
+    phi
+}
+
+impl<'p> Core<'p> {
+    pub(crate) fn new(
+        nlp: &'p mut dyn IpmProblem,
+        opts: &IpmOptions,
+        setup: &Setup,
+    ) -> Result<Self, CoreError> {
+        let n = nlp.n();
+        let m = nlp.m();
+        let mut x_l = vec![0.0; n];
+        let mut x_u = vec![0.0; n];
+        let mut g_l = vec![0.0; m];
+        let mut g_u = vec![0.0; m];
+        nlp.bounds(&mut x_l, &mut x_u, &mut g_l, &mut g_u);
+        let mut slack_of_row = vec![usize::MAX; m];
+        let mut row_of_slack = Vec::new();
+        let mut g_eq = vec![0.0; m];
+        for i in 0..m {
+            if g_l[i] == g_u[i] {
+                g_eq[i] = g_l[i];
+            } else {
+                slack_of_row[i] = row_of_slack.len();
+                row_of_slack.push(i);
+            }
+        }
+        let ni = row_of_slack.len();
+        let nw = n + ni;
+        let mut wl = vec![f64::NEG_INFINITY; nw];
+        let mut wu = vec![f64::INFINITY; nw];
+        wl[..n].copy_from_slice(&x_l);
+        wu[..n].copy_from_slice(&x_u);
+        for (k, &i) in row_of_slack.iter().enumerate() {
+            wl[n + k] = g_l[i];
+            wu[n + k] = g_u[i];
+        }
+        let rf = setup.bound_relax_factor;
+        for j in 0..nw {
+            if wl[j].is_finite() {
+                wl[j] -= rf * wl[j].abs().max(1.0);
+            }
+            if wu[j].is_finite() {
+                wu[j] += rf * wu[j].abs().max(1.0);
+            }
+        }
+        let has_l: Vec<bool> = wl.iter().map(|v| v.is_finite()).collect();
+        let has_u: Vec<bool> = wu.iter().map(|v| v.is_finite()).collect();
+        let kkt = Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())?;
+        let nnz_j = nlp.jac_g_sparsity().row_idx().len();
+        let nnz_h = nlp.hess_l_sparsity().row_idx().len();
+        let mut kkt = kkt;
+        kkt.min_refinement_steps = opts.min_refinement_steps;
+        kkt.max_refinement_steps = opts.max_refinement_steps;
+        kkt.residual_ratio_max = opts.residual_ratio_max;
+        // Refinement target: K without the static regularisation of equality rows.
+        let shift = vec![0.0; n + m];
+        let mut hess_diag = vec![usize::MAX; n];
+        {
+            let hp = nlp.hess_l_sparsity();
+            for (j, d) in hess_diag.iter_mut().enumerate() {
+                for p in hp.col_range(j) {
+                    if hp.row_idx()[p] == j {
+                        *d = p;
+                    }
+                }
+            }
+        }
+        let lay = Layout {
+            n,
+            m,
+            ni,
+            nw,
+            slack_of_row,
+            row_of_slack,
+            g_eq,
+            wl,
+            wu,
+            has_l,
+            has_u,
+        };
+        Ok(Core {
+            nlp,
+            opts: opts.clone(),
+            lay,
+            it: Iterate {
+                w: vec![0.0; nw],
+                y: vec![0.0; m],
+                zl: vec![0.0; nw],
+                zu: vec![0.0; nw],
+                f: 0.0,
+                grad: vec![0.0; n],
+                g: vec![0.0; m],
+                c: vec![0.0; m],
+                jac: vec![0.0; nnz_j],
+                hess: vec![0.0; nnz_h],
+            },
+            trial: Trial {
+                w: vec![0.0; nw],
+                y: vec![0.0; m],
+                f: 0.0,
+                grad: vec![0.0; n],
+                g: vec![0.0; m],
+                c: vec![0.0; m],
+                jac: vec![0.0; nnz_j],
+                hess: vec![0.0; nnz_h],
+            },
+            dir: Direction::new(nw, m),
+            dir_soc: Direction::new(nw, m),
+            c_soc: vec![0.0; m],
+            kw: KktWork {
+                kkt,
+                kdx: vec![0.0; n],
+                kdc: vec![0.0; m],
+                rhs: vec![0.0; n + m],
+                rhs_s: vec![0.0; ni],
+                rhs_copy: vec![0.0; n + m],
+                ds: vec![0.0; ni],
+                shift,
+                eq_reg: vec![0.0; m],
+                eq_reg_step: vec![0.0; m],
+                hess_diag,
+                hzero: vec![0.0; nnz_h],
+                work_nw: vec![0.0; nw],
+            },
+            pert: Perturbation::default(),
+            count: Counters::default(),
+            mu: setup.mu_init,
+            tau: tau(setup.mu_init, opts),
+            filter: Filter::new(),
+            theta_min: 0.0,
+            theta_max: 0.0,
+            free_mode: setup.mu_strategy == MuStrategy::Adaptive,
+            kkt_refs: Vec::new(),
+            termination: Termination::default(),
+            setup_in_resto: setup.in_resto,
+            obj_scale: setup.obj_scale,
+            g_scale: setup.g_scale.clone(),
+            mu_strategy: setup.mu_strategy,
+            resto_start: None,
+        })
+    }
+
+    // ------------------------------------------------------------------ records
+
+    fn record(
+        &mut self,
+        shared: &mut Shared,
+        d_norm: f64,
+        alpha_du: f64,
+        alpha_pr: f64,
+        ch: char,
+        ls: usize,
+        dual: f64,
+    ) {
+        // In restoration, the objective and inf_pr columns are the original problem's at
+        // the current x and s (IPOPT's RestoIterationOutput); inf_du and lg(mu) are the
+        // restoration problem's.
+        let (objective, inf_pr) = match self.nlp.original_measures(&self.it.w) {
+            Some(v) => v,
+            None => (
+                self.it.f / self.obj_scale,
+                self.it
+                    .c
+                    .iter()
+                    .zip(&self.g_scale)
+                    .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s)),
+            ),
+        };
+        shared.stats.records.push(IterationRecord {
+            iter: shared.iter,
+            restoration: self.setup_in_resto,
+            objective,
+            inf_pr,
+            inf_du: dual,
+            mu: self.mu,
+            d_norm,
+            regularization: self.pert.delta_w,
+            alpha_du,
+            alpha_pr,
+            alpha_pr_char: ch,
+            ls,
+        });
+        if let (Some(obs), Some(rec)) = (shared.observer.as_mut(), shared.stats.records.last()) {
+            let (x, lambda) = obs.buffers();
+            self.nlp
+                .user_point(&self.it.w[..self.lay.n], &self.it.y, x, lambda);
+            obs.call(rec);
+        }
+        if self.setup_in_resto {
+            shared.stats.restoration_iterations += 1;
+        }
+        if self.pert.delta_w > shared.stats.max_regularization {
+            shared.stats.max_regularization = self.pert.delta_w;
+        }
+        if self.opts.print_level >= 5 {
+            if shared.stats.records.len() % 10 == 1 {
+                println!("{}", crate::log::header());
+            }
+            println!(
+                "{}",
+                crate::log::format_record(shared.stats.records.last().unwrap_or(
+                    &IterationRecord {
+                        iter: 0,
+                        restoration: false,
+                        objective: 0.0,
+                        inf_pr: 0.0,
+                        inf_du: 0.0,
+                        mu: 0.0,
+                        d_norm: 0.0,
+                        regularization: 0.0,
+                        alpha_du: 0.0,
+                        alpha_pr: 0.0,
+                        alpha_pr_char: ' ',
+                        ls: 0
+                    }
+                ))
+            );
+        }
+    }
+
+    pub(crate) fn outcome(
+        &self,
+        status: Status,
+        message: impl Into<String>,
+        resto_converged: bool,
+    ) -> Outcome {
+        Outcome {
+            status,
+            w: self.it.w.clone(),
+            y: self.it.y.clone(),
+            zl: self.it.zl.clone(),
+            zu: self.it.zu.clone(),
+            message: message.into(),
+            resto_converged,
+        }
+    }
+
+    // ------------------------------------------------------------------ main loop
+
+    /// The tests before each iteration: user stop, convergence (or, in restoration, the
+    /// restoration problem's own convergence) and the limits. Ok carries the scaled
+    /// optimality error E_0 for the adaptive μ update.
+    #[allow(clippy::result_large_err)]
+    fn stop_test(&mut self, shared: &Shared, max_resto_iter_end: usize) -> Result<f64, Outcome> {
+        // The iteration callback (called by `record`) asked to stop (IPOPT tests
+        // this before convergence).
+        if shared.observer.as_ref().is_some_and(|o| o.stopped()) {
+            return Err(self.outcome(
+                Status::UserRequestedStop,
+                "stopped by the iteration callback",
+                false,
+            ));
+        }
+        // ---------------- convergence
+        let (e0, eu) = self.nlp_error(0.0, false);
+        if !self.setup_in_resto {
+            let e = KktResiduals {
+                overall: e0,
+                dual: eu[0],
+                primal: eu[1],
+                compl: eu[2],
+            };
+            if let Some(status) = self.termination.check(&e, self.it.f, &self.opts.common) {
+                return Err(self.outcome(status, "", false));
+            }
+        } else if e0 <= self.opts.tol {
+            return Err(self.outcome(
+                Status::SolveSucceeded,
+                "restoration problem converged",
+                true,
+            ));
+        } else {
+            self.termination.set_last_objective(self.it.f);
+        }
+        if shared.iter >= self.opts.max_iter {
+            return Err(self.outcome(Status::MaximumIterationsExceeded, "", false));
+        }
+        if self.setup_in_resto && shared.iter >= max_resto_iter_end {
+            return Err(self.outcome(Status::MaximumIterationsExceeded, "max_resto_iter", false));
+        }
+        if shared.start.elapsed().as_secs_f64() > self.opts.max_wall_time {
+            return Err(self.outcome(Status::MaximumWallTimeExceeded, "", false));
+        }
+        if inf_norm(&self.it.w) > self.opts.diverging_iterates_tol {
+            return Err(self.outcome(Status::DivergingIterates, "", false));
+        }
+        Ok(e0)
+    }
+
+    pub(crate) fn run(&mut self, shared: &mut Shared, start: Start) -> Outcome {
+        if let Err(e) = self.initialize(start) {
+            return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
+        }
+        let (_, eu) = self.errors(0.0, false);
+        match self.resto_start.take() {
+            Some((a_pr, ls)) => self.record(shared, 0.0, 0.0, a_pr, 'R', ls, eu[0]),
+            None => self.record(shared, 0.0, 0.0, 0.0, ' ', 0, eu[0]),
+        }
+        let mut pending_resto = self.opts.start_with_resto && !self.setup_in_resto;
+        let max_resto_iter_end = shared.iter + self.opts.max_resto_iter;
+        loop {
+            let e0 = match self.stop_test(shared, max_resto_iter_end) {
+                Ok(e0) => e0,
+                Err(out) => return out,
+            };
+
+            if !pending_resto {
+                // ---------------- barrier update (monotone) and factorisation
+                if self.mu_strategy == MuStrategy::Monotone {
+                    self.update_mu_monotone(self.count.tiny_count > 0);
+                }
+                let factor_ok = self.factorize_with_inertia_correction(shared);
+                if factor_ok && self.mu_strategy == MuStrategy::Adaptive {
+                    self.update_mu_adaptive(shared, e0);
+                }
+                let dir_ok = factor_ok && self.solve_direction(shared, self.mu, false);
+                if dir_ok {
+                    shared.iter += 1;
+                    let d_norm = inf_norm(&self.dir.dw);
+                    // Tiny step test.
+                    let rel = (0..self.lay.nw)
+                        .map(|j| self.dir.dw[j].abs() / (1.0 + self.it.w[j].abs()))
+                        .fold(0.0, f64::max);
+                    let tiny = rel < self.opts.tiny_step_tol
+                        && inf_norm(&self.dir.dy)
+                            < self.opts.tiny_step_y_tol * (1.0 + inf_norm(&self.it.y));
+                    if tiny && self.take_full_step() {
+                        self.count.tiny_count += 1;
+                        let (_, eu) = self.errors(0.0, false);
+                        self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
+                        if self.count.tiny_count >= 2
+                            && self.mu <= mu_floor(&self.opts) * (1.0 + 1e-12)
+                        {
+                            return self.outcome(Status::SearchDirectionBecomesTooSmall, "", false);
+                        }
+                        continue;
+                    }
+                    self.count.tiny_count = 0;
+                    match self.line_search(shared) {
+                        LineSearch::Accepted {
+                            alpha_pr,
+                            alpha_du,
+                            kind,
+                            trials,
+                        } => {
+                            let (_, eu) = self.errors(0.0, false);
+                            let ch = kind.log_char();
+                            self.record(shared, d_norm, alpha_du, alpha_pr, ch, trials, eu[0]);
+                            if self.setup_in_resto && self.nlp.restoration_accepts(&self.it.w) {
+                                return self.outcome(Status::SolveSucceeded, "", false);
+                            }
+                            continue;
+                        }
+                        LineSearch::Failed { alpha_pr, trials } => {
+                            // The restoration phase's first row reports the failed line
+                            // search (IPOPT: "12r", alpha_pr 'R', and its ls count, one
+                            // more than the trial steps).
+                            shared.iter -= 1;
+                            self.resto_start = Some((alpha_pr, trials + 1));
+                        }
+                    }
+                } else if self.setup_in_resto {
+                    return self.outcome(
+                        Status::ErrorInStepComputation,
+                        "inertia correction failed in restoration",
+                        false,
+                    );
+                }
+                if !dir_ok && !factor_ok && self.lay.m == 0 {
+                    return self.outcome(
+                        Status::ErrorInStepComputation,
+                        "inertia correction failed",
+                        false,
+                    );
+                }
+            }
+            pending_resto = false;
+            // ---------------- line search failed (or step failed): restoration
+            if self.setup_in_resto {
+                return self.outcome(
+                    Status::RestorationFailed,
+                    "line search failed in restoration",
+                    false,
+                );
+            }
+            if self.lay.m == 0 {
+                let status = if self.termination.last_was_acceptable() {
+                    Status::SolvedToAcceptableLevel
+                } else {
+                    Status::SearchDirectionBecomesTooSmall
+                };
+                return self.outcome(
+                    status,
+                    "line search failed for a problem without constraints",
+                    false,
+                );
+            }
+            self.count.resto_calls += 1;
+            // The restoration phase's first row takes the next iteration number (IPOPT's
+            // count: the iteration whose line search failed is that row).
+            shared.iter += 1;
+            // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9).
+            let theta = one_norm(&self.it.c);
+            let phi = self.barrier(&self.it.w, self.it.f, self.mu);
+            self.filter.add(
+                (1.0 - self.opts.gamma_theta) * theta,
+                phi - self.opts.gamma_phi * theta,
+            );
+            match restoration::restore(self, shared) {
+                Ok(()) => {
+                    self.pert.delta_w_last = 0.0;
+                    self.count.tiny_count = 0;
+                    continue;
+                }
+                Err(out) => return out,
+            }
+        }
+    }
+
+    // ------------------------------------------------------------------ for restoration
+
+    /// The layout and bounds of w.
+    pub(crate) fn layout(&self) -> &Layout {
+        &self.lay
+    }
+
+    /// The current iterate.
+    pub(crate) fn iterate(&self) -> &Iterate {
+        &self.it
+    }
+
+    /// The current barrier parameter μ.
+    pub(crate) fn mu(&self) -> f64 {
+        self.mu
+    }
+
+    /// The options of this run.
+    pub(crate) fn options(&self) -> &IpmOptions {
+        &self.opts
+    }
+
+    /// The problem being solved.
+    pub(crate) fn problem(&self) -> &dyn IpmProblem {
+        &*self.nlp
+    }
+
+    /// The problem being solved, for a nested restoration problem that evaluates it.
+    pub(crate) fn problem_mut(&mut self) -> &mut dyn IpmProblem {
+        &mut *self.nlp
+    }
+
+    /// The filter (restoration accepts only points acceptable to it).
+    pub(crate) fn filter(&self) -> &Filter {
+        &self.filter
+    }
+
+    /// Empties the filter.
+    pub(crate) fn reset_filter(&mut self) {
+        self.filter.reset();
+    }
+
+    /// Takes the failed line search that starts a restoration phase (see `resto_start`).
+    pub(crate) fn take_resto_start(&mut self) -> Option<(f64, usize)> {
+        self.resto_start.take()
+    }
+
+    /// Sets the failed line search to report in the first log row.
+    pub(crate) fn set_resto_start(&mut self, v: Option<(f64, usize)>) {
+        self.resto_start = v;
+    }
+
+    /// θ_max of the filter (the largest constraint violation accepted).
+    pub(crate) fn theta_max(&self) -> f64 {
+        self.theta_max
+    }
+
+    /// Objective scale factor (for the unscaled objective).
+    pub(crate) fn obj_scale(&self) -> f64 {
+        self.obj_scale
+    }
+
+    /// Constraint scale factors (for unscaled violations).
+    pub(crate) fn g_scale(&self) -> &[f64] {
+        &self.g_scale
+    }
+}
