@@ -7,9 +7,9 @@ use std::sync::Arc;
 /// `n` evaluations of a function, each input and output holding the `n` points one after
 /// the other (the layout of [`Function::eval_batch`]).
 ///
-/// With [`Map::parallel`]`(t)`, the points are split into `t` contiguous chunks evaluated
-/// as tasks of a rayon pool of `t` threads owned by the map, each chunk with its own part
-/// of the work vector. Every
+/// With [`Map::parallel`]`(t)`, the points are split into `t` contiguous chunks: the
+/// calling thread evaluates the first, a rayon pool of `t − 1` threads owned by the map
+/// the others, each chunk with its own part of the work vector. Every
 /// point is computed by the same tape on the same numbers, so the results are
 /// bit-identical whatever the number of threads.
 ///
@@ -45,13 +45,14 @@ impl Function {
 }
 
 impl Map {
-    /// Splits the points over `threads` threads of a rayon pool built here (1 or 0:
-    /// serial); `Err` if the operating system refuses the threads.
+    /// Splits the points over `threads` threads: the caller and a rayon pool of
+    /// `threads − 1` built here (1 or 0: serial); `Err` if the operating system refuses
+    /// the threads.
     pub fn parallel(mut self, threads: usize) -> Result<Map, SymxError> {
         self.chunks = threads.clamp(1, self.n.max(1));
         self.pool = if self.chunks > 1 {
             let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(self.chunks)
+                .num_threads(self.chunks - 1)
                 .build()
                 .map_err(|e| SymxError::Threads {
                     message: e.to_string(),
@@ -118,26 +119,33 @@ impl Map {
             }
         }
         let w = f.work_size();
-        pool.scope(|s| {
-            for ((c, mut outs), work) in out_parts
+        let run = move |c: usize, mut outs: Vec<&mut [f64]>, work: &mut [f64]| {
+            let first = c * per;
+            let count = per.min(self.n.saturating_sub(first));
+            if count == 0 {
+                return;
+            }
+            let ins: Vec<&[f64]> = inputs
+                .iter()
+                .zip(f.input_sizes())
+                .map(|(x, &size)| &x[first * size..(first + count) * size])
+                .collect();
+            f.eval_batch(&ins, &mut outs, work, count)
+                .expect("sizes checked before splitting");
+        };
+        // The calling thread evaluates the first chunk itself while the pool's threads
+        // evaluate the others (no hand-over of every chunk to sleeping workers).
+        pool.in_place_scope(|s| {
+            let mut jobs = out_parts
                 .into_iter()
                 .enumerate()
-                .zip(work.chunks_mut(w.max(1)))
-            {
-                let first = c * per;
-                let count = per.min(self.n.saturating_sub(first));
-                if count == 0 {
-                    continue;
-                }
-                s.spawn(move |_| {
-                    let ins: Vec<&[f64]> = inputs
-                        .iter()
-                        .zip(f.input_sizes())
-                        .map(|(x, &size)| &x[first * size..(first + count) * size])
-                        .collect();
-                    f.eval_batch(&ins, &mut outs, work, count)
-                        .expect("sizes checked before splitting");
-                });
+                .zip(work.chunks_mut(w.max(1)));
+            let own = jobs.next();
+            for ((c, outs), work) in jobs {
+                s.spawn(move |_| run(c, outs, work));
+            }
+            if let Some(((c, outs), work)) = own {
+                run(c, outs, work);
             }
         });
         Ok(())
