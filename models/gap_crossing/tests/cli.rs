@@ -2,13 +2,9 @@
 
 use gap_crossing::status::StatusKind;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_gap-crossing");
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("binary runs")
-}
+mod common;
+use common::run;
 
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
@@ -16,10 +12,7 @@ fn text(b: &[u8]) -> String {
 
 /// A fresh directory per test.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("gap_crossing_cli_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("cli", name)
 }
 
 /// The spec's example stance, twice, with goal = start: a valid plan.

@@ -17,19 +17,13 @@ use gap_crossing::solve::{self, Settings};
 use gap_crossing::status::StatusKind;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_gap-crossing");
+mod common;
+use common::run;
 
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("binary runs")
-}
-
+/// A fresh directory per test.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("gap_crossing_cross_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("cross", name)
 }
 
 fn examples() -> PathBuf {

@@ -4,13 +4,10 @@
 //! errors.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const BIN: &str = env!("CARGO_BIN_EXE_gap-crossing");
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("binary runs")
-}
+mod common;
+use common::run;
 
 fn text(o: &Output) -> String {
     format!(
@@ -22,10 +19,7 @@ fn text(o: &Output) -> String {
 
 /// A fresh directory per test.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("gap_crossing_files_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::fresh_dir("files", name)
 }
 
 /// Every entry of `dir` with its content (`<dir>` for a directory), sorted.
