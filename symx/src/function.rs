@@ -93,6 +93,13 @@ pub struct Function {
     pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
 }
 
+/// The output slices as raw pointers, for [`Function::run`]: `&mut [f64]` and
+/// `*mut [f64]` have the same layout, and no reference to the slices' contents is made,
+/// so threads may write disjoint points through them.
+pub(crate) fn output_pointers(outputs: &mut [&mut [f64]]) -> *const *mut [f64] {
+    outputs.as_mut_ptr().cast::<*mut [f64]>()
+}
+
 /// A fresh function identity.
 pub(crate) fn next_uid() -> u64 {
     static NEXT: AtomicU64 = AtomicU64::new(1);
@@ -294,8 +301,9 @@ impl Function {
         work: &mut [f64],
     ) -> Result<(), SymxError> {
         self.check(inputs, outputs, work, 1)?;
+        let outs = output_pointers(outputs);
         // SAFETY: sizes checked above; the tape's indices were bounded at compilation.
-        unsafe { self.run(inputs, outputs, work, 0) };
+        unsafe { self.run(inputs, outs, work.as_mut_ptr(), 0) };
         Ok(())
     }
 
@@ -309,9 +317,10 @@ impl Function {
         points: usize,
     ) -> Result<(), SymxError> {
         self.check(inputs, outputs, work, points)?;
+        let outs = output_pointers(outputs);
         for p in 0..points {
             // SAFETY: sizes checked above for all points.
-            unsafe { self.run(inputs, outputs, work, p) };
+            unsafe { self.run(inputs, outs, work.as_mut_ptr(), p) };
         }
         Ok(())
     }
@@ -325,18 +334,21 @@ impl Function {
         Ok(out)
     }
 
+    /// Evaluates point `p`: reads `inputs`, writes output `k` at `outputs[k]` (see
+    /// [`output_pointers`]) and uses the work vector at `w`.
+    ///
     /// # Safety
-    /// `inputs`/`outputs` must hold `(p+1)·size` numbers per argument and `work` at least
-    /// `work_size` numbers (checked by [`Function::check`]).
+    /// `inputs` and the `n_outputs()` slices behind `outputs` must hold `(p+1)·size`
+    /// numbers per argument and `w` at least `work_size` numbers (checked by
+    /// [`Function::check`]); no other thread may access point `p` of the outputs or `w`.
     #[inline(always)]
-    unsafe fn run(
+    pub(crate) unsafe fn run(
         &self,
         inputs: &[&[f64]],
-        outputs: &mut [&mut [f64]],
-        work: &mut [f64],
+        outputs: *const *mut [f64],
+        w: *mut f64,
         p: usize,
     ) {
-        let w = work.as_mut_ptr();
         for (k, x) in inputs.iter().enumerate() {
             if *self.input_used.get_unchecked(k) {
                 let n = *self.input_sizes.get_unchecked(k);
@@ -345,10 +357,14 @@ impl Function {
             }
         }
         self.exec(w);
-        for (k, y) in outputs.iter_mut().enumerate() {
-            let n = *self.output_sizes.get_unchecked(k);
-            let at = *self.output_offsets.get_unchecked(k);
-            std::ptr::copy_nonoverlapping(w.add(at), y.as_mut_ptr().add(p * n), n);
+        for (k, (&n, &at)) in self
+            .output_sizes
+            .iter()
+            .zip(&self.output_offsets)
+            .enumerate()
+        {
+            let y = (*outputs.add(k)).cast::<f64>();
+            std::ptr::copy_nonoverlapping(w.add(at), y.add(p * n), n);
         }
     }
 

@@ -35,6 +35,7 @@ mod matrix;
 mod op;
 mod simplify;
 pub mod sparsity;
+mod team;
 
 pub use ad::{forward, gradient, hessian, jacobian, lagrangian_hessian, reverse};
 pub use display::parse;
