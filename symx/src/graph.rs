@@ -201,6 +201,53 @@ impl Graph {
     }
 }
 
+/// Runs `f` with a new, empty expression graph on this thread, then drops that graph
+/// (releasing its memory) and restores the one that was current before, also when `f`
+/// panics. Scopes nest.
+///
+/// The graph only grows while a program builds expressions; a long-running program that
+/// builds many models one after the other wraps each build in a scope, keeps the compiled
+/// [`crate::Function`]s (they hold no reference to any graph) and lets the rest go.
+///
+/// The rule that keeps it sound: an [`crate::Expr`] belongs to the graph it was made in.
+/// The bounds make crossing the scope impossible by construction: `f` must be `Send`, so
+/// it cannot capture an `Expr` (or a `Matrix`, or a reference to one) from outside, and
+/// the result must be `Send`, so no `Expr` comes out. (What the bounds cannot see is an
+/// `Expr` smuggled through a `thread_local!` or a global of the caller's own: don't.)
+///
+/// ```
+/// use symx::{node_count, with_fresh_arena, Expr, Function};
+/// let before = node_count();
+/// let f = with_fresh_arena(|| {
+///     let x = Expr::sym("x");
+///     Function::new(&[&[x]], &[&[x.sin() * x]]).unwrap()
+/// });
+/// assert_eq!(node_count(), before); // the scope's nodes are gone...
+/// assert_eq!(f.call(&[&[2.0]]).unwrap()[0][0], 2.0f64.sin() * 2.0); // ...its function works
+/// ```
+/// An `Expr` from outside cannot be used inside, nor one from inside outside:
+/// ```compile_fail
+/// let x = symx::Expr::sym("x");
+/// symx::with_fresh_arena(|| symx::Function::new(&[&[x]], &[&[x.sin()]]).unwrap());
+/// ```
+/// ```compile_fail
+/// let y = symx::with_fresh_arena(|| symx::Expr::sym("y"));
+/// ```
+pub fn with_fresh_arena<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    /// Puts the outer graph back when the scope ends, normally or by unwinding.
+    struct Restore(Option<Graph>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            if let Some(outer) = self.0.take() {
+                let inner = with(|g| std::mem::replace(g, outer));
+                drop(inner);
+            }
+        }
+    }
+    let _restore = Restore(Some(with(|g| std::mem::replace(g, Graph::new()))));
+    f()
+}
+
 /// Number of nodes in this thread's graph (a measure of memory use).
 pub fn node_count() -> usize {
     with(|g| g.len())
