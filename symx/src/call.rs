@@ -192,6 +192,10 @@ fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
                 let t = g.table_id(&f.tables[c]);
                 g.interpolant(reg[a], t)
             }
+            Op::Interpolant2 => {
+                let t = g.table_id(&f.tables[c]);
+                g.interpolant2(reg[a], reg[b], t)
+            }
             Op::IfElse => g.if_else(reg[a], reg[b], reg[c]),
             op if op.arity() == 1 => g.unary(op, reg[a]),
             op => g.binary(op, reg[a], reg[b]),

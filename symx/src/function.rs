@@ -28,15 +28,15 @@ use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::graph;
-use crate::interpolant::Table;
 use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
+use crate::table::Table;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
 /// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`;
-/// for [`Op::Interpolant`], `c` is the index of the table in [`Function`]'s own list; for
+/// for [`Op::Interpolant`] and [`Op::Interpolant2`], `c` is the index of the table in [`Function`]'s own list; for
 /// [`Op::Call`], `d` is the index of the call in [`Function`]'s list and `a = b = c = 0`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Instr {
@@ -426,7 +426,8 @@ impl Function {
                 Op::Expm1 => a.exp_m1(),
                 Op::Fmod => a % b,
                 Op::Hypot => a.hypot(b),
-                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(a),
+                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(&[a]),
+                Op::Interpolant2 => self.tables.get_unchecked(ins.c as usize).eval(&[a, b]),
                 Op::IfElse => {
                     if a != 0.0 {
                         b

@@ -6,8 +6,8 @@
 //! already exist, ascending index order is a topological order of the whole graph; every
 //! traversal in this crate relies on that and none of them recurses.
 use crate::call::CallSite;
-use crate::interpolant::Table;
 use crate::op::Op;
+use crate::table::Table;
 use rustc_hash::FxHashMap;
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -64,8 +64,8 @@ pub(crate) struct Graph {
     /// Table number of each registered table, by address (the graph keeps the `Arc`, so an
     /// address is never reused while registered).
     table_index: FxHashMap<usize, u32>,
-    /// Table number of each table's derivative, once built.
-    table_derivative: Vec<Option<u32>>,
+    /// Table number of each table's partial derivatives (by axis), once built.
+    table_derivative: Vec<[Option<u32>; 2]>,
     /// Calls of compiled functions, by call number (`Call` nodes hold the number).
     pub calls: Vec<CallSite>,
     /// Call number of each (function, argument nodes) pair: identical calls are one call.
@@ -137,31 +137,45 @@ impl Graph {
         }
         let t = self.tables.len() as u32;
         self.tables.push(table.clone());
-        self.table_derivative.push(None);
+        self.table_derivative.push([None; 2]);
         self.table_index.insert(key, t);
         t
     }
 
-    /// The number of the derivative of table `t`, built once.
-    pub fn derivative_table(&mut self, t: u32) -> u32 {
-        if let Some(d) = self.table_derivative[t as usize] {
+    /// The number of the partial derivative of table `t` along `axis`, built once.
+    pub fn derivative_table(&mut self, t: u32, axis: usize) -> u32 {
+        if let Some(d) = self.table_derivative[t as usize][axis] {
             return d;
         }
-        let d = Arc::new(self.tables[t as usize].derivative());
+        let d = Arc::new(self.tables[t as usize].derivative(axis));
         let d = self.table_id(&d);
-        self.table_derivative[t as usize] = Some(d);
+        self.table_derivative[t as usize][axis] = Some(d);
         d
     }
 
-    /// `table_t(x)`: a lookup node (folded when `x` is a constant).
+    /// `table_t(x)`: a 1-D lookup node (folded when `x` is a constant).
     pub fn interpolant(&mut self, x: u32, t: u32) -> u32 {
+        debug_assert_eq!(self.tables[t as usize].dims(), 1);
         if let Some(v) = self.value(x) {
-            let y = self.tables[t as usize].eval(v);
+            let y = self.tables[t as usize].eval(&[v]);
             return self.constant(y);
         }
         self.intern(Node {
             op: Op::Interpolant,
             args: [x, t, 0],
+        })
+    }
+
+    /// `table_t(x, y)`: a 2-D lookup node (folded when `x` and `y` are constants).
+    pub fn interpolant2(&mut self, x: u32, y: u32, t: u32) -> u32 {
+        debug_assert_eq!(self.tables[t as usize].dims(), 2);
+        if let (Some(u), Some(v)) = (self.value(x), self.value(y)) {
+            let z = self.tables[t as usize].eval(&[u, v]);
+            return self.constant(z);
+        }
+        self.intern(Node {
+            op: Op::Interpolant2,
+            args: [x, y, t],
         })
     }
 

@@ -36,6 +36,7 @@ mod matrix;
 mod op;
 mod simplify;
 pub mod sparsity;
+mod table;
 mod team;
 
 pub use ad::{forward, gradient, hessian, jacobian, lagrangian_hessian, reverse};
@@ -44,7 +45,7 @@ pub use error::SymxError;
 pub use expr::{and, eq, ge, gt, if_else, le, logsumexp, lt, ne, not, or, Expr};
 pub use function::Function;
 pub use graph::{node_count, with_fresh_arena};
-pub use interpolant::Interpolant;
+pub use interpolant::{Interpolant, Interpolant2};
 pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
 pub use op::Op;

@@ -72,6 +72,9 @@ pub enum Op {
     /// A lookup table (see [`crate::Interpolant`]) applied to the operand; the node also
     /// records which table, so it prints as `interpolant#k(x)` and does not parse back.
     Interpolant,
+    /// A 2-D lookup table (see [`crate::Interpolant2`]) applied to the two operands; the
+    /// third slot records which table; prints as `interpolant#k(x,y)`, does not parse back.
+    Interpolant2,
     /// A call of a compiled [`crate::Function`] (see [`crate::Function::apply`]); its
     /// operands (the argument entries) live in the graph's call table, so `arity` is 0.
     /// It has no value of its own: its outputs are `CallOutput` nodes.
@@ -90,7 +93,7 @@ impl Op {
             | Tanh | Abs | Sign | Not | Floor | Ceil | Erf | Asinh | Acosh | Atanh | Log1p
             | Expm1 | Interpolant | CallOutput => 1,
             Add | Sub | Mul | Div | Pow | Atan2 | Min | Max | Lt | Le | Eq | Ne | And | Or
-            | StrongMul | Fmod | Hypot => 2,
+            | StrongMul | Fmod | Hypot | Interpolant2 => 2,
             IfElse => 3,
         }
     }
@@ -224,7 +227,7 @@ impl Op {
             Expm1 => "expm1",
             Fmod => "fmod",
             Hypot => "hypot",
-            Interpolant => "interpolant",
+            Interpolant | Interpolant2 => "interpolant",
             Call => "call",
             CallOutput => "call_output",
         }
