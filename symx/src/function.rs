@@ -36,7 +36,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 /// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
 /// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`;
-/// for [`Op::Interpolant`] and [`Op::Interpolant2`], `c` is the index of the table in [`Function`]'s own list; for
+/// for [`Op::Interpolant`] and [`Op::Interpolant2`], `c` is the index of the table in [`Function`]'s own list
+/// ([`Op::InterpolantN`] also, reading the `b` registers from `a`, `b` < the work size); for
 /// [`Op::Call`], `d` is the index of the call in [`Function`]'s list and `a = b = c = 0`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Instr {
@@ -428,6 +429,14 @@ impl Function {
                 Op::Hypot => a.hypot(b),
                 Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(&[a]),
                 Op::Interpolant2 => self.tables.get_unchecked(ins.c as usize).eval(&[a, b]),
+                Op::InterpolantN => {
+                    self.tables
+                        .get_unchecked(ins.c as usize)
+                        .eval(std::slice::from_raw_parts(
+                            w.add(ins.a as usize),
+                            ins.b as usize,
+                        ))
+                }
                 Op::IfElse => {
                     if a != 0.0 {
                         b
@@ -550,6 +559,10 @@ impl Function {
                             .fold(0, |m, &j| m | bits[call.args[j as usize] as usize]);
                         bits[call.out as usize + q] = m;
                     }
+                }
+                Op::InterpolantN => {
+                    let (a, n) = (ins.a as usize, ins.b as usize);
+                    bits[ins.d as usize] = bits[a..a + n].iter().fold(0, |m, &b| m | b);
                 }
                 o if o.has_zero_derivative() => bits[ins.d as usize] = 0,
                 Op::IfElse => bits[ins.d as usize] = bits[ins.b as usize] | bits[ins.c as usize],

@@ -1,5 +1,5 @@
-//! [`Interpolant`] and [`Interpolant2`]: differentiable lookup tables on 1-D and 2-D
-//! rectilinear grids (CasADi's `interpolant`).
+//! [`Interpolant`], [`Interpolant2`] and [`InterpolantN`]: differentiable lookup tables on
+//! 1-D, 2-D and n-D rectilinear grids (CasADi's `interpolant`).
 //!
 //! A table is stored as a piecewise polynomial ([`crate::table`]: one polynomial per grid
 //! cell, cubic at most in each coordinate), so that its partial derivatives are again
@@ -13,11 +13,19 @@
 //!   what CasADi's `'bspline'` computes (checked in `symx/tests/ops.rs`); on a 2-D grid
 //!   the tensor product of it (checked in `symx/tests/interpolant2.rs`); as in CasADi it is
 //!   zero outside the grid.
+//!
+//! 1-D and 2-D lookups are graph nodes of their own (`Interpolant`, `Interpolant2`). A
+//! node holds at most three operand slots, so an n-D lookup is instead a call (see
+//! `call.rs`) of a small compiled function whose tape is one [`crate::Op::InterpolantN`]
+//! instruction; its Jacobian function calls the lookup functions of the partial-derivative
+//! tables, so it differentiates to any order like any call.
 use crate::error::SymxError;
 use crate::expr::Expr;
+use crate::function::{next_uid, Function, Instr};
 use crate::graph;
+use crate::op::Op;
 use crate::table::{linear_fit, not_a_knot_fit, Fit1, Table};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// A differentiable 1-D lookup table; apply it to an expression with [`Interpolant::eval`].
 ///
@@ -162,6 +170,165 @@ impl Interpolant2 {
         Ok(Interpolant2 {
             table: Arc::new(self.table.derivative(axis)),
         })
+    }
+}
+
+/// A lookup table on an n-D rectilinear grid (n from 1 to 8); apply it to n expressions
+/// with [`InterpolantN::eval`].
+///
+/// The values are ordered with the first coordinate fastest (`values[i₀ + n₀·(i₁ + n₁·i₂)]`
+/// in 3-D, CasADi's column-major order). In the graph a lookup is a call of
+/// [`InterpolantN::function`] (1-D and 2-D tables have cheaper nodes of their own:
+/// [`Interpolant`], [`Interpolant2`]).
+/// ```
+/// use symx::{gradient, Expr, Function, InterpolantN};
+/// // f = x + 10y + 100z on {0,1}³ (x fastest): trilinear reproduces it.
+/// let values: Vec<f64> = (0..8).map(|k| ((k & 1) + 10 * (k >> 1 & 1) + 100 * (k >> 2)) as f64).collect();
+/// let g = [0.0, 1.0];
+/// let table = InterpolantN::linear(&[&g, &g, &g], &values).unwrap();
+/// let v = [Expr::sym("x"), Expr::sym("y"), Expr::sym("z")];
+/// let f = table.eval(&v).unwrap();
+/// let df = gradient(f, &v).unwrap();
+/// let fun = Function::new(&[&v], &[&[f], &df]).unwrap();
+/// assert_eq!(fun.call(&[&[0.5, 0.25, 0.5]]).unwrap(), vec![vec![53.0], vec![1.0, 10.0, 100.0]]);
+/// assert_eq!(table.value(&[1.0, 1.0, 0.0]).unwrap(), 11.0);
+/// ```
+#[derive(Clone, Debug)]
+pub struct InterpolantN {
+    table: Arc<Table>,
+    function: Function,
+}
+
+/// Most coordinates of an [`InterpolantN`] (the evaluation keeps them on the stack).
+const MAX_DIMS: usize = 8;
+
+impl InterpolantN {
+    /// Multilinear interpolation of `values` on the grid `grids[0] × grids[1] × …` (each
+    /// strictly increasing, at least two points); outside the grid the end cells'
+    /// polynomials extend.
+    pub fn linear(grids: &[&[f64]], values: &[f64]) -> Result<InterpolantN, SymxError> {
+        InterpolantN::fit(grids, values, 2, linear_fit, true)
+    }
+
+    /// The tensor-product cubic spline with not-a-knot end conditions (each axis at least
+    /// four points; CasADi's `'bspline'`); zero outside the grid.
+    pub fn bspline(grids: &[&[f64]], values: &[f64]) -> Result<InterpolantN, SymxError> {
+        InterpolantN::fit(grids, values, 4, not_a_knot_fit, false)
+    }
+
+    fn fit(
+        grids: &[&[f64]],
+        values: &[f64],
+        min_points: usize,
+        fit: Fit1,
+        extrapolate: bool,
+    ) -> Result<InterpolantN, SymxError> {
+        if grids.is_empty() || grids.len() > MAX_DIMS {
+            return Err(SymxError::Table {
+                reason: format!("{} grid axes, 1 to {MAX_DIMS} supported", grids.len()),
+            });
+        }
+        for (k, grid) in grids.iter().enumerate() {
+            check_grid(&format!("grid {k}"), grid, min_points)?;
+        }
+        check_values(values, grids.iter().map(|g| g.len()).product())?;
+        let table = Arc::new(Table::tensor(grids, values, fit, extrapolate));
+        Ok(InterpolantN {
+            function: Function::lookup(table.clone()),
+            table,
+        })
+    }
+
+    /// Number of coordinates.
+    pub fn dims(&self) -> usize {
+        self.table.dims()
+    }
+
+    /// The table applied to `dims()` expressions (a call of [`InterpolantN::function`],
+    /// folded to a constant when all are constants); `Err` for another count.
+    pub fn eval(&self, x: &[Expr]) -> Result<Expr, SymxError> {
+        let values: Option<Vec<f64>> = x.iter().map(|e| e.value()).collect();
+        if let (Some(v), true) = (values, x.len() == self.dims()) {
+            return Ok(Expr::constant(self.table.eval(&v)));
+        }
+        Ok(self.function.apply(&[x])?[0][0])
+    }
+
+    /// The table's value at a point of `dims()` coordinates; `Err` for another count.
+    pub fn value(&self, x: &[f64]) -> Result<f64, SymxError> {
+        if x.len() != self.dims() {
+            return Err(SymxError::Length {
+                what: "interpolant point",
+                index: 0,
+                expected: self.dims(),
+                got: x.len(),
+            });
+        }
+        Ok(self.table.eval(x))
+    }
+
+    /// The table of the partial derivative along `axis`; `Err` if there is no such axis.
+    pub fn derivative(&self, axis: usize) -> Result<InterpolantN, SymxError> {
+        if axis >= self.dims() {
+            return Err(SymxError::Table {
+                reason: format!("axis {axis} of a {}-D table", self.dims()),
+            });
+        }
+        let table = Arc::new(self.table.derivative(axis));
+        Ok(InterpolantN {
+            function: Function::lookup(table.clone()),
+            table,
+        })
+    }
+
+    /// The lookup as a compiled function: one input of `dims()` entries, one output.
+    pub fn function(&self) -> &Function {
+        &self.function
+    }
+}
+
+impl Function {
+    /// The function `x ↦ table(x)` (input `x` of `table.dims()` entries), whose tape is one
+    /// [`Op::InterpolantN`] instruction: work vector `[x | y]`.
+    pub(crate) fn lookup(table: Arc<Table>) -> Function {
+        let n = table.dims();
+        Function {
+            name: format!("interpolant{n}d"),
+            input_names: vec!["x".into()],
+            output_names: vec!["y".into()],
+            uid: next_uid(),
+            input_sizes: vec![n],
+            output_sizes: vec![1],
+            input_offsets: vec![0],
+            input_used: vec![true],
+            output_offsets: vec![n],
+            tape: vec![Instr {
+                op: Op::InterpolantN,
+                d: n as u32,
+                a: 0,
+                b: n as u32,
+                c: 0,
+            }],
+            template: vec![0.0],
+            template_start: n,
+            work_size: n + 1,
+            tables: vec![table],
+            calls: Vec::new(),
+            call_scratch: n + 1,
+            dependencies: OnceLock::new(),
+            jacobians: Default::default(),
+        }
+    }
+
+    /// The table of a lookup function ([`Function::lookup`]).
+    pub(crate) fn lookup_table(&self) -> Option<&Arc<Table>> {
+        match self.tape.as_slice() {
+            [Instr {
+                op: Op::InterpolantN,
+                ..
+            }] => self.tables.first(),
+            _ => None,
+        }
     }
 }
 

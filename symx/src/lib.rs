@@ -45,7 +45,7 @@ pub use error::SymxError;
 pub use expr::{and, eq, ge, gt, if_else, le, logsumexp, lt, ne, not, or, Expr};
 pub use function::Function;
 pub use graph::{node_count, with_fresh_arena};
-pub use interpolant::{Interpolant, Interpolant2};
+pub use interpolant::{Interpolant, Interpolant2, InterpolantN};
 pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
 pub use op::Op;
