@@ -97,6 +97,15 @@ impl Table {
     /// The table's value at `x` (`dims()` coordinates).
     #[inline]
     pub fn eval(&self, x: &[f64]) -> f64 {
+        if let ([g], [x0]) = (self.grids.as_slice(), x) {
+            // 1-D, the common case, without the loop over axes.
+            let n = g.len();
+            if !self.extrapolate && (*x0 < g[0] || *x0 > g[n - 1]) {
+                return 0.0;
+            }
+            let i = g[1..n - 1].partition_point(|&p| p <= *x0);
+            return horner(&self.coeffs[4 * i..4 * i + 4], &[x0 - g[i]]);
+        }
         const MAX: usize = 8;
         let mut t = [0.0; MAX];
         let (mut cell, mut stride) = (0, 1);
