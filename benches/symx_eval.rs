@@ -27,9 +27,15 @@
 //! benches/reference/ocp_chain_casadi.py does the same with CasADi SX (inlined). Graph
 //! sizes (nodes) and tape sizes are printed first: the memory comparison.
 //!
+//! For the ocp groups criterion times only the evaluations; the set-up phases are printed
+//! as medians of 3 runs (`{group} setup_ms {…}`), the statistic of the CasADi
+//! script. `SYMX_OCP_MEMORY=inlined|calls|none` makes the binary build one version once and
+//! exit, for peak-memory measurement (see `memory_run`). benches/reference/ocp_compare.sh
+//! runs both sides and prints the ratios.
+//!
 //! `map` (`cargo bench --bench symx_eval -- map`): 10 000 evaluations of the RK4 step F
 //! with `Function::map`, serial and on 2 threads.
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::{criterion_group, BenchmarkId, Criterion, SamplingMode};
 use gap_crossing::model::{self, Formulation, Model};
 use gap_crossing::scenario::Scenario;
 use gap_crossing::{gait, terrain::GapTerrain};
@@ -186,7 +192,8 @@ fn checksums(name: &str, f: &Function, ins: &[&[f64]]) {
     );
 }
 
-/// (median of medians, minimum) of single-call wall times in µs.
+/// (median of medians, minimum) of single-call wall times in µs: 7 repetitions of 300
+/// calls (fewer, at least 10, when 300 would take over 0.3 s).
 fn per_call(f: &Function, ins: &[&[f64]]) -> (f64, f64) {
     let mut out = vec![0.0; f.output_sizes()[0]];
     let mut work = vec![0.0; f.work_size()];
@@ -196,8 +203,11 @@ fn per_call(f: &Function, ins: &[&[f64]]) -> (f64, f64) {
     };
     let mut medians = Vec::new();
     let mut min = f64::INFINITY;
+    let t = Instant::now();
+    f.eval(ins, &mut [&mut out], &mut work).unwrap();
+    let calls = ((0.3 / t.elapsed().as_secs_f64()) as usize).clamp(10, 300);
     for _ in 0..7 {
-        let mut times: Vec<f64> = (0..300)
+        let mut times: Vec<f64> = (0..calls)
             .map(|_| {
                 let t = Instant::now();
                 f.eval(black_box(ins), &mut [&mut out], &mut work).unwrap();
@@ -211,16 +221,61 @@ fn per_call(f: &Function, ins: &[&[f64]]) -> (f64, f64) {
     (median(&mut medians), min)
 }
 
-/// Prints checksums and per-call medians, then runs the criterion groups
-/// `{group}/setup` (phases of `setup`, named by `build_name` for the first) and
-/// `{group}/eval` for one problem.
+/// How [`measure`] times the set-up.
+struct SetupBench<'a> {
+    /// Name of the first phase (building the expressions).
+    build_name: &'a str,
+    /// Criterion's measurement time for each set-up benchmark.
+    time: Duration,
+    /// Whether criterion times the phases too (six benchmarks of ≥ 10 samples, each
+    /// re-running the whole set-up); if not, the printed medians of 3 runs are the figures.
+    criterion: bool,
+}
+
+/// Runs the set-up `reps` times and prints the median of each phase and of the total
+/// (ms), the statistic of the CasADi scripts (median over their repetitions), on one line
+/// `{group} setup_ms {json}` that benches/reference/ocp_compare.sh reads.
+fn print_setup_medians(
+    group: &str,
+    names: &[&str],
+    reps: usize,
+    setup: &impl Fn() -> [Duration; 5],
+) {
+    let runs: Vec<[Duration; 5]> = (0..reps).map(|_| setup()).collect();
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let mut fields: Vec<String> = (0..5)
+        .map(|k| {
+            format!(
+                "\"{}\": {:.3}",
+                names[k],
+                median(runs.iter().map(|r| ms(r[k])).collect())
+            )
+        })
+        .collect();
+    let total = median(
+        runs.iter()
+            .map(|r| r.iter().copied().map(ms).sum())
+            .collect(),
+    );
+    fields.push(format!("\"total\": {total:.3}"));
+    eprintln!(
+        "{group} setup_ms {{{}}} (median of {reps})",
+        fields.join(", ")
+    );
+}
+
+/// Prints checksums, per-call medians and set-up phase medians, then runs the criterion
+/// groups `{group}/setup` and `{group}/eval` for one problem.
 fn measure(
     c: &mut Criterion,
     group: &str,
     fns: &Compiled,
     hess_in: [&[f64]; 3],
-    build_name: &str,
-    setup_time: Duration,
+    setup_bench: SetupBench,
     setup: impl Fn() -> [Duration; 5],
 ) {
     let functions = [
@@ -236,21 +291,36 @@ fn measure(
     // shared machine, unlike a mean over batches).
     for (name, f, ins) in functions {
         let (median, min) = per_call(f, ins);
-        eprintln!("{name:7} per-call median {median:8.3} us  min {min:8.3} us");
+        eprintln!("{group} {name:7} per-call median {median:8.3} us  min {min:8.3} us");
     }
-
-    let mut g = c.benchmark_group(format!("{group}/setup"));
-    g.sample_size(10)
-        .measurement_time(setup_time)
-        .warm_up_time(Duration::from_millis(500));
     let names = [
-        build_name,
+        setup_bench.build_name,
         "grad_f",
         "jac_g",
         "hess_L",
         "functions",
         "total",
     ];
+    print_setup_medians(group, &names, 3, &setup);
+    if setup_bench.criterion {
+        setup_criterion(c, group, &names, setup_bench.time, &setup);
+    }
+    eval_criterion(c, group, &functions);
+}
+
+/// The criterion group `{group}/setup`: one benchmark per phase and one for the total.
+fn setup_criterion(
+    c: &mut Criterion,
+    group: &str,
+    names: &[&str; 6],
+    time: Duration,
+    setup: &impl Fn() -> [Duration; 5],
+) {
+    let mut g = c.benchmark_group(format!("{group}/setup"));
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .measurement_time(time)
+        .warm_up_time(Duration::from_millis(500));
     for (k, name) in names.iter().enumerate() {
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter_custom(|iters| {
@@ -268,12 +338,15 @@ fn measure(
         });
     }
     g.finish();
+}
 
+/// The criterion group `{group}/eval`: one call of each function.
+fn eval_criterion(c: &mut Criterion, group: &str, functions: &[(&str, &Function, &[&[f64]]); 3]) {
     let mut g = c.benchmark_group(format!("{group}/eval"));
     g.sample_size(20)
         .measurement_time(Duration::from_secs(3))
         .warm_up_time(Duration::from_secs(1));
-    for (name, f, ins) in functions {
+    for &(name, f, ins) in functions {
         let mut out = vec![0.0; f.output_sizes()[0]];
         let mut work = vec![0.0; f.work_size()];
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
@@ -286,7 +359,27 @@ fn measure(
     g.finish();
 }
 
+/// Whether the benchmarks named in `ids` (space-separated) pass the command line's filter
+/// (criterion's filter is a regular expression searched in a benchmark's id; here its
+/// `|`-separated alternatives are taken as plain substrings, enough for `ocp_chain|map`):
+/// the printed figures, which criterion does not filter, are computed only for the
+/// selected groups.
+fn selected(ids: &str) -> bool {
+    let filters: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    filters.is_empty()
+        || filters
+            .iter()
+            .flat_map(|f| f.split('|'))
+            .any(|f| ids.contains(f))
+}
+
 fn bench(c: &mut Criterion) {
+    if !selected("symx_eval/setup/expr symx_eval/eval/hess_L") {
+        return;
+    }
     let (p, x0) = chain(LINKS);
     let fns = compile(&differentiate(p));
     let (x, sigma, lambda) = inputs(LINKS, &x0);
@@ -295,13 +388,19 @@ fn bench(c: &mut Criterion) {
         "symx_eval",
         &fns,
         [&x, &sigma, &lambda],
-        "expr",
-        Duration::from_secs(3),
+        SetupBench {
+            build_name: "expr",
+            time: Duration::from_secs(3),
+            criterion: true,
+        },
         || setup_phases(|| chain(LINKS).0),
     );
 }
 
 fn bench_gap(c: &mut Criterion) {
+    if !selected("symx_eval_gap/setup/build symx_eval_gap/eval/hess_L") {
+        return;
+    }
     let s = gap_scenario();
     let m = gap_model(&s);
     let sym = gap_symbolic(&m);
@@ -322,8 +421,11 @@ fn bench_gap(c: &mut Criterion) {
         "symx_eval_gap",
         &fns,
         [&x, &sigma, &lambda],
-        "build",
-        Duration::from_secs(5),
+        SetupBench {
+            build_name: "build",
+            time: Duration::from_secs(5),
+            criterion: true,
+        },
         || {
             let s = s.clone();
             setup_phases(move || gap_symbolic(&gap_model(&s)))
@@ -331,10 +433,17 @@ fn bench_gap(c: &mut Criterion) {
     );
 }
 
-const OCP_STAGES: usize = 1000;
+/// Stages of the ocp_chain problem: 1000 (issue 13's size), or `SYMX_OCP_STAGES` from
+/// the environment (a quick check of benches/reference/ocp_compare.sh at a small size).
+fn ocp_stages() -> usize {
+    std::env::var("SYMX_OCP_STAGES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1000)
+}
 
 fn ocp_symbolic(calls: bool) -> Symbolic {
-    let o = quadrotor_ocp::build(OCP_STAGES, calls);
+    let o = quadrotor_ocp::build(ocp_stages(), calls);
     Symbolic {
         f: o.f,
         g: o.g,
@@ -344,6 +453,9 @@ fn ocp_symbolic(calls: bool) -> Symbolic {
 
 fn bench_ocp(c: &mut Criterion) {
     for (calls, group) in [(false, "ocp_chain_inlined"), (true, "ocp_chain_calls")] {
+        if !selected(&format!("{group}/eval/hess_L")) {
+            continue;
+        }
         // Built on a fresh thread so that the node count is this problem's alone.
         let (fns, nodes) = std::thread::spawn(move || {
             let fns = compile(&differentiate(ocp_symbolic(calls)));
@@ -352,21 +464,30 @@ fn bench_ocp(c: &mut Criterion) {
         .join()
         .unwrap();
         eprintln!("{group}: graph after build + derivatives + compile: {nodes} nodes");
-        let m = (OCP_STAGES + 1) * quadrotor_ocp::NX;
-        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(OCP_STAGES));
+        let m = (ocp_stages() + 1) * quadrotor_ocp::NX;
+        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(ocp_stages()));
         measure(
             c,
             group,
             &fns,
             [&x, &sigma, &lambda],
-            "build",
-            Duration::from_secs(20),
+            // Not criterion here: its ≥ 10 samples of the ~12 s inlined set-up per phase
+            // took ~15 min; the printed medians of 3 runs are the figures (as the CasADi
+            // script's median of 3).
+            SetupBench {
+                build_name: "build",
+                time: Duration::from_secs(5),
+                criterion: false,
+            },
             move || setup_phases(move || ocp_symbolic(calls)),
         );
     }
 }
 
 fn bench_map(c: &mut Criterion) {
+    if !selected("map/rk4_step_10000/1") {
+        return;
+    }
     const COPIES: usize = 10_000;
     let f = quadrotor_ocp::step_function();
     let (nx, nu) = (quadrotor_ocp::NX, quadrotor_ocp::NU);
@@ -397,4 +518,37 @@ fn bench_map(c: &mut Criterion) {
 }
 
 criterion_group!(benches, bench, bench_gap, bench_ocp, bench_map);
-criterion_main!(benches);
+
+/// With `SYMX_OCP_MEMORY=inlined | calls | none` in the environment the binary builds,
+/// differentiates and compiles the `ocp_chain` problem once (or, for `none`, nothing),
+/// prints the sizes and exits without benchmarking: run under `/usr/bin/time -v`, its
+/// maximum resident set is the peak memory of one set-up (`none`: the binary's baseline).
+/// benches/reference/ocp_compare.sh does this.
+fn memory_run(mode: &str) {
+    let calls = match mode {
+        "inlined" => false,
+        "calls" => true,
+        "none" => return,
+        other => {
+            eprintln!("SYMX_OCP_MEMORY={other}: expected inlined, calls or none");
+            std::process::exit(2);
+        }
+    };
+    let fns = compile(&differentiate(ocp_symbolic(calls)));
+    eprintln!(
+        "ocp_chain {mode}: {} graph nodes; instructions grad_f {} jac_g {} hess_L {}",
+        symx::node_count(),
+        fns.grad.instruction_count(),
+        fns.jac.instruction_count(),
+        fns.hess.instruction_count()
+    );
+}
+
+fn main() {
+    if let Ok(mode) = std::env::var("SYMX_OCP_MEMORY") {
+        memory_run(&mode);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

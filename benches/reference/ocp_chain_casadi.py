@@ -2,16 +2,25 @@
 benches/common/quadrotor_ocp.rs (12 states, 4 controls, N stages, one RK4 step per stage,
 multiple shooting), built as SX (the RK4 step inlined at every stage, as SX does), then
 grad f, jac g, the lower triangle of the Lagrangian Hessian with symbolic sigma and lambda,
-and the three Functions. Prints a JSON line with the median times (ms) over `reps` runs and
-checksums of the three functions at the bench's point with sigma = 1, lambda_i = (i+1)/m.
+and the three Functions. Prints a JSON line with the median times (ms) over `reps` runs,
+checksums of the three functions at the bench's point with sigma = 1, lambda_i = (i+1)/m,
+and their evaluation times: CasADi's own `record_time` wall time of single calls (SX
+virtual machine, no Python), median over up to 300 calls, median of 7 repetitions (the
+statistic of the Rust bench's `per-call median`), with the SX instruction counts.
 
 Run: python3 benches/reference/ocp_chain_casadi.py [N=1000] [reps=3]
+     python3 benches/reference/ocp_chain_casadi.py N memory   (one set-up, then exit: for
+     peak memory with /usr/bin/time -v; benches/reference/ocp_compare.sh does this)
 """
 import json
+import os
 import sys
 import time
 
 import casadi as ca
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from eval_timing import internal_times  # noqa: E402
 
 NX, NU, H = 12, 4, 0.02
 MASS, GRAVITY, ARM, YAW_COEF, DRAG = 1.0, 9.81, 0.2, 0.05, 0.1
@@ -87,8 +96,26 @@ def run(n):
     return [1e3 * (b - a) for a, b in zip(t, t[1:])], (fg, fj, fh, g.numel())
 
 
+def eval_times(fns, ins):
+    """Per-call internal times (us) and instruction counts of the three functions."""
+    out = {}
+    for name, f in fns.items():
+        timed = ca.Function(name + "_timed", f.sx_in(), f.call(f.sx_in()), {"record_time": True})
+        args = ins[: f.n_in()]
+        t = time.perf_counter()
+        timed(*args)
+        calls = max(10, min(300, int(0.3 / max(time.perf_counter() - t, 1e-9))))
+        med, mn, _ = internal_times(timed, args, 7, calls)
+        out[name] = {"internal_us": med * 1e6, "internal_us_min": mn * 1e6,
+                     "instructions": f.n_instructions(), "work": f.sz_w()}
+    return out
+
+
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
+    if len(sys.argv) > 2 and sys.argv[2] == "memory":
+        run(n)
+        sys.exit(0)
     reps = int(sys.argv[2]) if len(sys.argv) > 2 else 3
     runs = [run(n) for _ in range(reps)]
     med = lambda xs: sorted(xs)[len(xs) // 2]
@@ -103,5 +130,7 @@ if __name__ == "__main__":
         "jac_g": float(ca.sum1(ca.sum2(fj(x)))),
         "hess_L": float(ca.sum1(ca.sum2(fh(x, 1.0, lam)))),
     }
+    ins = [ca.DM(x), ca.DM(1.0), ca.DM(lam)]
+    evals = eval_times({"grad_f": fg, "jac_g": fj, "hess_L": fh}, ins)
     print(json.dumps({"N": n, "reps": reps, "median_ms": times, "checksum": sums,
-                      "hess_nnz": fh.sparsity_out(0).nnz()}))
+                      "hess_nnz": fh.sparsity_out(0).nnz(), "eval": evals}))

@@ -205,8 +205,12 @@ fn partial(g: &mut Graph, y: u32, k: usize) -> u32 {
         }
         Op::Hypot => g.binary(Op::Div, if k == 0 { a } else { b }, y),
         Op::Interpolant => {
-            let d = g.derivative_table(b);
+            let d = g.derivative_table(b, 0);
             g.interpolant(a, d)
+        }
+        Op::Interpolant2 => {
+            let d = g.derivative_table(n.args[2], k);
+            g.interpolant2(a, b, d)
         }
         Op::Add => ONE,
         Op::Sub => {

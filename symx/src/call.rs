@@ -159,18 +159,27 @@ impl Function {
     }
 }
 
+/// Fresh symbols for `f`'s input entries (stacked).
+fn input_symbols(g: &mut Graph, f: &Function) -> Vec<u32> {
+    let mut inputs = Vec::new();
+    for (k, &n) in f.input_sizes.iter().enumerate() {
+        for i in 0..n {
+            inputs.push(g.symbol(&format!("{}.{}[{i}]", f.name, f.input_names[k])));
+        }
+    }
+    inputs
+}
+
 /// Rebuilds `f`'s computation in `g` on fresh symbols: the input symbols (stacked) and the
 /// output nodes (stacked).
 fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
     const UNSET: u32 = u32::MAX;
     let mut reg = vec![UNSET; f.work_size];
-    let mut inputs = Vec::new();
-    for (k, (&n, &at)) in f.input_sizes.iter().zip(&f.input_offsets).enumerate() {
-        for i in 0..n {
-            let s = g.symbol(&format!("{}.{}[{i}]", f.name, f.input_names[k]));
-            reg[at + i] = s;
-            inputs.push(s);
-        }
+    let inputs = input_symbols(g, f);
+    let mut p = 0;
+    for (&n, &at) in f.input_sizes.iter().zip(&f.input_offsets) {
+        reg[at..at + n].copy_from_slice(&inputs[p..p + n]);
+        p += n;
     }
     for (i, &v) in f.template.iter().enumerate() {
         reg[f.template_start + i] = g.constant(v);
@@ -192,7 +201,12 @@ fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
                 let t = g.table_id(&f.tables[c]);
                 g.interpolant(reg[a], t)
             }
+            Op::Interpolant2 => {
+                let t = g.table_id(&f.tables[c]);
+                g.interpolant2(reg[a], reg[b], t)
+            }
             Op::IfElse => g.if_else(reg[a], reg[b], reg[c]),
+            Op::InterpolantN => unreachable!("lookup functions are differentiated by their tables"),
             op if op.arity() == 1 => g.unary(op, reg[a]),
             op => g.binary(op, reg[a], reg[b]),
         };
@@ -218,11 +232,27 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
     if let Some(j) = cache(f).get(wrt) {
         return j.clone();
     }
-    let (inputs, outputs) = instantiate(g, f);
+    // A lookup function (`InterpolantN`) has no graph form: its partial derivatives are
+    // calls of the lookup functions of its derivative tables.
+    let lookup = f.lookup_table().cloned();
+    let (inputs, outputs) = match lookup {
+        Some(_) => (input_symbols(g, f), Vec::new()),
+        None => instantiate(g, f),
+    };
     let columns: Vec<usize> = (0..inputs.len()).filter(|&j| wrt[j]).collect();
     let wrt_syms: Vec<u32> = columns.iter().map(|&j| inputs[j]).collect();
-    let entries = crate::ad::jacobian_rows(g, &outputs, &wrt_syms, false);
-    let (n_in, n_out) = (inputs.len(), outputs.len());
+    let entries = match &lookup {
+        Some(table) => columns
+            .iter()
+            .enumerate()
+            .map(|(c, &j)| {
+                let d = g.function_arc(&Function::lookup(Arc::new(table.derivative(j))));
+                (0, c, g.call(&d, inputs.clone())[0])
+            })
+            .collect(),
+        None => crate::ad::jacobian_rows(g, &outputs, &wrt_syms, false),
+    };
+    let (n_in, n_out) = (inputs.len(), f.output_sizes.iter().sum());
     let mut by_input = vec![Vec::new(); n_in];
     let mut by_output = vec![Vec::new(); n_out];
     for (nz, &(k, c, _)) in entries.iter().enumerate() {
@@ -249,10 +279,14 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
         .map(|k| g.symbol(&format!("{}.adj[{k}]", f.name)))
         .collect();
     let mut xbar = vec![Expr::zero(); n_in];
-    for (&j, d) in columns
-        .iter()
-        .zip(crate::ad::guarded_vjp(g, &outputs, &wrt_syms, &ybar))
-    {
+    let vjp = match lookup {
+        Some(_) => entries
+            .iter()
+            .map(|e| g.binary(Op::StrongMul, ybar[0], e.2))
+            .collect(),
+        None => crate::ad::guarded_vjp(g, &outputs, &wrt_syms, &ybar),
+    };
+    for (&j, d) in columns.iter().zip(vjp) {
         xbar[j] = Expr::from_id(d);
     }
     let ybar: Vec<Expr> = ybar.into_iter().map(Expr::from_id).collect();

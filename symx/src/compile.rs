@@ -5,8 +5,8 @@ use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::function::{next_uid, Function, Instr};
 use crate::graph::Graph;
-use crate::interpolant::Table;
 use crate::op::Op;
+use crate::table::Table;
 use rustc_hash::FxHashMap;
 use std::sync::{Arc, OnceLock};
 
@@ -388,6 +388,8 @@ fn allocate(
         };
         let c = if node.op == Op::Interpolant {
             ext.table(g, node.args[1])
+        } else if node.op == Op::Interpolant2 {
+            ext.table(g, node.args[2])
         } else if arity == 3 {
             regs[2]
         } else {

@@ -121,6 +121,15 @@ fn write_tree(
                 tasks.push(Task::Text(")"));
                 tasks.push(Task::Node(n.args[0]));
             }
+            Op::Interpolant2 => {
+                write!(out, "interpolant#{}(", n.args[2])?;
+                tasks.extend([
+                    Task::Text(")"),
+                    Task::Node(n.args[1]),
+                    Task::Text(","),
+                    Task::Node(n.args[0]),
+                ]);
+            }
             Op::Neg => {
                 out.write_str("(-")?;
                 tasks.push(Task::Text(")"));

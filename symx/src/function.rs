@@ -28,15 +28,16 @@ use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::graph;
-use crate::interpolant::Table;
 use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
+use crate::table::Table;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// One tape instruction: `w[d] = op(w[a], w[b], w[c])`; unary operations ignore `b`
 /// (set to `a`), only `if_else` reads `c`. [`Op::Sym`] is reused as the copy `w[d] = w[a]`;
-/// for [`Op::Interpolant`], `c` is the index of the table in [`Function`]'s own list; for
+/// for [`Op::Interpolant`] and [`Op::Interpolant2`], `c` is the index of the table in [`Function`]'s own list
+/// ([`Op::InterpolantN`] also, reading the `b` registers from `a`, `b` < the work size); for
 /// [`Op::Call`], `d` is the index of the call in [`Function`]'s list and `a = b = c = 0`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Instr {
@@ -91,6 +92,13 @@ pub struct Function {
     /// The Jacobian functions used to differentiate calls of this function, by the set
     /// of input entries differentiated (built on first use; shared by clones).
     pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
+}
+
+/// The output slices as raw pointers, for [`Function::run`]: `&mut [f64]` and
+/// `*mut [f64]` have the same layout, and no reference to the slices' contents is made,
+/// so threads may write disjoint points through them.
+pub(crate) fn output_pointers(outputs: &mut [&mut [f64]]) -> *const *mut [f64] {
+    outputs.as_mut_ptr().cast::<*mut [f64]>()
 }
 
 /// A fresh function identity.
@@ -294,8 +302,9 @@ impl Function {
         work: &mut [f64],
     ) -> Result<(), SymxError> {
         self.check(inputs, outputs, work, 1)?;
+        let outs = output_pointers(outputs);
         // SAFETY: sizes checked above; the tape's indices were bounded at compilation.
-        unsafe { self.run(inputs, outputs, work, 0) };
+        unsafe { self.run(inputs, outs, work.as_mut_ptr(), 0) };
         Ok(())
     }
 
@@ -309,9 +318,10 @@ impl Function {
         points: usize,
     ) -> Result<(), SymxError> {
         self.check(inputs, outputs, work, points)?;
+        let outs = output_pointers(outputs);
         for p in 0..points {
             // SAFETY: sizes checked above for all points.
-            unsafe { self.run(inputs, outputs, work, p) };
+            unsafe { self.run(inputs, outs, work.as_mut_ptr(), p) };
         }
         Ok(())
     }
@@ -325,18 +335,21 @@ impl Function {
         Ok(out)
     }
 
+    /// Evaluates point `p`: reads `inputs`, writes output `k` at `outputs[k]` (see
+    /// [`output_pointers`]) and uses the work vector at `w`.
+    ///
     /// # Safety
-    /// `inputs`/`outputs` must hold `(p+1)·size` numbers per argument and `work` at least
-    /// `work_size` numbers (checked by [`Function::check`]).
+    /// `inputs` and the `n_outputs()` slices behind `outputs` must hold `(p+1)·size`
+    /// numbers per argument and `w` at least `work_size` numbers (checked by
+    /// [`Function::check`]); no other thread may access point `p` of the outputs or `w`.
     #[inline(always)]
-    unsafe fn run(
+    pub(crate) unsafe fn run(
         &self,
         inputs: &[&[f64]],
-        outputs: &mut [&mut [f64]],
-        work: &mut [f64],
+        outputs: *const *mut [f64],
+        w: *mut f64,
         p: usize,
     ) {
-        let w = work.as_mut_ptr();
         for (k, x) in inputs.iter().enumerate() {
             if *self.input_used.get_unchecked(k) {
                 let n = *self.input_sizes.get_unchecked(k);
@@ -345,10 +358,14 @@ impl Function {
             }
         }
         self.exec(w);
-        for (k, y) in outputs.iter_mut().enumerate() {
-            let n = *self.output_sizes.get_unchecked(k);
-            let at = *self.output_offsets.get_unchecked(k);
-            std::ptr::copy_nonoverlapping(w.add(at), y.as_mut_ptr().add(p * n), n);
+        for (k, (&n, &at)) in self
+            .output_sizes
+            .iter()
+            .zip(&self.output_offsets)
+            .enumerate()
+        {
+            let y = (*outputs.add(k)).cast::<f64>();
+            std::ptr::copy_nonoverlapping(w.add(at), y.add(p * n), n);
         }
     }
 
@@ -410,7 +427,16 @@ impl Function {
                 Op::Expm1 => a.exp_m1(),
                 Op::Fmod => a % b,
                 Op::Hypot => a.hypot(b),
-                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(a),
+                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(&[a]),
+                Op::Interpolant2 => self.tables.get_unchecked(ins.c as usize).eval(&[a, b]),
+                Op::InterpolantN => {
+                    self.tables
+                        .get_unchecked(ins.c as usize)
+                        .eval(std::slice::from_raw_parts(
+                            w.add(ins.a as usize),
+                            ins.b as usize,
+                        ))
+                }
                 Op::IfElse => {
                     if a != 0.0 {
                         b
@@ -533,6 +559,10 @@ impl Function {
                             .fold(0, |m, &j| m | bits[call.args[j as usize] as usize]);
                         bits[call.out as usize + q] = m;
                     }
+                }
+                Op::InterpolantN => {
+                    let (a, n) = (ins.a as usize, ins.b as usize);
+                    bits[ins.d as usize] = bits[a..a + n].iter().fold(0, |m, &b| m | b);
                 }
                 o if o.has_zero_derivative() => bits[ins.d as usize] = 0,
                 Op::IfElse => bits[ins.d as usize] = bits[ins.b as usize] | bits[ins.c as usize],

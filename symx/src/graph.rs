@@ -6,8 +6,8 @@
 //! already exist, ascending index order is a topological order of the whole graph; every
 //! traversal in this crate relies on that and none of them recurses.
 use crate::call::CallSite;
-use crate::interpolant::Table;
 use crate::op::Op;
+use crate::table::Table;
 use rustc_hash::FxHashMap;
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -64,8 +64,8 @@ pub(crate) struct Graph {
     /// Table number of each registered table, by address (the graph keeps the `Arc`, so an
     /// address is never reused while registered).
     table_index: FxHashMap<usize, u32>,
-    /// Table number of each table's derivative, once built.
-    table_derivative: Vec<Option<u32>>,
+    /// Table number of each table's partial derivatives (by axis), once built.
+    table_derivative: Vec<[Option<u32>; 2]>,
     /// Calls of compiled functions, by call number (`Call` nodes hold the number).
     pub calls: Vec<CallSite>,
     /// Call number of each (function, argument nodes) pair: identical calls are one call.
@@ -137,31 +137,45 @@ impl Graph {
         }
         let t = self.tables.len() as u32;
         self.tables.push(table.clone());
-        self.table_derivative.push(None);
+        self.table_derivative.push([None; 2]);
         self.table_index.insert(key, t);
         t
     }
 
-    /// The number of the derivative of table `t`, built once.
-    pub fn derivative_table(&mut self, t: u32) -> u32 {
-        if let Some(d) = self.table_derivative[t as usize] {
+    /// The number of the partial derivative of table `t` along `axis`, built once.
+    pub fn derivative_table(&mut self, t: u32, axis: usize) -> u32 {
+        if let Some(d) = self.table_derivative[t as usize][axis] {
             return d;
         }
-        let d = Arc::new(self.tables[t as usize].derivative());
+        let d = Arc::new(self.tables[t as usize].derivative(axis));
         let d = self.table_id(&d);
-        self.table_derivative[t as usize] = Some(d);
+        self.table_derivative[t as usize][axis] = Some(d);
         d
     }
 
-    /// `table_t(x)`: a lookup node (folded when `x` is a constant).
+    /// `table_t(x)`: a 1-D lookup node (folded when `x` is a constant).
     pub fn interpolant(&mut self, x: u32, t: u32) -> u32 {
+        debug_assert_eq!(self.tables[t as usize].dims(), 1);
         if let Some(v) = self.value(x) {
-            let y = self.tables[t as usize].eval(v);
+            let y = self.tables[t as usize].eval(&[v]);
             return self.constant(y);
         }
         self.intern(Node {
             op: Op::Interpolant,
             args: [x, t, 0],
+        })
+    }
+
+    /// `table_t(x, y)`: a 2-D lookup node (folded when `x` and `y` are constants).
+    pub fn interpolant2(&mut self, x: u32, y: u32, t: u32) -> u32 {
+        debug_assert_eq!(self.tables[t as usize].dims(), 2);
+        if let (Some(u), Some(v)) = (self.value(x), self.value(y)) {
+            let z = self.tables[t as usize].eval(&[u, v]);
+            return self.constant(z);
+        }
+        self.intern(Node {
+            op: Op::Interpolant2,
+            args: [x, y, t],
         })
     }
 
@@ -199,6 +213,53 @@ impl Graph {
     pub fn len(&self) -> usize {
         self.nodes.len()
     }
+}
+
+/// Runs `f` with a new, empty expression graph on this thread, then drops that graph
+/// (releasing its memory) and restores the one that was current before, also when `f`
+/// panics. Scopes nest.
+///
+/// The graph only grows while a program builds expressions; a long-running program that
+/// builds many models one after the other wraps each build in a scope, keeps the compiled
+/// [`crate::Function`]s (they hold no reference to any graph) and lets the rest go.
+///
+/// The rule that keeps it sound: an [`crate::Expr`] belongs to the graph it was made in.
+/// The bounds make crossing the scope impossible by construction: `f` must be `Send`, so
+/// it cannot capture an `Expr` (or a `Matrix`, or a reference to one) from outside, and
+/// the result must be `Send`, so no `Expr` comes out. (What the bounds cannot see is an
+/// `Expr` smuggled through a `thread_local!` or a global of the caller's own: don't.)
+///
+/// ```
+/// use symx::{node_count, with_fresh_arena, Expr, Function};
+/// let before = node_count();
+/// let f = with_fresh_arena(|| {
+///     let x = Expr::sym("x");
+///     Function::new(&[&[x]], &[&[x.sin() * x]]).unwrap()
+/// });
+/// assert_eq!(node_count(), before); // the scope's nodes are gone...
+/// assert_eq!(f.call(&[&[2.0]]).unwrap()[0][0], 2.0f64.sin() * 2.0); // ...its function works
+/// ```
+/// An `Expr` from outside cannot be used inside, nor one from inside outside:
+/// ```compile_fail
+/// let x = symx::Expr::sym("x");
+/// symx::with_fresh_arena(|| symx::Function::new(&[&[x]], &[&[x.sin()]]).unwrap());
+/// ```
+/// ```compile_fail
+/// let y = symx::with_fresh_arena(|| symx::Expr::sym("y"));
+/// ```
+pub fn with_fresh_arena<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    /// Puts the outer graph back when the scope ends, normally or by unwinding.
+    struct Restore(Option<Graph>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            if let Some(outer) = self.0.take() {
+                let inner = with(|g| std::mem::replace(g, outer));
+                drop(inner);
+            }
+        }
+    }
+    let _restore = Restore(Some(with(|g| std::mem::replace(g, Graph::new()))));
+    f()
 }
 
 /// Number of nodes in this thread's graph (a measure of memory use).

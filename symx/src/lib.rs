@@ -18,7 +18,8 @@
 //! ```
 //!
 //! Expressions live in a graph owned by the current thread; a compiled [`Function`] is
-//! independent of it and can be shared across threads.
+//! independent of it and can be shared across threads. [`with_fresh_arena`] runs a
+//! build in a graph of its own and frees it afterwards.
 mod ad;
 mod assemble;
 mod call;
@@ -35,14 +36,16 @@ mod matrix;
 mod op;
 mod simplify;
 pub mod sparsity;
+mod table;
+mod team;
 
 pub use ad::{forward, gradient, hessian, jacobian, lagrangian_hessian, reverse};
 pub use display::parse;
 pub use error::SymxError;
 pub use expr::{and, eq, ge, gt, if_else, le, logsumexp, lt, ne, not, or, Expr};
 pub use function::Function;
-pub use graph::node_count;
-pub use interpolant::Interpolant;
+pub use graph::{node_count, with_fresh_arena};
+pub use interpolant::{Interpolant, Interpolant2, InterpolantN};
 pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
 pub use op::Op;

@@ -72,6 +72,13 @@ pub enum Op {
     /// A lookup table (see [`crate::Interpolant`]) applied to the operand; the node also
     /// records which table, so it prints as `interpolant#k(x)` and does not parse back.
     Interpolant,
+    /// A 2-D lookup table (see [`crate::Interpolant2`]) applied to the two operands; the
+    /// third slot records which table; prints as `interpolant#k(x,y)`, does not parse back.
+    Interpolant2,
+    /// A lookup table of any dimension: only the instruction of the compiled function an
+    /// [`crate::InterpolantN`] calls (its operands are `b` consecutive registers from `a`),
+    /// never a graph node.
+    InterpolantN,
     /// A call of a compiled [`crate::Function`] (see [`crate::Function::apply`]); its
     /// operands (the argument entries) live in the graph's call table, so `arity` is 0.
     /// It has no value of its own: its outputs are `CallOutput` nodes.
@@ -85,12 +92,12 @@ impl Op {
     pub fn arity(self) -> usize {
         use Op::*;
         match self {
-            Const | Sym | Call => 0,
+            Const | Sym | Call | InterpolantN => 0,
             Neg | Sq | Sqrt | Exp | Log | Sin | Cos | Tan | Asin | Acos | Atan | Sinh | Cosh
             | Tanh | Abs | Sign | Not | Floor | Ceil | Erf | Asinh | Acosh | Atanh | Log1p
             | Expm1 | Interpolant | CallOutput => 1,
             Add | Sub | Mul | Div | Pow | Atan2 | Min | Max | Lt | Le | Eq | Ne | And | Or
-            | StrongMul | Fmod | Hypot => 2,
+            | StrongMul | Fmod | Hypot | Interpolant2 => 2,
             IfElse => 3,
         }
     }
@@ -224,7 +231,7 @@ impl Op {
             Expm1 => "expm1",
             Fmod => "fmod",
             Hypot => "hypot",
-            Interpolant => "interpolant",
+            Interpolant | Interpolant2 | InterpolantN => "interpolant",
             Call => "call",
             CallOutput => "call_output",
         }

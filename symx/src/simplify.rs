@@ -46,6 +46,11 @@ impl Graph {
     /// Creates `op(a, b)`, simplified.
     pub fn binary(&mut self, op: Op, a: u32, b: u32) -> u32 {
         debug_assert_eq!(op.arity(), 2);
+        debug_assert_ne!(
+            op,
+            Op::Interpolant2,
+            "lookups are built by Graph::interpolant2"
+        );
         let (va, vb) = (self.value(a), self.value(b));
         if let (Some(x), Some(y)) = (va, vb) {
             return self.constant(op.eval2(x, y));

@@ -1,4 +1,4 @@
-//! `Function::map`: many points, serial or over rayon tasks; the results must be
+//! `Function::map`: many points, serial or over threads; the results must be
 //! bit-identical to `eval_batch` (the same tape on the same numbers) for any split.
 use symx::{Function, Matrix, SymxError};
 
@@ -75,4 +75,47 @@ fn compiled_objects_are_send_and_sync() {
     assert_send_sync::<Function>();
     assert_send_sync::<symx::Map>();
     assert_send_sync::<symx::Interpolant>();
+}
+
+/// One map (with its worker threads) shared by several calling threads at once: runs are
+/// serialised inside the map and every caller gets the serial results; fewer points than
+/// threads and no points at all work too.
+#[test]
+fn one_parallel_map_serves_concurrent_callers_and_small_sizes() {
+    let f = function();
+    let n = 300;
+    let xs: Vec<f64> = (0..3 * n).map(|i| (i as f64 * 0.11).cos()).collect();
+    let ps: Vec<f64> = (0..n).map(|i| i as f64 * 0.01).collect();
+    let (mut y_ref, mut z_ref) = (vec![0.0; 3 * n], vec![0.0; n]);
+    let mut work = vec![0.0; f.work_size()];
+    f.eval_batch(&[&xs, &ps], &mut [&mut y_ref, &mut z_ref], &mut work, n)
+        .unwrap();
+    let map = f.map(n).parallel(3).unwrap();
+    assert_eq!(map.threads(), 3);
+    std::thread::scope(|s| {
+        for _ in 0..4 {
+            s.spawn(|| {
+                let (mut y, mut z) = (vec![0.0; 3 * n], vec![0.0; n]);
+                let mut work = vec![0.0; map.work_size()];
+                for _ in 0..20 {
+                    map.eval(&[&xs, &ps], &mut [&mut y, &mut z], &mut work)
+                        .unwrap();
+                    assert!(y == y_ref && z == z_ref);
+                }
+            });
+        }
+    });
+    let small = f.map(2).parallel(8).unwrap();
+    assert_eq!(small.threads(), 2);
+    let (mut y, mut z) = (vec![0.0; 6], vec![0.0; 2]);
+    let mut work = vec![0.0; small.work_size()];
+    small
+        .eval(&[&xs[..6], &ps[..2]], &mut [&mut y, &mut z], &mut work)
+        .unwrap();
+    assert!(y[..] == y_ref[..6] && z[..] == z_ref[..2]);
+    let empty = f.map(0).parallel(4).unwrap();
+    let mut work = vec![0.0; empty.work_size()];
+    empty
+        .eval(&[&[], &[]], &mut [&mut [], &mut []], &mut work)
+        .unwrap();
 }
