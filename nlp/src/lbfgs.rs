@@ -73,6 +73,8 @@ pub(crate) enum UpdateKind {
     Updated,
     /// The pair was rejected; B is unchanged.
     Skipped,
+    /// The point is the previous one: nothing to do.
+    Unchanged,
 }
 
 /// The stored pairs, σ and the compact representation of B.
@@ -129,6 +131,7 @@ impl LimitedMemory {
     }
 
     /// Number of stored pairs.
+    #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.s.len()
     }
@@ -161,6 +164,12 @@ impl LimitedMemory {
             return UpdateKind::Reset;
         };
         let n = self.n;
+        if x == &last.x[..] {
+            // The same point evaluated again (the core re-evaluates after its initial
+            // least-squares multipliers): not a new iterate, so no pair and no skip
+            // (IPOPT updates once per iteration).
+            return UpdateKind::Unchanged;
+        }
         let s: Vec<f64> = (0..n).map(|j| x[j] - last.x[j]).collect();
         // y = ∇f₊ − ∇f + (J₊ − J)ᵀ λ₊.
         jac_t_times(pat, jac, lambda, &mut self.jty);
@@ -192,7 +201,8 @@ impl LimitedMemory {
     fn accept(&self, s: &[f64], y: &[f64]) -> bool {
         let tol = f64::EPSILON.sqrt();
         let s_max = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        if !(s_max >= 100.0 * f64::EPSILON) || y.iter().any(|v| !v.is_finite()) {
+        let finite = s_max.is_finite() && y.iter().all(|v| v.is_finite());
+        if !finite || s_max < 100.0 * f64::EPSILON {
             return false;
         }
         match self.set.update {

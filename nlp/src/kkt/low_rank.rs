@@ -17,7 +17,7 @@
 
 use faer::{Mat, Side};
 
-use super::{inf_norm, Inertia, Kkt, KktError};
+use super::{inf_norm, Inertia, Kkt, KktError, REFINEMENT_FLOOR};
 
 /// Eigenvalues below this × the largest magnitude in their matrix count as zero (the
 /// small matrices are formed from sums of products of O(n) vectors, so their entries
@@ -148,6 +148,7 @@ impl LowRankTerm {
     }
 
     /// σ of B₀ = σI.
+    #[cfg(test)]
     pub(crate) fn sigma(&self) -> f64 {
         self.sigma
     }
@@ -360,9 +361,14 @@ impl LowRankKkt {
                 }
                 break;
             }
+            // Keep refining past the target while a step still gains a lot, as
+            // `Kkt::solve_shifted` does (a backward error at the target can leave the
+            // small entries of x far off on an ill-conditioned K).
+            let fast = new_ratio <= 0.5 * ratio;
             ratio = new_ratio;
-            if (steps >= kkt.min_refinement_steps && ratio <= kkt.residual_ratio_max)
-                || steps >= kkt.max_refinement_steps
+            let converged = ratio <= kkt.residual_ratio_max
+                && (ratio <= REFINEMENT_FLOOR || (steps > 0 && !fast));
+            if (steps >= kkt.min_refinement_steps && converged) || steps >= kkt.max_refinement_steps
             {
                 break;
             }

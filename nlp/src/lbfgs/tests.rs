@@ -214,9 +214,15 @@ fn curvature_test_skips_and_repeated_skips_reset() {
         mem.update(&x2, &[5.0, 5.0, 5.0], &[], &pat, &[]),
         UpdateKind::Skipped
     );
-    // No step.
+    // The same point again: no pair, and not a skip.
     assert_eq!(
         mem.update(&x2, &[5.0, 5.0, 5.0], &[], &pat, &[]),
+        UpdateKind::Unchanged
+    );
+    // A step below 100ε.
+    let x3 = [1e-15, 0.0, 0.0];
+    assert_eq!(
+        mem.update(&x3, &[5.0, 5.0, 5.0], &[], &pat, &[]),
         UpdateKind::Skipped
     );
     assert_eq!(mem.len(), 1);
