@@ -27,6 +27,9 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use thiserror::Error;
 
+mod low_rank;
+pub(crate) use low_rank::{LowRankKkt, LowRankTerm};
+
 /// Numbers of positive, negative and zero eigenvalues.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Inertia {
@@ -480,6 +483,43 @@ impl Kkt {
                 *yi += si * xi;
             }
         }
+    }
+
+    /// y = (K + diag(shift)) x in the original (unpermuted) ordering, K the matrix of the
+    /// last [`Kkt::factorize`].
+    pub fn multiply(
+        &self,
+        x: &[f64],
+        shift: Option<&[f64]>,
+        y: &mut [f64],
+    ) -> Result<(), KktError> {
+        let dim = self.dim();
+        for (what, len) in [("x", x.len()), ("y", y.len())] {
+            if len != dim {
+                return Err(KktError::Length {
+                    what,
+                    expected: dim,
+                    got: len,
+                });
+            }
+        }
+        match &self.simplicial {
+            Some(simp) => {
+                let px: Vec<f64> = simp.fwd.iter().map(|&o| x[o]).collect();
+                let mut py = vec![0.0; dim];
+                self.matvec(&px, None, &mut py);
+                for (&v, &o) in py.iter().zip(&simp.fwd) {
+                    y[o] = v;
+                }
+            }
+            None => self.matvec(x, None, y),
+        }
+        if let Some(s) = shift {
+            for ((yi, si), xi) in y.iter_mut().zip(s).zip(x) {
+                *yi += si * xi;
+            }
+        }
+        Ok(())
     }
 
     /// Solves K x = rhs in place with residual-checked iterative refinement.

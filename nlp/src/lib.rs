@@ -9,6 +9,7 @@ pub mod error;
 pub mod frontend;
 pub mod ipm;
 pub(crate) mod kkt;
+pub(crate) mod lbfgs;
 pub(crate) mod log;
 pub mod mpcc;
 pub mod numeric;
@@ -41,7 +42,10 @@ pub use mpcc::{
 pub use numeric::{AffineCone, NumericNlp};
 pub use ocp::{Horizon, Method, Ocp, OcpError, Trajectory};
 pub use option_names::{NamedOptions, OptionError};
-pub use options::{IpmOptions, MuOracle, MuStrategy, ScalingMethod};
+pub use options::{
+    IpmHessian, IpmOptions, LimitedMemoryInit, LimitedMemoryUpdate, MuOracle, MuStrategy,
+    ScalingMethod,
+};
 pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};

@@ -39,6 +39,43 @@ pub enum ScalingMethod {
     GradientBased,
 }
 
+/// Where the Hessian of the Lagrangian comes from (IPOPT `hessian_approximation`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IpmHessian {
+    /// The exact Hessian from [`NumericNlp::eval_hess_l`](crate::NumericNlp::eval_hess_l).
+    Exact,
+    /// A limited-memory quasi-Newton approximation built from gradients only
+    /// (`eval_hess_l` is never called; an empty Hessian pattern is fine).
+    LimitedMemory,
+}
+
+/// Quasi-Newton formula of the limited-memory Hessian (IPOPT `limited_memory_update_type`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LimitedMemoryUpdate {
+    /// BFGS, skipping pairs with sᵀy ≤ √ε‖s‖‖y‖ (positive definite approximation).
+    Bfgs,
+    /// Symmetric rank one (may be indefinite; the inertia correction handles that).
+    Sr1,
+}
+
+/// How σ of B₀ = σI is chosen after each update (IPOPT `limited_memory_initialization`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LimitedMemoryInit {
+    /// σ = sᵀy / sᵀs of the newest pair.
+    Scalar1,
+    /// σ = yᵀy / sᵀy of the newest pair.
+    Scalar2,
+    /// Arithmetic mean of scalar1 and scalar2.
+    Scalar3,
+    /// Geometric mean of scalar1 and scalar2.
+    Scalar4,
+    /// σ = `limited_memory_init_val` always.
+    Constant,
+}
+
 /// All options of the interior-point method.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(remote = "Self", default)]
@@ -206,6 +243,23 @@ pub struct IpmOptions {
     pub max_refinement_steps: usize,
     /// Target relative residual of the linear solves. Default 1e-10.
     pub residual_ratio_max: f64,
+    // ---------- Hessian ----------
+    /// Exact Hessian or limited-memory quasi-Newton approximation. Default exact.
+    pub hessian_approximation: IpmHessian,
+    /// Number of (s, y) pairs kept by the limited-memory approximation. Default 6.
+    pub limited_memory_max_history: usize,
+    /// Quasi-Newton formula (BFGS or SR1). Default BFGS.
+    pub limited_memory_update_type: LimitedMemoryUpdate,
+    /// Choice of σ in B₀ = σI. Default scalar1 (σ = sᵀy/sᵀs).
+    pub limited_memory_initialization: LimitedMemoryInit,
+    /// σ before the first update, and always with `constant`. Default 1.
+    pub limited_memory_init_val: f64,
+    /// Upper safeguard of σ. Default 1e8.
+    pub limited_memory_init_val_max: f64,
+    /// Lower safeguard of σ. Default 1e-8.
+    pub limited_memory_init_val_min: f64,
+    /// After this many successive skipped updates the memory is reset. Default 2.
+    pub limited_memory_max_skipping: usize,
     // ---------- restoration ----------
     /// κ_resto: required infeasibility reduction in restoration. Default 0.9.
     pub required_infeasibility_reduction: f64,
@@ -291,6 +345,14 @@ impl Default for IpmOptions {
             min_refinement_steps: 1,
             max_refinement_steps: 10,
             residual_ratio_max: 1e-10,
+            hessian_approximation: IpmHessian::Exact,
+            limited_memory_max_history: 6,
+            limited_memory_update_type: LimitedMemoryUpdate::Bfgs,
+            limited_memory_initialization: LimitedMemoryInit::Scalar1,
+            limited_memory_init_val: 1.0,
+            limited_memory_init_val_max: 1e8,
+            limited_memory_init_val_min: 1e-8,
+            limited_memory_max_skipping: 2,
             required_infeasibility_reduction: 0.9,
             resto_penalty_parameter: 1000.0,
             resto_proximity_weight: 1.0,
@@ -359,7 +421,10 @@ impl IpmOptions {
             resto_penalty_parameter,
             bound_mult_reset_threshold,
             residual_ratio_max,
-            kkt_static_regularization
+            kkt_static_regularization,
+            limited_memory_init_val,
+            limited_memory_init_val_max,
+            limited_memory_init_val_min
         );
         nonneg!(
             bound_push,
@@ -445,6 +510,15 @@ impl IpmOptions {
                 "min_refinement_steps",
                 "must not exceed max_refinement_steps",
             ));
+        }
+        if self.limited_memory_init_val_min > self.limited_memory_init_val_max {
+            return Err(bad(
+                "limited_memory_init_val_min",
+                "must not exceed limited_memory_init_val_max",
+            ));
+        }
+        if self.limited_memory_max_skipping == 0 {
+            return Err(bad("limited_memory_max_skipping", "must be >= 1"));
         }
         if !(self.nlp_scaling_max_value >= 1.0) {
             return Err(bad("nlp_scaling_max_value", "must be >= 1"));

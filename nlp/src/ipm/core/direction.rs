@@ -74,10 +74,7 @@ impl Core<'_> {
         // Refine against the system without the static regularisation.
         let t = Instant::now();
         self.kw.rhs_copy.copy_from_slice(&self.kw.rhs);
-        let mut res = self
-            .kw
-            .kkt
-            .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift));
+        let mut res = self.kw.solve_rhs();
         if self.pert.delta_c == 0.0 && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
             // The system without the static regularisation is (numerically) singular:
             // a rank-deficient Jacobian of the equality rows with inconsistent
@@ -103,10 +100,7 @@ impl Core<'_> {
             }
             let t = Instant::now();
             self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
-            res = self
-                .kw
-                .kkt
-                .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift));
+            res = self.kw.solve_rhs();
             shared.stats.factor_seconds += t.elapsed().as_secs_f64();
             let mut dw = self.pert.delta_w;
             while ok && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
@@ -124,10 +118,7 @@ impl Core<'_> {
                 self.pert.delta_w_last = dw;
                 let t = Instant::now();
                 self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
-                res = self
-                    .kw
-                    .kkt
-                    .solve_shifted(&mut self.kw.rhs, Some(&self.kw.shift));
+                res = self.kw.solve_rhs();
                 shared.stats.factor_seconds += t.elapsed().as_secs_f64();
             }
         } else {

@@ -99,6 +99,11 @@ impl Core<'_> {
         if !all_finite(&self.trial.jac) {
             return false;
         }
+        if let Some(lm) = self.kw.lm.as_mut() {
+            let (g, j, pat) = (&self.trial.grad, &self.trial.jac, self.nlp.jac_g_sparsity());
+            lm.update(x, g, j, pat, &self.trial.y);
+            return true; // the Hessian values stay 0: W = the low-rank approximation
+        }
         self.nlp
             .eval_hess_l(x, 1.0, &self.trial.y, &mut self.trial.hess);
         all_finite(&self.trial.hess)
@@ -175,6 +180,11 @@ impl Core<'_> {
     pub(super) fn eval_hessian(&mut self, at: At) -> Result<(), CoreError> {
         let n = self.lay.n;
         let x = &self.it.w[..n];
+        if let Some(lm) = self.kw.lm.as_mut() {
+            let (g, j, pat) = (&self.it.grad, &self.it.jac, self.nlp.jac_g_sparsity());
+            lm.update(x, g, j, pat, &self.it.y);
+            return Ok(()); // the Hessian values stay 0: W = the low-rank approximation
+        }
         self.nlp.eval_hess_l(x, 1.0, &self.it.y, &mut self.it.hess);
         if let Some(p) = first_non_finite(&self.it.hess) {
             let pat = self.nlp.hess_l_sparsity();

@@ -34,6 +34,18 @@ pub(super) struct KktWork {
     pub(super) hess_diag: Vec<usize>,
     pub(super) hzero: Vec<f64>,
     pub(super) work_nw: Vec<f64>,
+    /// The limited-memory Hessian (`hessian_approximation = limited-memory`).
+    pub(super) lm: Option<crate::lbfgs::LimitedMemoryHessian>,
+}
+
+impl KktWork {
+    /// Solves the factorised system for `rhs` in place (refined against K + diag(shift)).
+    pub(super) fn solve_rhs(&mut self) -> Result<f64, crate::kkt::KktError> {
+        match self.lm.as_mut() {
+            Some(lm) => lm.solve_shifted(&mut self.kkt, &mut self.rhs, Some(&self.shift)),
+            None => self.kkt.solve_shifted(&mut self.rhs, Some(&self.shift)),
+        }
+    }
 }
 
 impl Core<'_> {
@@ -177,10 +189,11 @@ impl Core<'_> {
             };
         }
         let t = Instant::now();
-        let res = self
-            .kw
-            .kkt
-            .factorize(&self.it.hess, &self.kw.kdx, &self.it.jac, &self.kw.kdc);
+        let (h, dx, j, dc) = (&self.it.hess, &self.kw.kdx, &self.it.jac, &self.kw.kdc);
+        let res = match self.kw.lm.as_mut() {
+            Some(lm) => lm.factorize(&mut self.kw.kkt, h, dx, j, dc),
+            None => self.kw.kkt.factorize(h, dx, j, dc),
+        };
         shared.stats.factor_seconds += t.elapsed().as_secs_f64();
         shared.stats.n_factorizations += 1;
         res

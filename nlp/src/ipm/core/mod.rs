@@ -324,6 +324,7 @@ impl<'p> Core<'p> {
                 hess_diag,
                 hzero: vec![0.0; nnz_h],
                 work_nw: vec![0.0; nw],
+                lm: crate::lbfgs::LimitedMemoryHessian::from_options(opts, n),
             },
             pert: Perturbation::default(),
             count: Counters::default(),
