@@ -21,6 +21,10 @@ pub struct Diagnosis {
     pub regularized: usize,
     /// Largest δ_w.
     pub max_regularization: f64,
+    /// Steps whose equality rows carried the Jacobian regularisation δ_c > 0.
+    pub jacobian_regularized: usize,
+    /// First iteration with δ_c > 0.
+    pub first_jacobian_regularized: Option<usize>,
     /// f-type steps (IPOPT's 'f'/'F').
     pub f_steps: usize,
     /// h-type steps ('h'/'H').
@@ -53,6 +57,10 @@ pub fn diagnose(sol: &Solution) -> Diagnosis {
         if r.regularization > 0.0 {
             d.regularized += 1;
             d.max_regularization = d.max_regularization.max(r.regularization);
+        }
+        if r.jacobian_regularization > 0.0 {
+            d.jacobian_regularized += 1;
+            d.first_jacobian_regularized.get_or_insert(r.iter);
         }
         match r.alpha_pr_char {
             'f' => d.f_steps += 1,
