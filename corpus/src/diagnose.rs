@@ -33,6 +33,8 @@ pub struct Diagnosis {
     pub soc_steps: usize,
     /// Backtracking trials, summed.
     pub line_search_trials: usize,
+    /// Objective (unscaled) at the last iteration.
+    pub final_objective: f64,
     /// μ at the last iteration.
     pub final_mu: f64,
     /// Primal infeasibility at the last iteration.
@@ -78,6 +80,7 @@ pub fn diagnose(sol: &Solution) -> Diagnosis {
         d.line_search_trials += r.ls;
     }
     if let Some(last) = sol.stats.records.last() {
+        d.final_objective = last.objective;
         d.final_mu = last.mu;
         d.final_inf_pr = last.inf_pr;
         d.final_inf_du = last.inf_du;
