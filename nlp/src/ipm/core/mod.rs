@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use crate::callback::Observer;
 use crate::frontend::{KktResiduals, Termination};
-use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, probing_mu, tau};
+use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, mu_floor_adaptive, probing_mu, tau};
 use crate::ipm::error::{At, CoreError};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
@@ -538,7 +538,7 @@ impl<'p> Core<'p> {
                         let (_, eu) = self.errors(0.0, false);
                         self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
                         if self.count.tiny_count >= 2
-                            && self.mu <= mu_floor(&self.opts) * (1.0 + 1e-12)
+                            && self.mu <= mu_floor(&self.opts, self.obj_scale) * (1.0 + 1e-12)
                         {
                             return self.outcome(Status::SearchDirectionBecomesTooSmall, "", false);
                         }
