@@ -42,7 +42,11 @@ fn check(strategy: MuStrategy) {
     assert!(sol.x[0].abs() < 1e-8 + 1e-12, "x = {}", sol.x[0]);
     // f* = 1e8 at x = 0; the bound is relaxed to −1e-8 (bound_relax_factor), where
     // f = 1e8·(1 − 1e-8)² ≈ 1e8 − 2: allow that, plus 1e-6 relative.
-    assert!((sol.objective - 1e8).abs() < 2.0 + 1e2, "f = {}", sol.objective);
+    assert!(
+        (sol.objective - 1e8).abs() < 2.0 + 1e2,
+        "f = {}",
+        sol.objective
+    );
     // (SolveSucceeded already says that the unscaled complementarity, measured to the
     // relaxed bound, is ≤ compl_inf_tol; `sol.compl` is measured to the original bound
     // 0, 1e-8 away, where it is 1e-8·2e8 = 2.)
