@@ -245,3 +245,31 @@ fn tiny_alpha_run_leads_to_restoration() {
     assert!(forced(&on) > 0 && runs(&on).1 > 0);
     assert_ne!(on.status, nlp::Status::MaximumIterationsExceeded);
 }
+
+/// IPOPT's soft restoration phase (`soft_resto_pderror_reduction_factor` = 1 − 1e-4,
+/// IPOPT's default; off by default in symnlp because chain_800 then fails): on
+/// rocket_trap_400 the line search fails near feasibility at iteration 11 and the soft
+/// steps avoid the 28 restoration iterations and the ~100 steps of α ≈ 5e-4 that follow
+/// them without it (183 iterations). Bound: 2× IPOPT's 27 (corpus.jsonl).
+#[test]
+fn rocket_with_soft_restoration_within_twice_ipopt() {
+    let inst = corpus::instance("rocket_trap_400").expect("instance exists");
+    let mut o = run::options(120.0);
+    o.soft_resto_pderror_reduction_factor = 1.0 - 1e-4;
+    let out = run::solve(&inst, &o).expect("solves");
+    assert!(out.success, "{}", out.status);
+    let f_ipopt = -1.0128352213043499_f64;
+    assert!(
+        (out.objective - f_ipopt) / f_ipopt.abs() < 1e-6,
+        "{}",
+        out.objective
+    );
+    assert!(out.iterations <= 54, "{} iterations", out.iterations);
+    // The default (no soft restoration) takes far more on this instance.
+    let plain = run::solve(&inst, &run::options(120.0)).expect("solves");
+    assert!(
+        plain.iterations > 2 * out.iterations,
+        "{}",
+        plain.iterations
+    );
+}

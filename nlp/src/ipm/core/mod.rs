@@ -29,6 +29,7 @@ mod line_search;
 mod measures;
 mod mu;
 mod perturbation;
+mod soft_resto;
 
 use direction::Direction;
 pub(crate) use iterate::Iterate;
@@ -117,6 +118,10 @@ struct Counters {
     resto_calls: usize,
     /// Accepted steps in a row with α_pr < `tiny_alpha`.
     tiny_alpha_run: usize,
+    /// In IPOPT's soft restoration phase: the number of its iterations so far.
+    soft_resto: Option<usize>,
+    /// The filter already holds the current point (a soft restoration was tried).
+    filter_has_current: bool,
 }
 
 /// The interior-point iteration: its named parts and the barrier and filter state.
@@ -508,6 +513,7 @@ impl<'p> Core<'p> {
         loop {
             // Why the restoration phase below starts (or, where it cannot, the solve ends).
             let mut why = "line search failed";
+            self.count.filter_has_current = false;
             let e0 = match self.stop_test(shared, max_resto_iter_end) {
                 Ok(e0) => e0,
                 Err(out) => return out,
@@ -534,6 +540,7 @@ impl<'p> Core<'p> {
                         && inf_norm(&self.dir.dy)
                             < self.opts.tiny_step_y_tol * (1.0 + inf_norm(&self.it.y));
                     if tiny && self.take_full_step() {
+                        self.count.soft_resto = None;
                         self.count.tiny_count += 1;
                         let (_, eu) = self.errors(0.0, false);
                         self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
@@ -545,7 +552,7 @@ impl<'p> Core<'p> {
                         continue;
                     }
                     self.count.tiny_count = 0;
-                    match self.line_search(shared) {
+                    match self.search_step(shared) {
                         LineSearch::Accepted {
                             alpha_pr,
                             alpha_du,
@@ -614,15 +621,19 @@ impl<'p> Core<'p> {
             // The restoration phase's first row takes the next iteration number (IPOPT's
             // count: the iteration whose line search failed is that row).
             shared.iter += 1;
-            // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9).
-            let theta = one_norm(&self.it.c);
-            let phi = self.barrier(&self.it.w, self.it.f, self.mu);
-            self.filter.add(
-                (1.0 - self.opts.gamma_theta) * theta,
-                phi - self.opts.gamma_phi * theta,
-            );
+            // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9)
+            // unless the soft restoration attempt did.
+            if !std::mem::take(&mut self.count.filter_has_current) {
+                let theta = one_norm(&self.it.c);
+                let phi = self.barrier(&self.it.w, self.it.f, self.mu);
+                self.filter.add(
+                    (1.0 - self.opts.gamma_theta) * theta,
+                    phi - self.opts.gamma_phi * theta,
+                );
+            }
             match restoration::restore(self, shared) {
                 Ok(()) => {
+                    self.count.soft_resto = None;
                     self.pert.delta_w_last = 0.0;
                     self.count.tiny_count = 0;
                     continue;
