@@ -21,6 +21,10 @@ pub struct Diagnosis {
     pub regularized: usize,
     /// Largest δ_w.
     pub max_regularization: f64,
+    /// Steps whose equality rows carried the Jacobian regularisation δ_c > 0.
+    pub jacobian_regularized: usize,
+    /// First iteration with δ_c > 0.
+    pub first_jacobian_regularized: Option<usize>,
     /// f-type steps (IPOPT's 'f'/'F').
     pub f_steps: usize,
     /// h-type steps ('h'/'H').
@@ -29,6 +33,8 @@ pub struct Diagnosis {
     pub soc_steps: usize,
     /// Backtracking trials, summed.
     pub line_search_trials: usize,
+    /// Objective (unscaled) at the last iteration.
+    pub final_objective: f64,
     /// μ at the last iteration.
     pub final_mu: f64,
     /// Primal infeasibility at the last iteration.
@@ -54,6 +60,10 @@ pub fn diagnose(sol: &Solution) -> Diagnosis {
             d.regularized += 1;
             d.max_regularization = d.max_regularization.max(r.regularization);
         }
+        if r.jacobian_regularization > 0.0 {
+            d.jacobian_regularized += 1;
+            d.first_jacobian_regularized.get_or_insert(r.iter);
+        }
         match r.alpha_pr_char {
             'f' => d.f_steps += 1,
             'F' => {
@@ -70,6 +80,7 @@ pub fn diagnose(sol: &Solution) -> Diagnosis {
         d.line_search_trials += r.ls;
     }
     if let Some(last) = sol.stats.records.last() {
+        d.final_objective = last.objective;
         d.final_mu = last.mu;
         d.final_inf_pr = last.inf_pr;
         d.final_inf_du = last.inf_du;

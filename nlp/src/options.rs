@@ -203,6 +203,28 @@ pub struct IpmOptions {
     pub tiny_step_tol: f64,
     /// Dual step size below which a tiny step ends the run. Default 1e-2.
     pub tiny_step_y_tol: f64,
+    /// IPOPT's soft restoration phase (nlp/src/ipm/core/soft_resto.rs): when the line
+    /// search fails, the step with equal primal and dual step sizes is taken if it
+    /// reduces the primal-dual system error to this factor of its current value (or is
+    /// acceptable to the filter). 0 disables it. Default **0** (IPOPT: 1 − 1e-4): with
+    /// IPOPT's value the rocket takes 46 / 83 / 78 iterations instead of 183 / 96 / 166
+    /// (IPOPT 27 / 26 / 34), but chain_800 ends in RestorationFailed (101 iterations
+    /// without; IPOPT 698) and the HS total goes from 944 to 952 (docs/performance.md,
+    /// "Step regularisation: the decision").
+    pub soft_resto_pderror_reduction_factor: f64,
+    /// Most iterations in a row of the soft restoration phase. Default 10 (IPOPT's).
+    pub max_soft_resto_iters: usize,
+    /// Primal step size α_pr below which an accepted step counts toward
+    /// `tiny_alpha_max_iter`. Default 1e-8. Not an IPOPT option (see there).
+    pub tiny_alpha: f64,
+    /// After this many accepted steps in a row with α_pr < `tiny_alpha`, the next
+    /// iteration is treated as a failed line search: the restoration phase starts (in
+    /// restoration: `RestorationFailed`; without constraints:
+    /// `SearchDirectionBecomesTooSmall`, or `SolvedToAcceptableLevel` at an acceptable
+    /// point). 0 disables. Default 10 (IPOPT's `watchdog_shortened_iter_trigger`: IPOPT
+    /// leaves such a run of shortened steps by its watchdog, which symnlp does not have;
+    /// without this rule catenary_999 took 1159 steps with α_pr < 1e-8 at μ = 0.1).
+    pub tiny_alpha_max_iter: usize,
     // ---------- linear algebra / inertia correction ----------
     /// δ_w^0: first Hessian perturbation. Default 1e-4.
     pub first_hessian_perturbation: f64,
@@ -331,6 +353,10 @@ impl Default for IpmOptions {
             kappa_sigma: 1e10,
             tiny_step_tol: 10.0 * f64::EPSILON,
             tiny_step_y_tol: 1e-2,
+            soft_resto_pderror_reduction_factor: 0.0,
+            max_soft_resto_iters: 10,
+            tiny_alpha: 1e-8,
+            tiny_alpha_max_iter: 10,
             first_hessian_perturbation: 1e-4,
             min_hessian_perturbation: 1e-20,
             max_hessian_perturbation: 1e40,
@@ -437,6 +463,8 @@ impl IpmOptions {
             constr_mult_reset_threshold,
             tiny_step_tol,
             tiny_step_y_tol,
+            tiny_alpha,
+            soft_resto_pderror_reduction_factor,
             kappa_d,
             jacobian_regularization_value,
             jacobian_regularization_exponent,

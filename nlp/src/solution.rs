@@ -95,6 +95,11 @@ pub struct IterationRecord {
     pub d_norm: f64,
     /// Hessian regularisation δ_w used for the step (0: none; printed as lg(rg)).
     pub regularization: f64,
+    /// Jacobian regularisation δ_c of the equality rows used for the step (0: none; the
+    /// interior point's IPOPT perturbation, not printed in the table, as in IPOPT; the SQP
+    /// leaves it 0). Absent in records serialised before it existed (read as 0).
+    #[serde(default)]
+    pub jacobian_regularization: f64,
     /// Dual step size.
     pub alpha_du: f64,
     /// Primal step size.

@@ -787,6 +787,7 @@ mod tests {
             mu: 1e-6,
             d_norm: 1.0,
             regularization: 0.0,
+            jacobian_regularization: 0.0,
             alpha_du: 1.0,
             alpha_pr,
             alpha_pr_char: 'h',

@@ -454,6 +454,7 @@ impl Sqp {
             mu: 0.0,
             d_norm: 0.0,
             regularization: 0.0,
+            jacobian_regularization: 0.0,
             alpha_du: 0.0,
             alpha_pr: 0.0,
             alpha_pr_char: ' ',
@@ -823,6 +824,7 @@ impl Sqp {
                 mu: rho_a_last,
                 d_norm,
                 regularization: delta,
+                jacobian_regularization: 0.0,
                 alpha_du: alpha,
                 alpha_pr: alpha,
                 alpha_pr_char: if soc_used {

@@ -10,6 +10,7 @@
 use super::*;
 
 /// A primal-dual point with the problem's values there.
+#[derive(Clone)]
 pub(crate) struct Iterate {
     /// w = [x; s].
     pub(crate) w: Vec<f64>,

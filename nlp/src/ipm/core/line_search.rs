@@ -16,6 +16,9 @@ pub(super) enum StepKind {
     FType { soc: bool },
     /// h-type: the filter was augmented.
     HType { soc: bool },
+    /// A soft restoration step (IPOPT's 's'; 'S' when it is acceptable to the filter,
+    /// which ends the soft restoration phase).
+    Soft { original: bool },
 }
 
 impl StepKind {
@@ -33,6 +36,8 @@ impl StepKind {
             StepKind::HType { soc: false } => 'h',
             StepKind::FType { soc: true } => 'F',
             StepKind::HType { soc: true } => 'H',
+            StepKind::Soft { original: false } => 's',
+            StepKind::Soft { original: true } => 'S',
         }
     }
 }

@@ -25,6 +25,10 @@ pub(super) struct Perturbation {
     pub(super) singular_iters: usize,
     /// Iterations in a row that needed δ_w > 0.
     pub(super) perturbed_iters: usize,
+    /// A step was solved without δ_c: the Jacobian is not degenerate, and
+    /// `jac_degenerate` can no longer be set (IPOPT's PDPerturbationHandler decides
+    /// degeneracy once, in the first iterations: "Nj" in its info string).
+    pub(super) jac_determined: bool,
 }
 
 impl Perturbation {
