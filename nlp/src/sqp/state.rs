@@ -1,0 +1,476 @@
+//! The state of one SQP solve ([`SqpState`]) — problem shape, geometry, the iterate, the
+//! Hessian's convexification, the QP, the penalty and the counters — with its set-up and
+//! the steps of an iteration that are not the QP (`subproblem.rs`) or the line search
+//! (`line_search.rs`): the stop tests, the convexified Hessian, rejecting or accepting a
+//! step.
+
+#![allow(clippy::needless_range_loop)]
+
+use std::time::Instant;
+
+use faer::sparse::SymbolicSparseColMat;
+
+use super::bfgs::bfgs_update;
+use super::convexify::{active_sets, Convexify};
+use super::geometry::Geometry;
+use super::iterate::{Iterate, Mult};
+use super::line_search::{LineSearch, Trial};
+use super::options::{HessianApproximation, SqpOptions};
+use super::qp::{Qp, QpResult};
+use super::scaled::{Counters, Scaled};
+use super::stop::{StepError, Stop};
+use crate::callback::Observer;
+use crate::frontend::validate::Validated;
+use crate::frontend::{KktResiduals, Termination};
+use crate::kkt::Kkt;
+use crate::numeric::NumericNlp;
+use crate::scaling::gradient_scale;
+use crate::solution::{IterationRecord, Solution, Stats, Status};
+
+/// Sizes and sparsity patterns of the problem, fixed for the solve.
+pub(super) struct Shape {
+    pub n: usize,
+    pub m: usize,
+    /// Length of the stacked cone vector.
+    pub n_cone: usize,
+    pub jp: SymbolicSparseColMat<usize>,
+    pub hp: SymbolicSparseColMat<usize>,
+    /// Pattern of the cone Jacobian (rows: stacked cone entries).
+    pub cp: Option<SymbolicSparseColMat<usize>>,
+    /// (offset, dimension) of each cone in the stacked cone vector.
+    pub block: Vec<(usize, usize)>,
+    /// Dense damped BFGS instead of the exact Hessian.
+    pub dense: bool,
+}
+
+/// The Hessian term B of the QP and how it was convexified.
+pub(super) struct Curvature {
+    /// Lower-triangular ∇²L values.
+    pub hv: Vec<f64>,
+    /// Dense B, column-major (BFGS only; empty otherwise).
+    pub bfgs: Vec<f64>,
+    /// ρ_a on the active rows, 0 elsewhere.
+    pub row_weight: Vec<f64>,
+    /// ρ_a on the active bounds, 0 elsewhere.
+    pub bound_weight: Vec<f64>,
+    pub rho_a_last: f64,
+    pub delta_last: f64,
+    /// Proximal shift added after rejected or heavily cut steps.
+    pub extra_shift: f64,
+}
+
+/// Work counters for `Stats`.
+#[derive(Default)]
+pub(super) struct Work {
+    pub n_qp: usize,
+    pub qp_iterations: u64,
+    pub qp_seconds: f64,
+    pub factor_seconds: f64,
+    pub n_fact: usize,
+    pub n_polished: usize,
+}
+
+/// Everything one SQP solve carries from iteration to iteration.
+pub(super) struct SqpState<'a> {
+    pub o: &'a SqpOptions,
+    pub sc: Scaled<'a>,
+    pub shape: Shape,
+    pub geo: Geometry,
+    pub it: Iterate,
+    pub curv: Curvature,
+    /// KKT matrix for the convexity test and polishing (`None` with BFGS).
+    pub kkt: Option<Kkt>,
+    pub qp: Qp,
+    /// ℓ1 penalty ρ.
+    pub rho: f64,
+    /// Merit weights w_i.
+    pub merit_w: Vec<f64>,
+    pub work: Work,
+    pub stats: Stats,
+    /// The row of the iteration log being filled.
+    pub record: IterationRecord,
+    /// Consecutive rejected steps.
+    pub ls_failures: usize,
+    lgrad: Vec<f64>,
+}
+
+/// A new QP laid out for `shape` and `geo` (`aug`: with the augmented term).
+pub(super) fn new_qp(shape: &Shape, geo: &Geometry, o: &SqpOptions, aug: bool) -> Qp {
+    Qp::new(
+        &shape.hp,
+        &shape.jp,
+        &geo.x_l,
+        &geo.x_u,
+        &geo.g_l,
+        &geo.g_u,
+        &shape.block,
+        shape.cp.as_ref(),
+        &geo.cone_row,
+        aug,
+        shape.dense,
+        o.qp_tol,
+        o.qp_max_iter,
+    )
+}
+
+impl<'a> SqpState<'a> {
+    /// Lays out the solve, scales the problem at the (clamped) starting point and
+    /// evaluates it there; `warm` supplies the first multipliers.
+    pub fn new(
+        o: &'a SqpOptions,
+        nlp: &'a mut dyn NumericNlp,
+        v: Validated,
+        warm: Option<&Solution>,
+    ) -> Self {
+        let (n, m) = (nlp.n(), nlp.m());
+        let cones = nlp.affine_cones().to_vec();
+        let n_cone = cones.iter().map(|c| c.offset + c.dim).max().unwrap_or(0);
+        let mut cone_row = vec![false; m];
+        for c in &cones {
+            cone_row[c.row] = true;
+        }
+        let shape = Shape {
+            n,
+            m,
+            n_cone,
+            jp: nlp.jac_g_sparsity().clone(),
+            hp: nlp.hess_l_sparsity().clone(),
+            cp: nlp.cone_jac_sparsity().cloned(),
+            block: cones.iter().map(|c| (c.offset, c.dim)).collect(),
+            dense: o.hessian_approximation == HessianApproximation::DampedBfgs,
+        };
+        let mut geo = Geometry {
+            x_l: v.x_l,
+            x_u: v.x_u,
+            g_l: v.g_l,
+            g_u: v.g_u,
+            cone_row,
+            cones,
+        };
+        let mut x = v.x0;
+        for j in 0..n {
+            x[j] = x[j].clamp(geo.x_l[j], geo.x_u[j]);
+        }
+        let mut sc = Scaled {
+            nlp,
+            obj_scale: 1.0,
+            g_scale: vec![1.0; m],
+            counters: Counters::default(),
+        };
+        let mut grad = vec![0.0; n];
+        let mut jv = vec![0.0; shape.jp.row_idx().len()];
+        let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
+        // Gradient-based scaling at the starting point (IPOPT's rule).
+        if o.gradient_scaling {
+            sc.grad(&x, &mut grad);
+            let gmax = grad.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            sc.obj_scale =
+                gradient_scale(gmax, o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
+            sc.jac(&x, &mut jv, &mut cv);
+            let mut rmax = vec![0.0f64; m];
+            for (p, &r) in shape.jp.row_idx().iter().enumerate() {
+                rmax[r] = rmax[r].max(jv[p].abs());
+            }
+            for i in 0..m {
+                if !geo.cone_row[i] {
+                    sc.g_scale[i] = gradient_scale(
+                        rmax[i],
+                        o.nlp_scaling_max_gradient,
+                        o.nlp_scaling_min_value,
+                    );
+                }
+            }
+        }
+        for i in 0..m {
+            geo.g_l[i] *= sc.g_scale[i];
+            geo.g_u[i] *= sc.g_scale[i];
+        }
+        let stats = Stats {
+            obj_scaling: sc.obj_scale,
+            ..Stats::default()
+        };
+        let mut g = vec![0.0; m];
+        let mut cone = vec![0.0; n_cone];
+        let f = sc.f(&x);
+        sc.g(&x, &mut g, &mut cone);
+        sc.grad(&x, &mut grad);
+        sc.jac(&x, &mut jv, &mut cv);
+        let mut mult = Mult::zeros(n, m, n_cone);
+        if let Some(p) = warm {
+            for i in 0..m {
+                mult.lambda[i] = p.lambda[i] * sc.obj_scale / sc.g_scale[i];
+            }
+            for j in 0..n {
+                mult.z_l[j] = p.z_l[j] * sc.obj_scale;
+                mult.z_u[j] = p.z_u[j] * sc.obj_scale;
+            }
+        }
+        let curv = Curvature {
+            hv: vec![0.0; shape.hp.row_idx().len()],
+            bfgs: if shape.dense {
+                (0..n * n)
+                    .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+                    .collect()
+            } else {
+                vec![]
+            },
+            row_weight: vec![0.0; m],
+            bound_weight: vec![0.0; n],
+            rho_a_last: 0.0,
+            delta_last: 0.0,
+            extra_shift: 0.0,
+        };
+        let record = IterationRecord {
+            iter: 0,
+            restoration: false,
+            objective: f / sc.obj_scale,
+            inf_pr: 0.0,
+            inf_du: 0.0,
+            mu: 0.0,
+            d_norm: 0.0,
+            regularization: 0.0,
+            alpha_du: 0.0,
+            alpha_pr: 0.0,
+            alpha_pr_char: ' ',
+            ls: 0,
+        };
+        let qp = new_qp(&shape, &geo, o, false);
+        SqpState {
+            o,
+            sc,
+            it: Iterate {
+                x,
+                f,
+                g,
+                cone,
+                grad,
+                jv,
+                cv,
+                mult,
+                have_mult: warm.is_some(),
+            },
+            curv,
+            kkt: None,
+            qp,
+            rho: o.penalty_init,
+            merit_w: vec![0.0; m],
+            work: Work::default(),
+            stats,
+            record,
+            ls_failures: 0,
+            lgrad: vec![0.0; n],
+            shape,
+            geo,
+        }
+    }
+
+    /// Sets up the KKT matrix of the convexity test (not with BFGS).
+    pub fn setup_kkt(&mut self) -> Result<(), StepError> {
+        let s = &self.shape;
+        if !s.dense {
+            self.kkt = Some(Kkt::new(s.n, s.m, &s.hp, &s.jp)?);
+        }
+        Ok(())
+    }
+
+    /// Logs iteration `iter`, shows it to the callback and tests for convergence and the
+    /// other stop criteria; `Some` ends the solve.
+    pub fn check(
+        &mut self,
+        iter: usize,
+        termination: &mut Termination,
+        observer: Option<&mut Observer<'_>>,
+        start: Instant,
+    ) -> Option<Stop> {
+        let o = self.o;
+        let err = self
+            .it
+            .kkt_errors(o.s_max, &self.geo, &self.shape, &mut self.lgrad);
+        let os = self.sc.obj_scale;
+        let it = &self.it;
+        self.record.iter = iter;
+        self.record.objective = it.f / os;
+        self.record.inf_pr = err.inf_pr;
+        self.record.inf_du = err.inf_du;
+        self.stats.records.push(self.record);
+        if o.print_level >= 5 {
+            if iter % 10 == 0 {
+                println!("{}", crate::log::header());
+            }
+            println!("{}", crate::log::format_record(&self.record));
+        }
+        if let Some(obs) = observer {
+            let (l, sg, cones) = (&it.mult.lambda, &self.sc.g_scale, &self.geo.cones);
+            if obs.call_sqp(&self.record, &it.x, l, sg, os, cones, &it.mult.z_cone) {
+                return Some(Stop {
+                    status: Status::UserRequestedStop,
+                    message: "stopped by the iteration callback".into(),
+                });
+            }
+        }
+        let unscaled_pr = self
+            .geo
+            .unscaled_max(&self.sc.g_scale, &it.x, &it.g, &it.cone);
+        // Without multipliers (a cold start's iteration 0) the dual error is not
+        // measured: no test, and the streak of acceptable iterates restarts.
+        let residuals = KktResiduals {
+            overall: err.scaled,
+            dual: err.inf_du / os,
+            primal: unscaled_pr,
+            compl: err.compl / os,
+        };
+        if !it.have_mult {
+            *termination = Termination::default();
+            termination.set_last_objective(it.f);
+        } else if let Some(s) = termination.check(&residuals, it.f, &o.common) {
+            return Some(Stop::new(s));
+        }
+        let status = if iter >= o.max_iter {
+            Status::MaximumIterationsExceeded
+        } else if start.elapsed().as_secs_f64() > o.max_wall_time {
+            Status::MaximumWallTimeExceeded
+        } else if it.x.iter().any(|v| v.abs() > o.diverging_iterates_tol) {
+            Status::DivergingIterates
+        } else {
+            return None;
+        };
+        Some(Stop::new(status))
+    }
+
+    /// Evaluates ∇²L at the iterate and convexifies it ([`Convexify`]), setting the
+    /// augmented weights; returns the shift δ (0 with BFGS, whose B is positive definite).
+    pub fn convexify(&mut self) -> Result<f64, StepError> {
+        if self.shape.dense {
+            return Ok(0.0);
+        }
+        let (it, geo, curv) = (&self.it, &self.geo, &mut self.curv);
+        let lam: Vec<f64> = (0..self.shape.m)
+            .map(|i| {
+                if geo.cone_row[i] {
+                    0.0
+                } else {
+                    it.mult.lambda[i]
+                }
+            })
+            .collect();
+        self.sc.hess(&it.x, &lam, &mut curv.hv);
+        if curv.hv.iter().any(|v| !v.is_finite()) {
+            return Err(StepError::NonFiniteHessian);
+        }
+        let (active_r, active_b) = active_sets(geo, &it.x, &it.g, &it.mult);
+        let conv = Convexify {
+            kkt: self
+                .kkt
+                .as_mut()
+                .expect("the KKT matrix is set up before iterating"),
+            hv: &curv.hv,
+            jv: &it.jv,
+            active_r: &active_r,
+            active_b: &active_b,
+        };
+        let (delta, rho_a) = conv
+            .run(
+                self.o,
+                curv.delta_last,
+                curv.rho_a_last,
+                curv.extra_shift,
+                &mut self.work.n_fact,
+            )
+            .ok_or(StepError::NoConvexification)?;
+        curv.rho_a_last = rho_a;
+        for (w, &a) in curv.row_weight.iter_mut().zip(&active_r) {
+            *w = if a { rho_a } else { 0.0 };
+        }
+        for (w, &a) in curv.bound_weight.iter_mut().zip(&active_b) {
+            *w = if a { rho_a } else { 0.0 };
+        }
+        if rho_a > 0.0 && !self.qp.has_aug() {
+            self.qp = new_qp(&self.shape, geo, self.o, true);
+        }
+        curv.delta_last = delta;
+        Ok(delta)
+    }
+
+    /// After a failed line search: stops when the step is negligible or the searches keep
+    /// failing, otherwise shifts the next Hessian and keeps the QP's multipliers.
+    pub fn reject(&mut self, ls: &LineSearch, res: &QpResult, delta: f64) -> Option<Stop> {
+        self.ls_failures += 1;
+        let x = &self.it.x;
+        let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if ls.d_norm <= 1e-14 * (1.0 + x_max) || self.ls_failures > 8 {
+            let it = &self.it;
+            let pr = self.geo.unscaled_max(&self.sc.g_scale, x, &it.g, &it.cone);
+            let status = if pr > self.o.constr_viol_tol {
+                Status::InfeasibleProblemDetected
+            } else {
+                Status::SearchDirectionBecomesTooSmall
+            };
+            let (pred, d_norm) = (ls.pred, ls.d_norm);
+            return Some(Stop {
+                status,
+                message: format!("line search failed (pred = {pred:.3e}, ‖d‖ = {d_norm:.3e})"),
+            });
+        }
+        // Shorter, more conservative steps next time (a trust-region-like reaction).
+        let c = &mut self.curv;
+        c.extra_shift = (c.extra_shift * 10.0).max(1e-2 * (1.0 + delta));
+        // Multipliers of the QP are still the best estimate.
+        self.it.mult = Mult::from_qp(res);
+        self.it.have_mult = true;
+        None
+    }
+
+    /// Takes the accepted trial point: adapts the proximal shift to the step length,
+    /// evaluates the derivatives there and updates a BFGS matrix.
+    pub fn accept(&mut self, trial: Trial, ls: &LineSearch) -> Result<(), StepError> {
+        self.ls_failures = 0;
+        // Levenberg–Marquardt-like safeguard: a heavily cut step means the model is
+        // poor at this length, so the next step is shortened by a proximal shift;
+        // full steps relax it again.
+        let c = &mut self.curv;
+        if ls.alpha < 0.1 && !ls.soc_used {
+            c.extra_shift = (c.extra_shift * 10.0).max(1e-1);
+        } else if ls.alpha == 1.0 {
+            c.extra_shift = if c.extra_shift > 1e-6 {
+                c.extra_shift / 10.0
+            } else {
+                0.0
+            };
+        }
+        let it = &mut self.it;
+        let x_old = std::mem::replace(&mut it.x, trial.x);
+        it.f = trial.f;
+        it.g = trial.g;
+        it.cone = trial.cone;
+        it.mult = Mult::from_qp(&trial.res);
+        it.have_mult = true;
+        let grad_old = it.grad.clone();
+        let jv_old = it.jv.clone();
+        let cv_old = it.cv.clone();
+        self.sc.grad(&it.x, &mut it.grad);
+        self.sc.jac(&it.x, &mut it.jv, &mut it.cv);
+        if it.grad.iter().chain(&it.jv).any(|v| !v.is_finite()) {
+            return Err(StepError::NonFiniteDerivatives);
+        }
+        if self.shape.dense {
+            let s = &self.shape;
+            bfgs_update(
+                &mut self.curv.bfgs,
+                s.n,
+                &x_old,
+                &it.x,
+                &grad_old,
+                &jv_old,
+                &cv_old,
+                &it.grad,
+                &it.jv,
+                &it.cv,
+                &s.jp,
+                s.cp.as_ref(),
+                &it.mult,
+                &self.geo.cone_row,
+            );
+        }
+        Ok(())
+    }
+}
