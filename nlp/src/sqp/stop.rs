@@ -70,3 +70,23 @@ impl From<StepError> for Stop {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_kkt_setup_failure_names_its_cause() {
+        let stop = Stop::from(StepError::from(KktError::Symbolic("out of memory".into())));
+        assert_eq!(stop.status, Status::InternalError);
+        assert!(stop.message.contains("KKT matrix"), "{}", stop.message);
+        assert!(stop.message.contains("out of memory"), "{}", stop.message);
+        let stop = Stop::from(StepError::QpStatus(SolverStatus::InsufficientProgress));
+        assert_eq!(stop.status, Status::ErrorInStepComputation);
+        assert!(
+            stop.message.contains("InsufficientProgress"),
+            "{}",
+            stop.message
+        );
+    }
+}

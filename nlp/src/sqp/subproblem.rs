@@ -16,6 +16,14 @@ use super::state::{Curvature, SqpState};
 use super::stop::StepError;
 use crate::kkt::Kkt;
 
+/// Retry policies of one QP step, each with its own budget: how often an unbounded QP
+/// is solved again with a pure shift ×100, how often another clarabel failure is solved
+/// again with the shift ×10, and how often elastic mode raises ρ. (Before, one counter of
+/// all QP solves in the step served all three, with limits 8, 4 and 12 solves.)
+const MAX_UNBOUNDED_RETRIES: usize = 7;
+const MAX_FAILED_QP_RETRIES: usize = 3;
+const MAX_PENALTY_INCREASES: usize = 11;
+
 /// The QP data at iterate `it` with shift `shift` and penalty `rho`.
 fn qp_data<'d>(
     it: &'d Iterate,
@@ -54,7 +62,7 @@ impl SqpState<'_> {
         let t_qp_loop = Instant::now();
         let dense = self.shape.dense;
         let mut qp_shift = delta;
-        let mut tries = 0;
+        let (mut unbounded_retries, mut failed_retries, mut penalty_increases) = (0, 0, 0);
         let mut elastic_prev: Option<(QpResult, f64, f64)> = None;
         // The accepted QP's result and the data it was solved with (for polishing).
         let found: Result<(QpResult, QpData), StepError> = loop {
@@ -68,10 +76,12 @@ impl SqpState<'_> {
                 Err(e) => break Err(e.into()),
             };
             self.work.qp_iterations += res.iterations as u64;
-            tries += 1;
             match res.status {
                 S::Solved | S::AlmostSolved => {}
-                S::DualInfeasible | S::AlmostDualInfeasible if tries < 8 => {
+                S::DualInfeasible | S::AlmostDualInfeasible
+                    if unbounded_retries < MAX_UNBOUNDED_RETRIES =>
+                {
+                    unbounded_retries += 1;
                     // Unbounded QP: B too flat along a feasible direction (δ·I and
                     // ρ_a·J_AᵀJ_A certified by `Convexify` are positive definite,
                     // but a near-singular B may still read as unbounded to
@@ -81,7 +91,8 @@ impl SqpState<'_> {
                     qp_shift = (qp_shift * 100.0).max(o.first_hessian_shift);
                     continue;
                 }
-                _ if tries < 4 => {
+                _ if failed_retries < MAX_FAILED_QP_RETRIES => {
+                    failed_retries += 1;
                     qp_shift = (qp_shift * 10.0).max(o.first_hessian_shift);
                     continue;
                 }
@@ -101,7 +112,8 @@ impl SqpState<'_> {
                         break Ok((prev, data));
                     }
                 }
-                if self.rho < o.penalty_max && tries < 12 {
+                if self.rho < o.penalty_max && penalty_increases < MAX_PENALTY_INCREASES {
+                    penalty_increases += 1;
                     elastic_prev = Some((res, e_sum, self.rho));
                     self.rho = (self.rho * o.penalty_increase).min(o.penalty_max);
                     continue;
