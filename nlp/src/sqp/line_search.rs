@@ -10,7 +10,7 @@ use clarabel::solver::SolverStatus;
 
 use super::bfgs::quad;
 use super::qp::QpResult;
-use super::state::SqpState;
+use super::state::{eval_g, SqpState};
 
 /// An accepted trial point, evaluated (scaled), with the QP result that led to it.
 pub(super) struct Trial {
@@ -117,7 +117,7 @@ impl SqpState<'_> {
         let mut gt = vec![0.0; s.m];
         let mut ct = vec![0.0; s.n_cone];
         let ft = self.sc.f(&xt);
-        self.sc.g(&xt, &mut gt, &mut ct);
+        eval_g(&mut self.sc, &xt, &mut gt, &mut ct);
         (xt, ft, gt, ct)
     }
 

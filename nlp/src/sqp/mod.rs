@@ -36,21 +36,20 @@
 //! accepting or rejecting a step), `subproblem.rs` (the QP step with its retry policies
 //! and the elastic mode), `line_search.rs` (merit and line search), `convexify.rs`,
 //! `bfgs.rs`, `iterate.rs` (the iterate and its KKT error), `geometry.rs` (bounds,
-//! cones, violations), `qp.rs` (the clarabel subproblem), `polish.rs`, `scaled.rs`
-//! (scaling and counters), `finish.rs` (the unscaled solution), `stop.rs`.
+//! cones, violations), `qp.rs` (the clarabel subproblem), `polish.rs`, `stop.rs`.
+//! Scaling, evaluation counters and the returned `Solution` are the front end's
+//! (`frontend/scaled.rs`, `frontend/user_solution.rs`), shared with the IPM.
 
 #![allow(clippy::needless_range_loop)]
 
 mod bfgs;
 mod convexify;
-mod finish;
 mod geometry;
 mod iterate;
 mod line_search;
 pub mod options;
 mod polish;
 pub(crate) mod qp;
-mod scaled;
 mod state;
 mod stop;
 mod subproblem;
@@ -160,18 +159,12 @@ impl Sqp {
         s.stats.n_qp_solves = w.n_qp;
         s.stats.qp_iterations = w.qp_iterations as usize;
         s.stats.qp_seconds = w.qp_seconds;
-        let sol = finish::finish(
-            &mut s.sc,
-            &s.geo,
-            &s.it.x,
-            &s.it.mult,
-            stop.status,
-            stop.message,
-            std::mem::take(&mut s.stats),
-            start,
-            s.shape.cp.as_ref(),
-            &s.geo.cones,
-        );
+        let mut sol = s.user_solution(stop);
+        s.stats.total_seconds = start.elapsed().as_secs_f64();
+        s.sc.write_stats(&mut s.stats);
+        let st = &mut s.stats;
+        st.other_seconds = (st.total_seconds - st.eval_seconds - st.factor_seconds).max(0.0);
+        sol.stats = std::mem::take(&mut s.stats);
         if o.print_level >= 3 {
             print!("{}", crate::log::format_summary(&sol));
             println!(

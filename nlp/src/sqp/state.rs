@@ -17,9 +17,10 @@ use super::iterate::{Iterate, Mult};
 use super::line_search::{LineSearch, Trial};
 use super::options::{HessianApproximation, SqpOptions};
 use super::qp::{Qp, QpResult};
-use super::scaled::{Counters, Scaled};
 use super::stop::{StepError, Stop};
 use crate::callback::Observer;
+use crate::frontend::scaled::ScaledNlp;
+use crate::frontend::user_solution::{user_solution, ConeDuals, UserPoint};
 use crate::frontend::validate::Validated;
 use crate::frontend::{KktResiduals, Termination};
 use crate::kkt::Kkt;
@@ -73,7 +74,9 @@ pub(super) struct Work {
 /// Everything one SQP solve carries from iteration to iteration.
 pub(super) struct SqpState<'a> {
     pub o: &'a SqpOptions,
-    pub sc: Scaled<'a>,
+    pub sc: ScaledNlp<'a>,
+    /// The user's bounds and starting point.
+    pub user: Validated,
     pub shape: Shape,
     pub geo: Geometry,
     pub it: Iterate,
@@ -92,6 +95,22 @@ pub(super) struct SqpState<'a> {
     /// Consecutive rejected steps.
     pub ls_failures: usize,
     lgrad: Vec<f64>,
+}
+
+/// Scaled g and the cone entries (when there are cones) at x, counted as one evaluation.
+pub(super) fn eval_g(sc: &mut ScaledNlp<'_>, x: &[f64], g: &mut [f64], cone: &mut [f64]) {
+    sc.g(x, g);
+    if !cone.is_empty() {
+        sc.cone_entries(x, cone);
+    }
+}
+
+/// Scaled Jacobian and the cone Jacobian (when there are cones) at x.
+pub(super) fn eval_jac(sc: &mut ScaledNlp<'_>, x: &[f64], jv: &mut [f64], cv: &mut [f64]) {
+    sc.jac(x, jv);
+    if !cv.is_empty() {
+        sc.cone_jac(x, cv);
+    }
 }
 
 /// A new QP laid out for `shape` and `geo` (`aug`: with the augmented term).
@@ -140,37 +159,26 @@ impl<'a> SqpState<'a> {
             dense: o.hessian_approximation == HessianApproximation::DampedBfgs,
         };
         let mut geo = Geometry {
-            x_l: v.x_l,
-            x_u: v.x_u,
-            g_l: v.g_l,
-            g_u: v.g_u,
+            x_l: v.x_l.clone(),
+            x_u: v.x_u.clone(),
+            g_l: v.g_l.clone(),
+            g_u: v.g_u.clone(),
             cone_row,
             cones,
         };
-        let mut x = v.x0;
+        let mut x = v.x0.clone();
         for j in 0..n {
             x[j] = x[j].clamp(geo.x_l[j], geo.x_u[j]);
         }
-        let mut sc = Scaled {
-            nlp,
-            obj_scale: 1.0,
-            g_scale: vec![1.0; m],
-            counters: Counters::default(),
-        };
+        let mut sc = ScaledNlp::new(nlp);
         let mut grad = vec![0.0; n];
         let mut jv = vec![0.0; shape.jp.row_idx().len()];
         let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
         // Gradient-based scaling at the starting point (IPOPT's rule).
         if o.gradient_scaling {
-            sc.grad(&x, &mut grad);
-            let gmax = grad.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let (gmax, rmax) = sc.unscaled_gradient_norms(&x, None);
             sc.obj_scale =
                 gradient_scale(gmax, o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
-            sc.jac(&x, &mut jv, &mut cv);
-            let mut rmax = vec![0.0f64; m];
-            for (p, &r) in shape.jp.row_idx().iter().enumerate() {
-                rmax[r] = rmax[r].max(jv[p].abs());
-            }
             for i in 0..m {
                 if !geo.cone_row[i] {
                     sc.g_scale[i] = gradient_scale(
@@ -192,17 +200,17 @@ impl<'a> SqpState<'a> {
         let mut g = vec![0.0; m];
         let mut cone = vec![0.0; n_cone];
         let f = sc.f(&x);
-        sc.g(&x, &mut g, &mut cone);
+        eval_g(&mut sc, &x, &mut g, &mut cone);
         sc.grad(&x, &mut grad);
-        sc.jac(&x, &mut jv, &mut cv);
+        eval_jac(&mut sc, &x, &mut jv, &mut cv);
         let mut mult = Mult::zeros(n, m, n_cone);
         if let Some(p) = warm {
             for i in 0..m {
-                mult.lambda[i] = p.lambda[i] * sc.obj_scale / sc.g_scale[i];
+                mult.lambda[i] = sc.lambda_from_user(i, p.lambda[i]);
             }
             for j in 0..n {
-                mult.z_l[j] = p.z_l[j] * sc.obj_scale;
-                mult.z_u[j] = p.z_u[j] * sc.obj_scale;
+                mult.z_l[j] = sc.z_from_user(p.z_l[j]);
+                mult.z_u[j] = sc.z_from_user(p.z_u[j]);
             }
         }
         let curv = Curvature {
@@ -238,6 +246,7 @@ impl<'a> SqpState<'a> {
         SqpState {
             o,
             sc,
+            user: v,
             it: Iterate {
                 x,
                 f,
@@ -353,7 +362,7 @@ impl<'a> SqpState<'a> {
                 }
             })
             .collect();
-        self.sc.hess(&it.x, &lam, &mut curv.hv);
+        self.sc.hess(&it.x, 1.0, &lam, &mut curv.hv);
         if curv.hv.iter().any(|v| !v.is_finite()) {
             return Err(StepError::NonFiniteHessian);
         }
@@ -448,7 +457,7 @@ impl<'a> SqpState<'a> {
         let jv_old = it.jv.clone();
         let cv_old = it.cv.clone();
         self.sc.grad(&it.x, &mut it.grad);
-        self.sc.jac(&it.x, &mut it.jv, &mut it.cv);
+        eval_jac(&mut self.sc, &it.x, &mut it.jv, &mut it.cv);
         if it.grad.iter().chain(&it.jv).any(|v| !v.is_finite()) {
             return Err(StepError::NonFiniteDerivatives);
         }
@@ -472,5 +481,32 @@ impl<'a> SqpState<'a> {
             );
         }
         Ok(())
+    }
+
+    /// The solution in the user's units at the iterate, ending with `stop`.
+    pub fn user_solution(&mut self, stop: Stop) -> Solution {
+        let (sc, it) = (&self.sc, &self.it);
+        let point = UserPoint {
+            x: it.x.clone(),
+            lambda: (0..self.shape.m)
+                .map(|i| sc.lambda_to_user(i, it.mult.lambda[i]))
+                .collect(),
+            z_l: it.mult.z_l.iter().map(|&z| sc.z_to_user(z)).collect(),
+            z_u: it.mult.z_u.iter().map(|&z| sc.z_to_user(z)).collect(),
+        };
+        let z_cone: Vec<f64> = it.mult.z_cone.iter().map(|&z| sc.z_to_user(z)).collect();
+        let cones = ConeDuals {
+            cones: &self.geo.cones,
+            cone_row: &self.geo.cone_row,
+            z_cone: &z_cone,
+        };
+        user_solution(
+            &mut self.sc,
+            &self.user,
+            point,
+            Some(cones),
+            stop.status,
+            stop.message,
+        )
     }
 }
