@@ -172,6 +172,23 @@ fn to_csc<T: Copy>(
     (colptr, rowval, payload)
 }
 
+/// The fixed structure of the QP's constraints: which sides are finite, which variables
+/// are fixed, the patterns of J and of the cone Jacobian.
+#[derive(Clone, Copy)]
+pub(crate) struct QpStructure<'a> {
+    pub jac: &'a SymbolicSparseColMat<usize>,
+    pub x_l: &'a [f64],
+    pub x_u: &'a [f64],
+    pub g_l: &'a [f64],
+    pub g_u: &'a [f64],
+    /// (offset, dimension) of each cone in the stacked cone vector.
+    pub cone_blocks: &'a [(usize, usize)],
+    /// Pattern of the cone Jacobian (rows = stacked cone entries).
+    pub cone_jac: Option<&'a SymbolicSparseColMat<usize>>,
+    /// Rows of g replaced by a cone.
+    pub skip_rows: &'a [bool],
+}
+
 /// The constraint rows of the QP (A, b's meaning, clarabel's cones) for a problem with
 /// the given Jacobian pattern, bounds and cones.
 struct ConstraintLayout {
@@ -191,17 +208,17 @@ struct ConstraintLayout {
 /// non-negativity in the nonnegative cone; then one second-order cone per affine cone
 /// (with one elastic variable on its t entry). Rows in `skip_rows` (replaced by cones)
 /// are left out.
-#[allow(clippy::too_many_arguments)]
-fn constraint_layout(
-    jac: &SymbolicSparseColMat<usize>,
-    x_l: &[f64],
-    x_u: &[f64],
-    g_l: &[f64],
-    g_u: &[f64],
-    cone_blocks: &[(usize, usize)],
-    cone_jac: Option<&SymbolicSparseColMat<usize>>,
-    skip_rows: &[bool],
-) -> ConstraintLayout {
+fn constraint_layout(st: &QpStructure) -> ConstraintLayout {
+    let QpStructure {
+        jac,
+        x_l,
+        x_u,
+        g_l,
+        g_u,
+        cone_blocks,
+        cone_jac,
+        skip_rows,
+    } = *st;
     let n = x_l.len();
     let m = g_l.len();
     let mut rows = Vec::new();
@@ -430,28 +447,18 @@ fn p_layout(
 }
 
 impl Qp {
-    /// Lays out the QP for a problem with the given patterns and bounds (fixed structure:
-    /// which sides are finite, which variables are fixed). `cone_blocks` are (offset,
-    /// dim) of each cone in the stacked cone vector, `cone_jac` the pattern of its
-    /// Jacobian (rows = stacked cone entries).
-    #[allow(clippy::too_many_arguments)]
+    /// Lays out the QP for a problem with the Hessian pattern `hess` and the constraint
+    /// structure `st`; `aug`: with the augmented term's pattern JᵀJ in P; `dense`: a full
+    /// P for BFGS.
     pub fn new(
         hess: &SymbolicSparseColMat<usize>,
-        jac: &SymbolicSparseColMat<usize>,
-        x_l: &[f64],
-        x_u: &[f64],
-        g_l: &[f64],
-        g_u: &[f64],
-        cone_blocks: &[(usize, usize)],
-        cone_jac: Option<&SymbolicSparseColMat<usize>>,
-        skip_rows: &[bool],
+        st: &QpStructure,
         aug: bool,
         dense: bool,
         tol: f64,
         max_iter: u32,
     ) -> Qp {
-        let n = x_l.len();
-        let m = g_l.len();
+        let (n, m) = (st.x_l.len(), st.g_l.len());
         let ConstraintLayout {
             rows,
             n_e,
@@ -460,7 +467,7 @@ impl Qp {
             a_rowval,
             a_src,
             jrows,
-        } = constraint_layout(jac, x_l, x_u, g_l, g_u, cone_blocks, cone_jac, skip_rows);
+        } = constraint_layout(st);
         let ncols = n + n_e;
         let a_vals = vec![0.0; a_src.len()];
         let PLayout {
@@ -493,7 +500,7 @@ impl Qp {
             tol,
             max_iter,
             solver: None,
-            cone_blocks: cone_blocks.to_vec(),
+            cone_blocks: st.cone_blocks.to_vec(),
             aug,
             jrows,
             jtj,

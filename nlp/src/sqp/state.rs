@@ -16,7 +16,7 @@ use super::geometry::Geometry;
 use super::iterate::{Iterate, Mult};
 use super::line_search::{LineSearch, Trial};
 use super::options::{HessianApproximation, SqpOptions};
-use super::qp::{Qp, QpResult};
+use super::qp::{Qp, QpResult, QpStructure};
 use super::stop::{StepError, Stop};
 use crate::callback::Observer;
 use crate::frontend::scaled::ScaledNlp;
@@ -115,21 +115,17 @@ pub(super) fn eval_jac(sc: &mut ScaledNlp<'_>, x: &[f64], jv: &mut [f64], cv: &m
 
 /// A new QP laid out for `shape` and `geo` (`aug`: with the augmented term).
 pub(super) fn new_qp(shape: &Shape, geo: &Geometry, o: &SqpOptions, aug: bool) -> Qp {
-    Qp::new(
-        &shape.hp,
-        &shape.jp,
-        &geo.x_l,
-        &geo.x_u,
-        &geo.g_l,
-        &geo.g_u,
-        &shape.block,
-        shape.cp.as_ref(),
-        &geo.cone_row,
-        aug,
-        shape.dense,
-        o.qp_tol,
-        o.qp_max_iter,
-    )
+    let st = QpStructure {
+        jac: &shape.jp,
+        x_l: &geo.x_l,
+        x_u: &geo.x_u,
+        g_l: &geo.g_l,
+        g_u: &geo.g_u,
+        cone_blocks: &shape.block,
+        cone_jac: shape.cp.as_ref(),
+        skip_rows: &geo.cone_row,
+    };
+    Qp::new(&shape.hp, &st, aug, shape.dense, o.qp_tol, o.qp_max_iter)
 }
 
 impl<'a> SqpState<'a> {
