@@ -5,8 +5,6 @@
 
 use faer::sparse::SymbolicSparseColMat;
 
-use super::iterate::{lagrangian_gradient, Mult};
-
 /// ½-less quadratic form dᵀBd for B = lower-triangular H + δI (or dense B).
 pub(super) fn quad(
     hp: &SymbolicSparseColMat<usize>,
@@ -36,31 +34,10 @@ pub(super) fn quad(
     s
 }
 
-/// Damped BFGS update (Powell) of the dense B with s = x⁺ − x, y = ∇L(x⁺) − ∇L(x) (both
-/// with the new multipliers).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn bfgs_update(
-    b: &mut [f64],
-    n: usize,
-    x0: &[f64],
-    x1: &[f64],
-    g0: &[f64],
-    j0: &[f64],
-    c0: &[f64],
-    g1: &[f64],
-    j1: &[f64],
-    c1: &[f64],
-    jp: &SymbolicSparseColMat<usize>,
-    cp: Option<&SymbolicSparseColMat<usize>>,
-    mult: &Mult,
-    cone_row: &[bool],
-) {
-    let mut l0 = vec![0.0; n];
-    let mut l1 = vec![0.0; n];
-    lagrangian_gradient(g0, jp, j0, cp, c0, mult, cone_row, &mut l0);
-    lagrangian_gradient(g1, jp, j1, cp, c1, mult, cone_row, &mut l1);
-    let s: Vec<f64> = (0..n).map(|i| x1[i] - x0[i]).collect();
-    let y: Vec<f64> = (0..n).map(|i| l1[i] - l0[i]).collect();
+/// Damped BFGS update (Powell 1978) of the dense n×n B (column-major) with the step
+/// s = x⁺ − x and y = ∇L(x⁺) − ∇L(x), both gradients with the new multipliers.
+pub(super) fn bfgs_update(b: &mut [f64], s: &[f64], y: &[f64]) {
+    let n = s.len();
     let bs: Vec<f64> = (0..n)
         .map(|i| (0..n).map(|j| b[i + j * n] * s[j]).sum())
         .collect();
@@ -68,7 +45,7 @@ pub(super) fn bfgs_update(
     if sbs <= 1e-20 {
         return;
     }
-    let sy: f64 = s.iter().zip(&y).map(|(a, c)| a * c).sum();
+    let sy: f64 = s.iter().zip(y).map(|(a, c)| a * c).sum();
     let theta = if sy >= 0.2 * sbs {
         1.0
     } else {

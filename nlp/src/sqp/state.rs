@@ -113,6 +113,26 @@ pub(super) fn eval_jac(sc: &mut ScaledNlp<'_>, x: &[f64], jv: &mut [f64], cv: &m
     }
 }
 
+/// Gradient-based scaling at the starting point x (IPOPT's rule, option
+/// `gradient_scaling`; rows replaced by cones stay unscaled), and the row bounds of `geo`
+/// scaled with it.
+fn scale(sc: &mut ScaledNlp<'_>, geo: &mut Geometry, x: &[f64], o: &SqpOptions) {
+    let (max_gradient, min_value) = (o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
+    if o.gradient_scaling {
+        let (gmax, rmax) = sc.unscaled_gradient_norms(x, None);
+        sc.obj_scale = gradient_scale(gmax, max_gradient, min_value);
+        for (i, r) in rmax.into_iter().enumerate() {
+            if !geo.cone_row[i] {
+                sc.g_scale[i] = gradient_scale(r, max_gradient, min_value);
+            }
+        }
+    }
+    for (i, s) in sc.g_scale.iter().enumerate() {
+        geo.g_l[i] *= s;
+        geo.g_u[i] *= s;
+    }
+}
+
 /// A new QP laid out for `shape` and `geo` (`aug`: with the augmented term).
 pub(super) fn new_qp(shape: &Shape, geo: &Geometry, o: &SqpOptions, aug: bool) -> Qp {
     let st = QpStructure {
@@ -170,25 +190,7 @@ impl<'a> SqpState<'a> {
         let mut grad = vec![0.0; n];
         let mut jv = vec![0.0; shape.jp.row_idx().len()];
         let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
-        // Gradient-based scaling at the starting point (IPOPT's rule).
-        if o.gradient_scaling {
-            let (gmax, rmax) = sc.unscaled_gradient_norms(&x, None);
-            sc.obj_scale =
-                gradient_scale(gmax, o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
-            for i in 0..m {
-                if !geo.cone_row[i] {
-                    sc.g_scale[i] = gradient_scale(
-                        rmax[i],
-                        o.nlp_scaling_max_gradient,
-                        o.nlp_scaling_min_value,
-                    );
-                }
-            }
-        }
-        for i in 0..m {
-            geo.g_l[i] *= sc.g_scale[i];
-            geo.g_u[i] *= sc.g_scale[i];
-        }
+        scale(&mut sc, &mut geo, &x, o);
         let stats = Stats {
             obj_scaling: sc.obj_scale,
             ..Stats::default()
@@ -442,39 +444,29 @@ impl<'a> SqpState<'a> {
                 0.0
             };
         }
-        let it = &mut self.it;
+        let (it, shape, cone_row) = (&mut self.it, &self.shape, &self.geo.cone_row);
         let x_old = std::mem::replace(&mut it.x, trial.x);
         it.f = trial.f;
         it.g = trial.g;
         it.cone = trial.cone;
         it.mult = Mult::from_qp(&trial.res);
         it.have_mult = true;
-        let grad_old = it.grad.clone();
-        let jv_old = it.jv.clone();
-        let cv_old = it.cv.clone();
+        // ∇L at the old point with the new multipliers (BFGS only).
+        let mut l_old = vec![0.0; if shape.dense { shape.n } else { 0 }];
+        if shape.dense {
+            it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_old);
+        }
         self.sc.grad(&it.x, &mut it.grad);
         eval_jac(&mut self.sc, &it.x, &mut it.jv, &mut it.cv);
         if it.grad.iter().chain(&it.jv).any(|v| !v.is_finite()) {
             return Err(StepError::NonFiniteDerivatives);
         }
-        if self.shape.dense {
-            let s = &self.shape;
-            bfgs_update(
-                &mut self.curv.bfgs,
-                s.n,
-                &x_old,
-                &it.x,
-                &grad_old,
-                &jv_old,
-                &cv_old,
-                &it.grad,
-                &it.jv,
-                &it.cv,
-                &s.jp,
-                s.cp.as_ref(),
-                &it.mult,
-                &self.geo.cone_row,
-            );
+        if shape.dense {
+            let mut l_new = vec![0.0; shape.n];
+            it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_new);
+            let s: Vec<f64> = it.x.iter().zip(&x_old).map(|(a, b)| a - b).collect();
+            let y: Vec<f64> = l_new.iter().zip(&l_old).map(|(a, b)| a - b).collect();
+            bfgs_update(&mut self.curv.bfgs, &s, &y);
         }
         Ok(())
     }
