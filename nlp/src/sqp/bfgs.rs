@@ -64,3 +64,52 @@ pub(super) fn bfgs_update(b: &mut [f64], s: &[f64], y: &[f64]) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{HessianApproximation, Problem, Relation, Sqp, SqpOptions, Status};
+
+    /// The update keeps B symmetric positive definite and, with θ = 1 (sᵀy ≥ 0.2 sᵀBs),
+    /// satisfies the secant equation B⁺s = y.
+    #[test]
+    fn update_satisfies_the_secant_equation() {
+        let mut b = vec![2.0, 0.0, 0.0, 1.0];
+        let (s, y) = ([1.0, 1.0], [3.0, 2.0]);
+        bfgs_update(&mut b, &s, &y);
+        let bs = [b[0] * s[0] + b[2] * s[1], b[1] * s[0] + b[3] * s[1]];
+        // Rounding of a few flops on O(1) numbers.
+        assert!(
+            (bs[0] - y[0]).abs() < 1e-14 && (bs[1] - y[1]).abs() < 1e-14,
+            "{bs:?}"
+        );
+        assert_eq!(b[1], b[2]);
+        assert!(b[0] > 0.0 && b[0] * b[3] - b[1] * b[2] > 0.0, "{b:?}");
+    }
+
+    /// hs071 (Hock & Schittkowski 1981): f* = 17.0140172891516 at
+    /// x* = (1, 4.74299963, 3.82114998, 1.37940829), solved with damped BFGS.
+    #[test]
+    fn damped_bfgs_solves_hs071() {
+        let mut pb = Problem::new();
+        let x = pb.variable("x", 4).unwrap();
+        pb.set_bounds(&x, 1.0, 5.0).unwrap();
+        pb.set_initial(&x, &[1.0, 5.0, 5.0, 1.0]).unwrap();
+        pb.minimize(x[0] * x[3] * (x[0] + x[1] + x[2]) + x[2]);
+        pb.subject_to((x[0] * x[1] * x[2] * x[3]).ge(25.0)).unwrap();
+        let sq = x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3];
+        pb.subject_to(sq.eq(40.0)).unwrap();
+        let o = SqpOptions {
+            hessian_approximation: HessianApproximation::DampedBfgs,
+            ..SqpOptions::default()
+        };
+        let sol = Sqp::new(o).solve(&mut pb.compile().unwrap()).unwrap();
+        assert_eq!(sol.status, Status::SolveSucceeded, "{}", sol.message);
+        // tol = 1e-8 on the KKT error bounds the objective error well below 1e-6.
+        assert!(
+            (sol.objective - 17.0140172891516).abs() < 1e-6,
+            "{}",
+            sol.objective
+        );
+    }
+}
