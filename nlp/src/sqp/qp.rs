@@ -459,51 +459,34 @@ impl Qp {
         max_iter: u32,
     ) -> Qp {
         let (n, m) = (st.x_l.len(), st.g_l.len());
-        let ConstraintLayout {
-            rows,
-            n_e,
-            cones,
-            a_colptr,
-            a_rowval,
-            a_src,
-            jrows,
-        } = constraint_layout(st);
-        let ncols = n + n_e;
-        let a_vals = vec![0.0; a_src.len()];
-        let PLayout {
-            p_colptr,
-            p_rowval,
-            h_pos,
-            diag_pos,
-            jtj,
-        } = p_layout(hess, &jrows, n, ncols, aug, dense);
-        let p_vals = vec![0.0; p_rowval.len()];
-        let n_rows = rows.len();
+        let a = constraint_layout(st);
+        let ncols = n + a.n_e;
+        let pl = p_layout(hess, &a.jrows, n, ncols, aug, dense);
         Qp {
             n,
             m,
-            n_e,
-            rows,
-            cones,
-            p_colptr,
-            p_rowval,
-            p_vals,
-            h_pos,
-            diag_pos,
+            n_e: a.n_e,
+            b: vec![0.0; a.rows.len()],
+            rows: a.rows,
+            cones: a.cones,
+            p_vals: vec![0.0; pl.p_rowval.len()],
+            p_colptr: pl.p_colptr,
+            p_rowval: pl.p_rowval,
+            h_pos: pl.h_pos,
+            diag_pos: pl.diag_pos,
             dense,
-            a_colptr,
-            a_rowval,
-            a_vals,
-            a_src,
-            b: vec![0.0; n_rows],
+            a_vals: vec![0.0; a.a_src.len()],
+            a_colptr: a.a_colptr,
+            a_rowval: a.a_rowval,
+            a_src: a.a_src,
             q: vec![0.0; ncols],
             tol,
             max_iter,
             solver: None,
             cone_blocks: st.cone_blocks.to_vec(),
             aug,
-            jrows,
-            jtj,
+            jrows: a.jrows,
+            jtj: pl.jtj,
             jac_copy: Vec::new(),
             weight_copy: vec![0.0; m],
         }
