@@ -16,7 +16,6 @@ use gap_crossing::render;
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
 use gap_crossing::sweep::{self, Grid, GridError, PointResult};
-use nlp::NamedOptions;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -225,11 +224,9 @@ fn settings(a: &SolverArgs, print_level: u8) -> Result<Settings, CliError> {
         ..Settings::default()
     };
     settings.set_print_level(print_level);
-    match settings.backend {
-        Backend::Ipm => settings.ipm.set_by_name(&a.opt),
-        Backend::Sqp => settings.sqp.set_by_name(&a.opt),
-    }
-    .map_err(|e| CliError::Opt(format!("--opt: {e}")))?;
+    settings
+        .set_by_name(&a.opt)
+        .map_err(|e| CliError::Opt(format!("--opt: {e}")))?;
     Ok(settings)
 }
 

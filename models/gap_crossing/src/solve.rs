@@ -34,8 +34,8 @@ use crate::status::{GoalShortfall, PlanStatus};
 use crate::terrain::{self, Terrain};
 use nlp::ipm::Ipm;
 use nlp::{
-    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, Solution, SolveError,
-    Solver, Sqp, SqpOptions, Status,
+    BuildError, IpmOptions, IterationRecord, IterationView, NamedOptions, NumericNlp, OptionError,
+    Solution, SolveError, Solver, Sqp, SqpOptions, Status,
 };
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -103,6 +103,15 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// Applies `KEY=VALUE` option assignments (IPOPT-style names, see
+    /// [`NamedOptions`]) to the chosen back end's options; on error nothing changes.
+    pub fn set_by_name<S: AsRef<str>>(&mut self, assignments: &[S]) -> Result<(), OptionError> {
+        match self.backend {
+            Backend::Ipm => self.ipm.set_by_name(assignments),
+            Backend::Sqp => self.sqp.set_by_name(assignments),
+        }
+    }
+
     /// Sets the iteration-log verbosity of both back ends.
     pub fn set_print_level(&mut self, level: u8) {
         self.ipm.print_level = level;

@@ -4,14 +4,20 @@
 //! - [`common_options`]: [`CommonOptions`], the options with one meaning in both;
 //! - `validate`: one check of the problem handed to a solver (sizes, the Hessian's
 //!   lower triangle, cone rows, bounds, starting point);
+//! - `scaled`: the user's problem scaled (`ScaledNlp`: s_f, s_g, evaluation counters
+//!   and timing, multipliers to and from the user's units);
+//! - `user_solution`: the returned `Solution`, evaluated in the user's units with its
+//!   KKT measures;
 //! - `termination`: the KKT error of an iterate (`KktResiduals`) and one
 //!   convergence test (`tol` and the `acceptable_*` options);
 //! - [`solver`]: the [`Solver`] trait both implement, through which drivers
 //!   ([`solve_mpcc`](crate::solve_mpcc), the planner) dispatch.
 
 pub mod common_options;
+pub(crate) mod scaled;
 pub mod solver;
 pub(crate) mod termination;
+pub(crate) mod user_solution;
 pub(crate) mod validate;
 
 pub(crate) use common_options::strict_options_serde;

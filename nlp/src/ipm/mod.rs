@@ -1,7 +1,8 @@
 //! Interior-point method: IPOPT's primal-dual barrier algorithm with a filter line search
 //! (Wächter & Biegler, Math. Prog. 106:25–57, 2006).
 //!
-//! Layout: `reduced` (fixed variables removed, scaling, evaluation counters),
+//! Layout: `reduced` (fixed variables and unbounded rows removed, on the front end's
+//! scaled problem `frontend/scaled.rs`),
 //! `core` (iteration, KKT step with inertia correction, line search with second-order
 //! corrections), `filter`, `barrier` (μ updates), `restoration` (ℓ1 restoration
 //! phase solved by the same core).
@@ -20,6 +21,7 @@ use std::time::Instant;
 
 use crate::callback::{IterationCallback, IterationView, Observer};
 use crate::error::SolveError;
+use crate::frontend::user_solution::{user_solution, UserPoint};
 use crate::frontend::validate::{validate, Validated};
 use crate::frontend::Solver;
 use crate::numeric::NumericNlp;
@@ -135,18 +137,17 @@ impl Ipm {
                     y: red
                         .rows
                         .iter()
-                        .enumerate()
-                        .map(|(k, &i)| prev.lambda[i] * red.obj_scale / red.g_scale[k])
+                        .map(|&i| red.sc.lambda_from_user(i, prev.lambda[i]))
                         .collect(),
                     zl: red
                         .free
                         .iter()
-                        .map(|&j| prev.z_l[j] * red.obj_scale)
+                        .map(|&j| red.sc.z_from_user(prev.z_l[j]))
                         .collect(),
                     zu: red
                         .free
                         .iter()
-                        .map(|&j| prev.z_u[j] * red.obj_scale)
+                        .map(|&j| red.sc.z_from_user(prev.z_u[j]))
                         .collect(),
                 },
             };
@@ -158,8 +159,8 @@ impl Ipm {
                 },
                 bound_relax_factor: opts.bound_relax_factor,
                 in_resto: false,
-                obj_scale: red.obj_scale,
-                g_scale: red.g_scale.clone(),
+                obj_scale: red.obj_scale(),
+                g_scale: red.g_scale(),
                 mu_strategy: opts.mu_strategy,
             };
             match Core::new(&mut red, opts, &setup) {
@@ -196,19 +197,12 @@ impl Ipm {
         if n == 0 && sol.constr_viol > opts.constr_viol_tol {
             sol.status = Status::InfeasibleProblemDetected;
         }
-        let counters = red.counters.clone();
         let mut stats = shared.stats;
         stats.iterations = shared.iter;
-        stats.n_eval_f = counters.f;
-        stats.n_eval_grad_f = counters.grad_f;
-        stats.n_eval_g = counters.g;
-        stats.n_eval_jac_g = counters.jac_g;
-        stats.n_eval_hess_l = counters.hess_l;
-        stats.eval_seconds = counters.seconds;
+        red.sc.write_stats(&mut stats);
         stats.total_seconds = start_time.elapsed().as_secs_f64();
         stats.other_seconds =
             (stats.total_seconds - stats.eval_seconds - stats.factor_seconds).max(0.0);
-        stats.obj_scaling = red.obj_scale;
         sol.stats = stats;
         if opts.print_level >= 3 {
             print!("{}", crate::log::format_summary(&sol));
@@ -235,7 +229,9 @@ impl Solver for Ipm {
     }
 }
 
-/// Builds the user-level solution from the reduced, scaled iterate.
+/// Builds the user-level solution from the reduced, scaled iterate: fixed variables at
+/// their values, multipliers unscaled (rows without bounds: λ = 0), then the front end's
+/// [`user_solution`].
 #[allow(clippy::too_many_arguments)]
 fn finish(
     red: &mut Reduced<'_>,
@@ -247,131 +243,56 @@ fn finish(
     zu: &[f64],
     message: String,
 ) -> Solution {
-    let n_user = v.x_l.len();
-    let m_user = v.g_l.len();
-    let mut x = red.x_full.clone();
+    let (n_user, m_user) = (v.x_l.len(), v.g_l.len());
+    let mut point = UserPoint {
+        x: red.x_full.clone(),
+        lambda: vec![0.0; m_user],
+        z_l: vec![0.0; n_user],
+        z_u: vec![0.0; n_user],
+    };
     for (k, &j) in red.free.iter().enumerate() {
         if k < w.len() {
-            x[j] = w[k];
+            point.x[j] = w[k];
         }
+        point.z_l[j] = red.sc.z_to_user(zl.get(k).copied().unwrap_or(0.0));
+        point.z_u[j] = red.sc.z_to_user(zu.get(k).copied().unwrap_or(0.0));
     }
-    let os = red.obj_scale;
-    let mut lambda = vec![0.0; m_user];
     for (k, &i) in red.rows.iter().enumerate() {
-        lambda[i] = y.get(k).copied().unwrap_or(0.0) * red.g_scale[k] / os;
+        point.lambda[i] = red.sc.lambda_to_user(i, y.get(k).copied().unwrap_or(0.0));
     }
-    let mut z_l = vec![0.0; n_user];
-    let mut z_u = vec![0.0; n_user];
-    for (k, &j) in red.free.iter().enumerate() {
-        z_l[j] = zl.get(k).copied().unwrap_or(0.0) / os;
-        z_u[j] = zu.get(k).copied().unwrap_or(0.0) / os;
-    }
-    let user = red.user();
-    let t = Instant::now();
-    let objective = user.eval_f(&x);
-    let mut grad = vec![0.0; n_user];
-    user.eval_grad_f(&x, &mut grad);
-    let mut g = vec![0.0; m_user];
-    user.eval_g(&x, &mut g);
-    let jp = user.jac_g_sparsity().clone();
-    let mut jv = vec![0.0; jp.row_idx().len()];
-    user.eval_jac_g(&x, &mut jv);
-    let secs = t.elapsed().as_secs_f64();
-    red.counters.f += 1;
-    red.counters.grad_f += 1;
-    red.counters.g += 1;
-    red.counters.jac_g += 1;
-    red.counters.seconds += secs;
-    // r = ∇f + Jᵀλ
-    let mut r = grad;
-    for c in 0..n_user {
-        for p in jp.col_range(c) {
-            r[c] += jv[p] * lambda[jp.row_idx()[p]];
-        }
-    }
-    let mut dual_inf: f64 = 0.0;
-    for j in 0..n_user {
-        if v.x_l[j] == v.x_u[j] {
-            // Fixed variable: its bound multipliers absorb the gradient.
-            z_l[j] = r[j].max(0.0);
-            z_u[j] = (-r[j]).max(0.0);
-        }
-        dual_inf = dual_inf.max((r[j] - z_l[j] + z_u[j]).abs());
-    }
-    let mut constr_viol: f64 = 0.0;
-    let mut compl: f64 = 0.0;
-    for j in 0..n_user {
-        constr_viol = constr_viol.max(v.x_l[j] - x[j]).max(x[j] - v.x_u[j]);
-        if v.x_l[j] != v.x_u[j] {
-            if v.x_l[j].is_finite() {
-                compl = compl.max(((x[j] - v.x_l[j]) * z_l[j]).abs());
-            }
-            if v.x_u[j].is_finite() {
-                compl = compl.max(((v.x_u[j] - x[j]) * z_u[j]).abs());
-            }
-        }
-    }
-    for i in 0..m_user {
-        constr_viol = constr_viol.max(v.g_l[i] - g[i]).max(g[i] - v.g_u[i]);
-        if v.g_l[i] != v.g_u[i] {
-            if v.g_l[i].is_finite() {
-                compl = compl.max(((g[i] - v.g_l[i]) * (-lambda[i]).max(0.0)).abs());
-            }
-            if v.g_u[i].is_finite() {
-                compl = compl.max(((v.g_u[i] - g[i]) * lambda[i].max(0.0)).abs());
-            }
-        }
-    }
-    Solution {
-        status,
-        x,
-        lambda,
-        z_l,
-        z_u,
-        g,
-        objective,
-        constr_viol: constr_viol.max(0.0),
-        dual_inf,
-        compl,
-        message,
-        stats: Stats::default(),
-    }
+    user_solution(&mut red.sc, v, point, None, status, message)
 }
 
 /// IPOPT's gradient-based scaling at the starting point (or the fixed objective factor):
-/// sets the reduced problem's objective and row scale factors.
+/// sets the scaled problem's objective and row factors (rows of the reduced problem).
 fn scale_at_start(red: &mut Reduced<'_>, opts: &IpmOptions) {
     let n = red.free.len();
-    let m = red.rows.len();
     if opts.nlp_scaling_method == ScalingMethod::GradientBased && n > 0 {
         let x0 = red.x0.clone();
-        let gmax = red.unscaled_grad_max(&x0);
-        red.obj_scale = opts.obj_scaling_factor
+        let (gmax, rmax) = red.unscaled_gradient_norms(&x0);
+        red.sc.obj_scale = opts.obj_scaling_factor
             * gradient_scale(
                 gmax,
                 opts.nlp_scaling_max_gradient,
                 opts.nlp_scaling_min_value,
             );
-        if m > 0 {
-            let mut rmax = vec![0.0; m];
-            red.unscaled_jac_row_max(&x0, &mut rmax);
-            for k in 0..m {
-                red.g_scale[k] = gradient_scale(
+        for (k, &i) in red.rows.iter().enumerate() {
+            let mut s = gradient_scale(
+                rmax[k],
+                opts.nlp_scaling_max_gradient,
+                opts.nlp_scaling_min_value,
+            );
+            // Upward scaling: equality rows only (see nlp_scaling_min_gradient).
+            if red.g_l[k] == red.g_u[k] {
+                s *= gradient_scale_up(
                     rmax[k],
-                    opts.nlp_scaling_max_gradient,
-                    opts.nlp_scaling_min_value,
+                    opts.nlp_scaling_min_gradient,
+                    opts.nlp_scaling_max_value,
                 );
-                // Upward scaling: equality rows only (see nlp_scaling_min_gradient).
-                if red.g_l[k] == red.g_u[k] {
-                    red.g_scale[k] *= gradient_scale_up(
-                        rmax[k],
-                        opts.nlp_scaling_min_gradient,
-                        opts.nlp_scaling_max_value,
-                    );
-                }
             }
+            red.sc.g_scale[i] = s;
         }
     } else {
-        red.obj_scale = opts.obj_scaling_factor;
+        red.sc.obj_scale = opts.obj_scaling_factor;
     }
 }

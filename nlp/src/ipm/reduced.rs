@@ -1,13 +1,13 @@
 //! The user's NLP as the interior-point core sees it: fixed variables removed
-//! (IPOPT's `fixed_variable_treatment = make_parameter`), rows without bounds dropped,
-//! gradient-based scaling applied, evaluations counted and timed.
+//! (IPOPT's `fixed_variable_treatment = make_parameter`) and rows without bounds dropped,
+//! on top of the front end's scaled problem ([`ScaledNlp`]: scaling, evaluation
+//! counters and timing).
 
 #![allow(clippy::needless_range_loop)]
 
-use std::time::Instant;
-
 use faer::sparse::SymbolicSparseColMat;
 
+use crate::frontend::scaled::ScaledNlp;
 use crate::numeric::NumericNlp;
 
 /// The problem interface of the core: a [`NumericNlp`] plus a hook that the restoration
@@ -31,19 +31,10 @@ pub(crate) trait IpmProblem: NumericNlp {
     }
 }
 
-/// Evaluation counters and time spent in user callbacks.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct EvalCounters {
-    pub f: usize,
-    pub grad_f: usize,
-    pub g: usize,
-    pub jac_g: usize,
-    pub hess_l: usize,
-    pub seconds: f64,
-}
-
+/// The reduced problem: free variables and bounded rows of the scaled user problem.
 pub(crate) struct Reduced<'a> {
-    user: &'a mut dyn NumericNlp,
+    /// The scaled user problem (factors of every user row; 1 on dropped rows).
+    pub sc: ScaledNlp<'a>,
     /// Free variable indices (user numbering).
     pub free: Vec<usize>,
     /// Kept row indices (user numbering).
@@ -58,15 +49,12 @@ pub(crate) struct Reduced<'a> {
     pub g_l: Vec<f64>,
     pub g_u: Vec<f64>,
     pub x0: Vec<f64>,
-    pub obj_scale: f64,
-    pub g_scale: Vec<f64>,
     pub x_full: Vec<f64>,
     g_full: Vec<f64>,
     jac_full: Vec<f64>,
     hess_full: Vec<f64>,
     lam_full: Vec<f64>,
     grad_full: Vec<f64>,
-    pub counters: EvalCounters,
 }
 
 impl<'a> Reduced<'a> {
@@ -121,8 +109,6 @@ impl<'a> Reduced<'a> {
             g_l: rows.iter().map(|&i| g_l[i]).collect(),
             g_u: rows.iter().map(|&i| g_u[i]).collect(),
             x0: free.iter().map(|&j| x0[j]).collect(),
-            obj_scale: 1.0,
-            g_scale: vec![1.0; rows.len()],
             rows,
             x_full,
             g_full: vec![0.0; m_user],
@@ -130,14 +116,18 @@ impl<'a> Reduced<'a> {
             hess_full: vec![0.0; hess_len],
             lam_full: vec![0.0; m_user],
             grad_full: vec![0.0; n_user],
-            counters: EvalCounters::default(),
-            user,
+            sc: ScaledNlp::new(user),
         }
     }
 
-    /// The user problem.
-    pub fn user(&mut self) -> &mut dyn NumericNlp {
-        self.user
+    /// Objective factor s_f.
+    pub fn obj_scale(&self) -> f64 {
+        self.sc.obj_scale
+    }
+
+    /// Row factors of the kept rows.
+    pub fn g_scale(&self) -> Vec<f64> {
+        self.rows.iter().map(|&i| self.sc.g_scale[i]).collect()
     }
 
     fn set_x(&mut self, x: &[f64]) {
@@ -146,38 +136,18 @@ impl<'a> Reduced<'a> {
         }
     }
 
-    /// Unscaled gradient (reduced) at the reduced point `x` (used for scaling).
-    pub fn unscaled_grad_max(&mut self, x: &[f64]) -> f64 {
+    /// Unscaled max-norms at the reduced point `x` (counted), for choosing the factors:
+    /// of ∇f over the free variables, and of each kept row of the Jacobian over them.
+    pub fn unscaled_gradient_norms(&mut self, x: &[f64]) -> (f64, Vec<f64>) {
         self.set_x(x);
-        let t = Instant::now();
-        self.user.eval_grad_f(&self.x_full, &mut self.grad_full);
-        self.counters.grad_f += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
-        self.free
-            .iter()
-            .map(|&j| self.grad_full[j].abs())
-            .fold(0.0, f64::max)
-    }
-
-    /// Unscaled row max-norms of the reduced Jacobian at `x` (used for scaling).
-    pub fn unscaled_jac_row_max(&mut self, x: &[f64], out: &mut [f64]) {
-        self.set_x(x);
-        let t = Instant::now();
-        self.user.eval_jac_g(&self.x_full, &mut self.jac_full);
-        self.counters.jac_g += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for c in 0..self.jac.ncols() {
-            for p in self.jac.col_range(c) {
-                let r = self.jac.row_idx()[p];
-                let v = self.jac_full[self.jmap[p]].abs();
-                if v.is_finite() {
-                    out[r] = out[r].max(v);
-                } else {
-                    out[r] = f64::NAN;
-                }
-            }
+        let mut is_free = vec![false; self.x_full.len()];
+        for &j in &self.free {
+            is_free[j] = true;
         }
+        let (gmax, rmax) = self
+            .sc
+            .unscaled_gradient_norms(&self.x_full, Some(&is_free));
+        (gmax, self.rows.iter().map(|&i| rmax[i]).collect())
     }
 }
 
@@ -229,9 +199,9 @@ impl NumericNlp for Reduced<'_> {
     fn bounds(&self, x_l: &mut [f64], x_u: &mut [f64], g_l: &mut [f64], g_u: &mut [f64]) {
         x_l.copy_from_slice(&self.x_l);
         x_u.copy_from_slice(&self.x_u);
-        for k in 0..self.rows.len() {
-            g_l[k] = self.g_l[k] * self.g_scale[k];
-            g_u[k] = self.g_u[k] * self.g_scale[k];
+        for (k, &i) in self.rows.iter().enumerate() {
+            g_l[k] = self.g_l[k] * self.sc.g_scale[i];
+            g_u[k] = self.g_u[k] * self.sc.g_scale[i];
         }
     }
     fn initial_point(&self, x: &mut [f64]) {
@@ -245,68 +215,45 @@ impl NumericNlp for Reduced<'_> {
     }
     fn eval_f(&mut self, x: &[f64]) -> f64 {
         self.set_x(x);
-        let t = Instant::now();
-        let f = self.user.eval_f(&self.x_full);
-        self.counters.f += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
-        f * self.obj_scale
+        self.sc.f(&self.x_full)
     }
     fn eval_grad_f(&mut self, x: &[f64], grad: &mut [f64]) {
         self.set_x(x);
-        let t = Instant::now();
-        self.user.eval_grad_f(&self.x_full, &mut self.grad_full);
-        self.counters.grad_f += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
+        self.sc.grad(&self.x_full, &mut self.grad_full);
         for (k, &j) in self.free.iter().enumerate() {
-            grad[k] = self.grad_full[j] * self.obj_scale;
+            grad[k] = self.grad_full[j];
         }
     }
     fn eval_g(&mut self, x: &[f64], g: &mut [f64]) {
         self.set_x(x);
-        let t = Instant::now();
-        self.user.eval_g(&self.x_full, &mut self.g_full);
-        self.counters.g += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
+        self.sc.g(&self.x_full, &mut self.g_full);
         for (k, &i) in self.rows.iter().enumerate() {
-            g[k] = self.g_full[i] * self.g_scale[k];
+            g[k] = self.g_full[i];
         }
     }
     fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]) {
         self.set_x(x);
-        let t = Instant::now();
-        self.user.eval_jac_g(&self.x_full, &mut self.jac_full);
-        self.counters.jac_g += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
-        for c in 0..self.jac.ncols() {
-            for p in self.jac.col_range(c) {
-                let r = self.jac.row_idx()[p];
-                values[p] = self.jac_full[self.jmap[p]] * self.g_scale[r];
-            }
+        self.sc.jac(&self.x_full, &mut self.jac_full);
+        for (v, &q) in values.iter_mut().zip(&self.jmap) {
+            *v = self.jac_full[q];
         }
     }
     fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]) {
         self.set_x(x);
         for (k, &i) in self.rows.iter().enumerate() {
-            self.lam_full[i] = lambda[k] * self.g_scale[k];
+            self.lam_full[i] = lambda[k];
         }
-        let t = Instant::now();
-        self.user.eval_hess_l(
-            &self.x_full,
-            obj_factor * self.obj_scale,
-            &self.lam_full,
-            &mut self.hess_full,
-        );
-        self.counters.hess_l += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
+        let (x_full, lam) = (&self.x_full, &self.lam_full);
+        self.sc.hess(x_full, obj_factor, lam, &mut self.hess_full);
         for (p, &q) in self.hmap.iter().enumerate() {
             values[p] = self.hess_full[q];
         }
     }
     fn variable_name(&self, i: usize) -> String {
-        self.user.variable_name(self.free[i])
+        self.sc.user().variable_name(self.free[i])
     }
     fn constraint_name(&self, i: usize) -> String {
-        self.user.constraint_name(self.rows[i])
+        self.sc.user().constraint_name(self.rows[i])
     }
 }
 
@@ -320,7 +267,7 @@ impl IpmProblem for Reduced<'_> {
         }
         lambda_user.iter_mut().for_each(|v| *v = 0.0);
         for (k, &i) in self.rows.iter().enumerate() {
-            lambda_user[i] = y[k] * self.g_scale[k] / self.obj_scale;
+            lambda_user[i] = self.sc.lambda_to_user(i, y[k]);
         }
     }
 }

@@ -34,78 +34,95 @@ enum Side {
     Both,
 }
 
-/// The polished QP result, or `None` when clarabel's active set does not give a KKT point
-/// of the QP (then clarabel's solution stands). `jp`, `hp` are the patterns of
-/// `p.jac` and `p.hess`. Counts one factorisation in `n_fact`.
-pub(crate) fn polish(
+/// Clarabel's active set W: the side of each row and bound, active when its multiplier
+/// exceeds its slack (the larger of the complementary pair).
+struct WorkingSet {
+    rows: Vec<Side>,
+    vars: Vec<Side>,
+}
+
+impl WorkingSet {
+    /// W from clarabel's solution `res`; `None` when a row or bound of the augmented term
+    /// left W (the polished step, without the term, would solve another QP).
+    fn from_qp(p: &QpData, jp: &SymbolicSparseColMat<usize>, res: &QpResult) -> Option<Self> {
+        let (n, m) = (p.x.len(), p.g.len());
+        let jd = jac_times(p, jp, &res.d);
+        let mut rows = vec![Side::Free; m];
+        for i in 0..m {
+            let lin = p.g[i] + jd[i];
+            rows[i] = if p.g_l[i] == p.g_u[i] {
+                Side::Both
+            } else if p.g_u[i].is_finite() && res.lambda[i] > 0.0 && res.lambda[i] > p.g_u[i] - lin
+            {
+                Side::Upper
+            } else if p.g_l[i].is_finite() && res.lambda[i] < 0.0 && -res.lambda[i] > lin - p.g_l[i]
+            {
+                Side::Lower
+            } else {
+                Side::Free
+            };
+            if p.row_weight[i] > 0.0 && rows[i] == Side::Free {
+                return None;
+            }
+        }
+        let mut vars = vec![Side::Free; n];
+        for j in 0..n {
+            let xn = p.x[j] + res.d[j];
+            vars[j] = if p.x_l[j] == p.x_u[j] {
+                Side::Both
+            } else if p.x_u[j].is_finite() && res.z_u[j] > 0.0 && res.z_u[j] > p.x_u[j] - xn {
+                Side::Upper
+            } else if p.x_l[j].is_finite() && res.z_l[j] > 0.0 && res.z_l[j] > xn - p.x_l[j] {
+                Side::Lower
+            } else {
+                Side::Free
+            };
+            if p.bound_weight[j] > 0.0 && vars[j] == Side::Free {
+                return None;
+            }
+        }
+        Some(WorkingSet { rows, vars })
+    }
+
+    /// The step of a bound in W: to that bound.
+    fn target(&self, p: &QpData, j: usize) -> f64 {
+        match self.vars[j] {
+            Side::Lower => p.x_l[j] - p.x[j],
+            Side::Upper | Side::Both => p.x_u[j] - p.x[j],
+            Side::Free => 0.0,
+        }
+    }
+}
+
+/// J·v for the Jacobian values of `p`.
+fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64]) -> Vec<f64> {
+    let mut jd = vec![0.0; p.g.len()];
+    for c in 0..p.x.len() {
+        for q in jp.col_range(c) {
+            jd[jp.row_idx()[q]] += p.jac[q] * v[c];
+        }
+    }
+    jd
+}
+
+/// The equality QP on W: `[B, J_Wᵀ; J_W, 0]·(d, λ) = (−∇f, r_W)`, the bounds of W fixed by
+/// a large diagonal and the zero block recovered from a 1e-10 regularisation by
+/// iterative refinement. `None` unless the inertia is (n, m) and the solve accurate.
+fn equality_qp_step(
     kkt: &mut Kkt,
     p: &QpData,
-    jp: &SymbolicSparseColMat<usize>,
-    hp: &SymbolicSparseColMat<usize>,
-    res: &QpResult,
+    w: &WorkingSet,
     n_fact: &mut usize,
-) -> Option<QpResult> {
+) -> Option<(Vec<f64>, Vec<f64>)> {
     let (n, m) = (p.x.len(), p.g.len());
-    if kkt.n() != n || kkt.m() != m {
-        return None;
-    }
-    // J d and the linearised rows of clarabel's step.
-    let mut jd = vec![0.0; m];
-    for c in 0..n {
-        for q in jp.col_range(c) {
-            jd[jp.row_idx()[q]] += p.jac[q] * res.d[c];
-        }
-    }
-    // ---- working set from clarabel's solution: active when the multiplier exceeds the
-    // slack (the larger of the complementary pair) ----
-    let mut row_side = vec![Side::Free; m];
-    for i in 0..m {
-        let lin = p.g[i] + jd[i];
-        row_side[i] = if p.g_l[i] == p.g_u[i] {
-            Side::Both
-        } else if p.g_u[i].is_finite() && res.lambda[i] > 0.0 && res.lambda[i] > p.g_u[i] - lin {
-            Side::Upper
-        } else if p.g_l[i].is_finite() && res.lambda[i] < 0.0 && -res.lambda[i] > lin - p.g_l[i] {
-            Side::Lower
-        } else {
-            Side::Free
-        };
-        // A row of the augmented term the QP leaves: the polished step (without the
-        // term) would be another QP's solution.
-        if p.row_weight[i] > 0.0 && row_side[i] == Side::Free {
-            return None;
-        }
-    }
-    let mut var_side = vec![Side::Free; n];
-    for j in 0..n {
-        let xn = p.x[j] + res.d[j];
-        var_side[j] = if p.x_l[j] == p.x_u[j] {
-            Side::Both
-        } else if p.x_u[j].is_finite() && res.z_u[j] > 0.0 && res.z_u[j] > p.x_u[j] - xn {
-            Side::Upper
-        } else if p.x_l[j].is_finite() && res.z_l[j] > 0.0 && res.z_l[j] > xn - p.x_l[j] {
-            Side::Lower
-        } else {
-            Side::Free
-        };
-        if p.bound_weight[j] > 0.0 && var_side[j] == Side::Free {
-            return None;
-        }
-    }
-    // ---- the equality QP on W ----
     let hmax = p.hess.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let big = 1e14 * hmax;
-    let target = |j: usize| match var_side[j] {
-        Side::Lower => p.x_l[j] - p.x[j],
-        Side::Upper | Side::Both => p.x_u[j] - p.x[j],
-        Side::Free => 0.0,
-    };
     let dx: Vec<f64> = (0..n)
-        .map(|j| p.shift + if var_side[j] == Side::Free { 0.0 } else { big })
+        .map(|j| p.shift + if w.vars[j] == Side::Free { 0.0 } else { big })
         .collect();
     const REG: f64 = 1e-10;
     let dc: Vec<f64> = (0..m)
-        .map(|i| if row_side[i] == Side::Free { 1e20 } else { REG })
+        .map(|i| if w.rows[i] == Side::Free { 1e20 } else { REG })
         .collect();
     *n_fact += 1;
     match kkt.factorize(p.hess, &dx, p.jac, &dc) {
@@ -115,14 +132,14 @@ pub(crate) fn polish(
     let mut rhs = vec![0.0; n + m];
     for j in 0..n {
         rhs[j] = -p.grad[j]
-            + if var_side[j] == Side::Free {
+            + if w.vars[j] == Side::Free {
                 0.0
             } else {
-                big * target(j)
+                big * w.target(p, j)
             };
     }
     for i in 0..m {
-        rhs[n + i] = match row_side[i] {
+        rhs[n + i] = match w.rows[i] {
             Side::Free => 0.0,
             Side::Lower => p.g_l[i] - p.g[i],
             Side::Upper | Side::Both => p.g_u[i] - p.g[i],
@@ -131,7 +148,7 @@ pub(crate) fn polish(
     // Remove the regularisation of the W rows (solve with the exact zero block).
     let shift: Vec<f64> = (0..n + m)
         .map(|k| {
-            if k >= n && row_side[k - n] != Side::Free {
+            if k >= n && w.rows[k - n] != Side::Free {
                 REG
             } else {
                 0.0
@@ -145,18 +162,30 @@ pub(crate) fn polish(
     let mut d = rhs[..n].to_vec();
     let mut lambda = rhs[n..].to_vec();
     for j in 0..n {
-        if var_side[j] != Side::Free {
-            d[j] = target(j);
+        if w.vars[j] != Side::Free {
+            d[j] = w.target(p, j);
         }
     }
     for i in 0..m {
-        if row_side[i] == Side::Free {
+        if w.rows[i] == Side::Free {
             lambda[i] = 0.0;
         }
     }
-    // Bound multipliers from the QP's stationarity: z_l − z_u = B d + ∇f + Jᵀλ, with the
-    // augmented weight ρ_a of an active bound in B (the QP's own bound multiplier, as
-    // clarabel's: the SQP takes it as the NLP's).
+    Some((d, lambda))
+}
+
+/// Bound multipliers from the QP's stationarity, z_l − z_u = B d + ∇f + Jᵀλ (with the
+/// augmented weight ρ_a of an active bound in B: the QP's own bound multiplier, as
+/// clarabel's), and the multiplier tolerance; `None` when a free variable is not
+/// stationary or a bound multiplier of W has the wrong sign.
+fn bound_multipliers(
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    w: &WorkingSet,
+    d: &[f64],
+    lambda: &[f64],
+) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    let n = p.x.len();
     let mut s = p.grad.to_vec();
     for c in 0..n {
         s[c] += (p.shift + p.bound_weight[c]) * d[c];
@@ -180,61 +209,74 @@ pub(crate) fn polish(
     // J_W make huge: then it passes while rows of W are not met).
     let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     for j in 0..n {
-        match var_side[j] {
-            Side::Free => {
-                // Stationarity holds for free variables by construction; a large residual
-                // means the solve failed.
-                if s[j].abs() > 1e-8 * grad_max {
-                    return None;
-                }
-            }
-            Side::Lower => {
-                if s[j] < -mult_tol {
-                    return None;
-                }
-                z_l[j] = s[j].max(0.0);
-            }
-            Side::Upper => {
-                if s[j] > mult_tol {
-                    return None;
-                }
-                z_u[j] = (-s[j]).max(0.0);
-            }
+        match w.vars[j] {
+            // Stationarity holds for free variables by construction; a large residual
+            // means the solve failed.
+            Side::Free if s[j].abs() > 1e-8 * grad_max => return None,
+            Side::Free => {}
+            Side::Lower if s[j] < -mult_tol => return None,
+            Side::Lower => z_l[j] = s[j].max(0.0),
+            Side::Upper if s[j] > mult_tol => return None,
+            Side::Upper => z_u[j] = (-s[j]).max(0.0),
             Side::Both => {
                 z_l[j] = s[j].max(0.0);
                 z_u[j] = (-s[j]).max(0.0);
             }
         }
     }
-    // ---- feasibility of the rows and bounds outside W, signs of W's multipliers ----
+    Some((z_l, z_u, mult_tol))
+}
+
+/// Whether the rows and bounds outside W hold at `x + d`, W's rows are met and their QP
+/// multipliers (λ_i − ρ_a·J_i d, with `jd` = J d) have the active side's sign.
+fn consistent(
+    p: &QpData,
+    w: &WorkingSet,
+    d: &[f64],
+    lambda: &[f64],
+    jd: &[f64],
+    mult_tol: f64,
+) -> bool {
     let tol = |b: f64| 1e-9 * (1.0 + b.abs());
-    let mut jd = vec![0.0; m];
-    for c in 0..n {
-        for q in jp.col_range(c) {
-            jd[jp.row_idx()[q]] += p.jac[q] * d[c];
-        }
-    }
-    for i in 0..m {
+    let rows_ok = (0..p.g.len()).all(|i| {
         let lin = p.g[i] + jd[i];
-        // The sign condition is the QP's: on its own multiplier λ_i − ρ_a·J_i d.
         let l_qp = lambda[i] - p.row_weight[i] * jd[i];
-        let ok = match row_side[i] {
+        match w.rows[i] {
             Side::Free => lin <= p.g_u[i] + tol(p.g_u[i]) && lin >= p.g_l[i] - tol(p.g_l[i]),
             Side::Upper => l_qp >= -mult_tol && (lin - p.g_u[i]).abs() <= tol(p.g_u[i]),
             Side::Lower => l_qp <= mult_tol && (lin - p.g_l[i]).abs() <= tol(p.g_l[i]),
             Side::Both => (lin - p.g_u[i]).abs() <= tol(p.g_u[i]),
-        };
-        if !ok {
-            return None;
         }
-    }
-    for j in 0..n {
-        if var_side[j] == Side::Free {
+    });
+    rows_ok
+        && (0..p.x.len()).all(|j| {
             let xn = p.x[j] + d[j];
-            if xn > p.x_u[j] + tol(p.x_u[j]) || xn < p.x_l[j] - tol(p.x_l[j]) {
-                return None;
-            }
-        }
+            w.vars[j] != Side::Free
+                || (xn <= p.x_u[j] + tol(p.x_u[j]) && xn >= p.x_l[j] - tol(p.x_l[j]))
+        })
+}
+
+/// The polished QP result, or `None` when clarabel's active set does not give a KKT point
+/// of the QP (then clarabel's solution stands). `jp`, `hp` are the patterns of
+/// `p.jac` and `p.hess`. Counts one factorisation in `n_fact`.
+pub(crate) fn polish(
+    kkt: &mut Kkt,
+    p: &QpData,
+    jp: &SymbolicSparseColMat<usize>,
+    hp: &SymbolicSparseColMat<usize>,
+    res: &QpResult,
+    n_fact: &mut usize,
+) -> Option<QpResult> {
+    let m = p.g.len();
+    if kkt.n() != p.x.len() || kkt.m() != m {
+        return None;
+    }
+    let w = WorkingSet::from_qp(p, jp, res)?;
+    let (d, lambda) = equality_qp_step(kkt, p, &w, n_fact)?;
+    let (z_l, z_u, mult_tol) = bound_multipliers(p, (jp, hp), &w, &d, &lambda)?;
+    let jd = jac_times(p, jp, &d);
+    if !consistent(p, &w, &d, &lambda, &jd, mult_tol) {
+        return None;
     }
     // A refinement, not another solution: the multipliers must agree with clarabel's.
     // They do not when the rows and bounds of W are (nearly) linearly dependent (the

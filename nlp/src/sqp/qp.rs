@@ -172,251 +172,321 @@ fn to_csc<T: Copy>(
     (colptr, rowval, payload)
 }
 
+/// The fixed structure of the QP's constraints: which sides are finite, which variables
+/// are fixed, the patterns of J and of the cone Jacobian.
+#[derive(Clone, Copy)]
+pub(crate) struct QpStructure<'a> {
+    pub jac: &'a SymbolicSparseColMat<usize>,
+    pub x_l: &'a [f64],
+    pub x_u: &'a [f64],
+    pub g_l: &'a [f64],
+    pub g_u: &'a [f64],
+    /// (offset, dimension) of each cone in the stacked cone vector.
+    pub cone_blocks: &'a [(usize, usize)],
+    /// Pattern of the cone Jacobian (rows = stacked cone entries).
+    pub cone_jac: Option<&'a SymbolicSparseColMat<usize>>,
+    /// Rows of g replaced by a cone.
+    pub skip_rows: &'a [bool],
+}
+
+/// The constraint rows of the QP (A, b's meaning, clarabel's cones) for a problem with
+/// the given Jacobian pattern, bounds and cones.
+struct ConstraintLayout {
+    rows: Vec<RowKind>,
+    /// Number of elastic variables.
+    n_e: usize,
+    cones: Vec<SupportedConeT<f64>>,
+    a_colptr: Vec<usize>,
+    a_rowval: Vec<usize>,
+    a_src: Vec<Src>,
+    /// Jacobian entries (column, storage position) of each row of g.
+    jrows: Vec<Vec<(usize, usize)>>,
+}
+
+/// Lays out A: equality rows (two elastic variables each) and fixed variables in the zero
+/// cone; inequality sides (one elastic variable each), bounds and elastic
+/// non-negativity in the nonnegative cone; then one second-order cone per affine cone
+/// (with one elastic variable on its t entry). Rows in `skip_rows` (replaced by cones)
+/// are left out.
+fn constraint_layout(st: &QpStructure) -> ConstraintLayout {
+    let QpStructure {
+        jac,
+        x_l,
+        x_u,
+        g_l,
+        g_u,
+        cone_blocks,
+        cone_jac,
+        skip_rows,
+    } = *st;
+    let n = x_l.len();
+    let m = g_l.len();
+    let mut rows = Vec::new();
+    let mut next_e = n;
+    let mut a_trip: Vec<(usize, usize, Src)> = Vec::new();
+    // Rows of g by column: collect J entries per row once.
+    let mut jrows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
+    for c in 0..n {
+        for p in jac.col_range(c) {
+            jrows[jac.row_idx()[p]].push((c, p));
+        }
+    }
+    let push_g_row = |rows: &mut Vec<RowKind>,
+                      kind: RowKind,
+                      i: usize,
+                      sign: f64,
+                      a: &mut Vec<(usize, usize, Src)>| {
+        let r = rows.len();
+        rows.push(kind);
+        for &(c, p) in &jrows[i] {
+            a.push((r, c, Src::Jac(p, sign)));
+        }
+        r
+    };
+    // Zero cone: equality rows (two elastic variables each), fixed variables.
+    for i in 0..m {
+        if skip_rows[i] || g_l[i] != g_u[i] {
+            continue;
+        }
+        let r = push_g_row(&mut rows, RowKind::EqG(i), i, 1.0, &mut a_trip);
+        a_trip.push((r, next_e, Src::Const(-1.0)));
+        a_trip.push((r, next_e + 1, Src::Const(1.0)));
+        next_e += 2;
+    }
+    for j in 0..n {
+        if x_l[j] == x_u[j] {
+            let r = rows.len();
+            rows.push(RowKind::Fixed(j));
+            a_trip.push((r, j, Src::Const(1.0)));
+        }
+    }
+    let n_zero = rows.len();
+    // Nonnegative cone.
+    for i in 0..m {
+        if skip_rows[i] || g_l[i] == g_u[i] {
+            continue;
+        }
+        if g_u[i].is_finite() {
+            let r = push_g_row(&mut rows, RowKind::UpperG(i), i, 1.0, &mut a_trip);
+            a_trip.push((r, next_e, Src::Const(-1.0)));
+            next_e += 1;
+        }
+        if g_l[i].is_finite() {
+            let r = push_g_row(&mut rows, RowKind::LowerG(i), i, -1.0, &mut a_trip);
+            a_trip.push((r, next_e, Src::Const(-1.0)));
+            next_e += 1;
+        }
+    }
+    for j in 0..n {
+        if x_l[j] == x_u[j] {
+            continue;
+        }
+        if x_u[j].is_finite() {
+            let r = rows.len();
+            rows.push(RowKind::UpperX(j));
+            a_trip.push((r, j, Src::Const(1.0)));
+        }
+        if x_l[j].is_finite() {
+            let r = rows.len();
+            rows.push(RowKind::LowerX(j));
+            a_trip.push((r, j, Src::Const(-1.0)));
+        }
+    }
+    // Cone elastic variables (one per cone, on its t entry) are allocated now so that
+    // their non-negativity rows sit in the nonnegative block.
+    let cone_e: Vec<usize> = (0..cone_blocks.len()).map(|k| next_e + k).collect();
+    next_e += cone_blocks.len();
+    for col in n..next_e {
+        let r = rows.len();
+        rows.push(RowKind::Elastic);
+        a_trip.push((r, col, Src::Const(-1.0)));
+    }
+    let n_nonneg = rows.len() - n_zero;
+    // Second-order cones: s = [t; v] + J_c d + [e_c; 0] ∈ SOC, i.e. A = −J_c, b = [t; v].
+    let mut cone_row0 = Vec::new();
+    if let Some(cj) = cone_jac {
+        let mut crows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); cj.nrows()];
+        for c in 0..n {
+            for p in cj.col_range(c) {
+                crows[cj.row_idx()[p]].push((c, p));
+            }
+        }
+        for (k, &(off, dim)) in cone_blocks.iter().enumerate() {
+            cone_row0.push(rows.len());
+            for q in 0..dim {
+                let r = rows.len();
+                rows.push(RowKind::Cone(off + q));
+                for &(c, p) in &crows[off + q] {
+                    a_trip.push((r, c, Src::ConeJac(p, -1.0)));
+                }
+                if q == 0 {
+                    a_trip.push((r, cone_e[k], Src::Const(-1.0)));
+                }
+            }
+        }
+    }
+    let n_e = next_e - n;
+    let mut cones = Vec::new();
+    if n_zero > 0 {
+        cones.push(SupportedConeT::ZeroConeT(n_zero));
+    }
+    if n_nonneg > 0 {
+        cones.push(SupportedConeT::NonnegativeConeT(n_nonneg));
+    }
+    for &(_, dim) in cone_blocks {
+        cones.push(SupportedConeT::SecondOrderConeT(dim));
+    }
+    let (a_colptr, a_rowval, a_src) = to_csc(n + n_e, a_trip);
+    ConstraintLayout {
+        rows,
+        n_e,
+        cones,
+        a_colptr,
+        a_rowval,
+        a_src,
+        jrows,
+    }
+}
+
+/// The fixed pattern of P and where the values of H, the diagonal and the augmented term
+/// go.
+struct PLayout {
+    p_colptr: Vec<usize>,
+    p_rowval: Vec<usize>,
+    h_pos: Vec<usize>,
+    diag_pos: Vec<usize>,
+    jtj: Vec<(usize, usize, usize, usize)>,
+}
+
+/// Lays out P for n variables and `ncols` QP columns (`jrows`: the Jacobian's entries by
+/// row, for the augmented term; `dense`: a full upper triangle for BFGS).
+fn p_layout(
+    hess: &SymbolicSparseColMat<usize>,
+    jrows: &[Vec<(usize, usize)>],
+    n: usize,
+    ncols: usize,
+    aug: bool,
+    dense: bool,
+) -> PLayout {
+    // ---- P: upper triangle of B (transpose of the lower Hessian pattern) + diagonal,
+    // plus (augmented-Lagrangian convexification) the pattern of JᵀJ, so that
+    // P = H + δI + ρ_a·(J_AᵀJ_A + I_b) is exactly the matrix `Convexify` certified
+    // positive definite. The pattern of JᵀJ over all rows contains that of any active
+    // subset, so it is fixed. ----
+    let mut pat: Vec<(usize, usize)> = Vec::new(); // (col, row), row ≤ col
+    if dense {
+        for j in 0..n {
+            for i in 0..=j {
+                pat.push((j, i));
+            }
+        }
+    } else {
+        for c in 0..n {
+            for p in hess.col_range(c) {
+                let r = hess.row_idx()[p];
+                pat.push((r.max(c), r.min(c)));
+            }
+            pat.push((c, c));
+        }
+    }
+    if aug {
+        for row in jrows {
+            for (a, &(ca, _)) in row.iter().enumerate() {
+                for &(cb, _) in &row[a..] {
+                    pat.push((ca.max(cb), ca.min(cb)));
+                }
+            }
+        }
+    }
+    pat.sort_unstable();
+    pat.dedup();
+    let mut p_colptr = vec![0usize; ncols + 1];
+    for &(c, _) in &pat {
+        p_colptr[c + 1] += 1;
+    }
+    for c in 0..ncols {
+        p_colptr[c + 1] += p_colptr[c];
+    }
+    let p_rowval: Vec<usize> = pat.iter().map(|&(_, r)| r).collect();
+    let pos = |r: usize, c: usize| -> usize {
+        let (r, c) = (r.min(c), r.max(c));
+        let lo = p_colptr[c];
+        lo + p_rowval[lo..p_colptr[c + 1]]
+            .binary_search(&r)
+            .expect("entry in the pattern of P")
+    };
+    let mut h_pos = vec![0usize; hess.row_idx().len()];
+    let mut diag_pos = vec![0usize; n];
+    if !dense {
+        for c in 0..n {
+            for p in hess.col_range(c) {
+                h_pos[p] = pos(hess.row_idx()[p], c);
+            }
+        }
+    }
+    for (j, dp) in diag_pos.iter_mut().enumerate() {
+        *dp = pos(j, j);
+    }
+    let mut jtj = Vec::new();
+    if aug {
+        for (i, row) in jrows.iter().enumerate() {
+            for (a, &(ca, pa)) in row.iter().enumerate() {
+                for &(cb, pb) in &row[a..] {
+                    jtj.push((i, pa, pb, pos(ca, cb)));
+                }
+            }
+        }
+    }
+    PLayout {
+        p_colptr,
+        p_rowval,
+        h_pos,
+        diag_pos,
+        jtj,
+    }
+}
+
 impl Qp {
-    /// Lays out the QP for a problem with the given patterns and bounds (fixed structure:
-    /// which sides are finite, which variables are fixed). `cone_blocks` are (offset,
-    /// dim) of each cone in the stacked cone vector, `cone_jac` the pattern of its
-    /// Jacobian (rows = stacked cone entries).
-    #[allow(clippy::too_many_arguments)]
+    /// Lays out the QP for a problem with the Hessian pattern `hess` and the constraint
+    /// structure `st`; `aug`: with the augmented term's pattern JᵀJ in P; `dense`: a full
+    /// P for BFGS.
     pub fn new(
         hess: &SymbolicSparseColMat<usize>,
-        jac: &SymbolicSparseColMat<usize>,
-        x_l: &[f64],
-        x_u: &[f64],
-        g_l: &[f64],
-        g_u: &[f64],
-        cone_blocks: &[(usize, usize)],
-        cone_jac: Option<&SymbolicSparseColMat<usize>>,
-        skip_rows: &[bool],
+        st: &QpStructure,
         aug: bool,
         dense: bool,
         tol: f64,
         max_iter: u32,
     ) -> Qp {
-        let n = x_l.len();
-        let m = g_l.len();
-        // ---- rows ----
-        let mut rows = Vec::new();
-        // Elastic columns: (row index, column, coefficient) added to A.
-        let mut elastic: Vec<(usize, f64)> = Vec::new();
-        let mut next_e = n;
-        let mut a_trip: Vec<(usize, usize, Src)> = Vec::new();
-        // Rows of g by column: collect J entries per row once.
-        let mut jrows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
-        for c in 0..n {
-            for p in jac.col_range(c) {
-                jrows[jac.row_idx()[p]].push((c, p));
-            }
-        }
-        let push_g_row = |rows: &mut Vec<RowKind>,
-                          kind: RowKind,
-                          i: usize,
-                          sign: f64,
-                          a: &mut Vec<(usize, usize, Src)>| {
-            let r = rows.len();
-            rows.push(kind);
-            for &(c, p) in &jrows[i] {
-                a.push((r, c, Src::Jac(p, sign)));
-            }
-            r
-        };
-        // Zero cone: equality rows (two elastic variables each), fixed variables.
-        for i in 0..m {
-            if skip_rows[i] || g_l[i] != g_u[i] {
-                continue;
-            }
-            let r = push_g_row(&mut rows, RowKind::EqG(i), i, 1.0, &mut a_trip);
-            a_trip.push((r, next_e, Src::Const(-1.0)));
-            a_trip.push((r, next_e + 1, Src::Const(1.0)));
-            elastic.push((next_e, 1.0));
-            elastic.push((next_e + 1, 1.0));
-            next_e += 2;
-        }
-        for j in 0..n {
-            if x_l[j] == x_u[j] {
-                let r = rows.len();
-                rows.push(RowKind::Fixed(j));
-                a_trip.push((r, j, Src::Const(1.0)));
-            }
-        }
-        let n_zero = rows.len();
-        // Nonnegative cone.
-        for i in 0..m {
-            if skip_rows[i] || g_l[i] == g_u[i] {
-                continue;
-            }
-            if g_u[i].is_finite() {
-                let r = push_g_row(&mut rows, RowKind::UpperG(i), i, 1.0, &mut a_trip);
-                a_trip.push((r, next_e, Src::Const(-1.0)));
-                elastic.push((next_e, 1.0));
-                next_e += 1;
-            }
-            if g_l[i].is_finite() {
-                let r = push_g_row(&mut rows, RowKind::LowerG(i), i, -1.0, &mut a_trip);
-                a_trip.push((r, next_e, Src::Const(-1.0)));
-                elastic.push((next_e, 1.0));
-                next_e += 1;
-            }
-        }
-        for j in 0..n {
-            if x_l[j] == x_u[j] {
-                continue;
-            }
-            if x_u[j].is_finite() {
-                let r = rows.len();
-                rows.push(RowKind::UpperX(j));
-                a_trip.push((r, j, Src::Const(1.0)));
-            }
-            if x_l[j].is_finite() {
-                let r = rows.len();
-                rows.push(RowKind::LowerX(j));
-                a_trip.push((r, j, Src::Const(-1.0)));
-            }
-        }
-        // Cone elastic variables (one per cone, on its t entry) are allocated now so that
-        // their non-negativity rows sit in the nonnegative block.
-        let cone_e: Vec<usize> = (0..cone_blocks.len()).map(|k| next_e + k).collect();
-        next_e += cone_blocks.len();
-        for col in n..next_e {
-            let r = rows.len();
-            rows.push(RowKind::Elastic);
-            a_trip.push((r, col, Src::Const(-1.0)));
-        }
-        let n_nonneg = rows.len() - n_zero;
-        // Second-order cones: s = [t; v] + J_c d + [e_c; 0] ∈ SOC, i.e. A = −J_c, b = [t; v].
-        let mut cone_row0 = Vec::new();
-        if let Some(cj) = cone_jac {
-            let mut crows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); cj.nrows()];
-            for c in 0..n {
-                for p in cj.col_range(c) {
-                    crows[cj.row_idx()[p]].push((c, p));
-                }
-            }
-            for (k, &(off, dim)) in cone_blocks.iter().enumerate() {
-                cone_row0.push(rows.len());
-                for q in 0..dim {
-                    let r = rows.len();
-                    rows.push(RowKind::Cone(off + q));
-                    for &(c, p) in &crows[off + q] {
-                        a_trip.push((r, c, Src::ConeJac(p, -1.0)));
-                    }
-                    if q == 0 {
-                        a_trip.push((r, cone_e[k], Src::Const(-1.0)));
-                    }
-                }
-            }
-        }
-        let n_e = next_e - n;
-        let _ = elastic;
-        let mut cones = Vec::new();
-        if n_zero > 0 {
-            cones.push(SupportedConeT::ZeroConeT(n_zero));
-        }
-        if n_nonneg > 0 {
-            cones.push(SupportedConeT::NonnegativeConeT(n_nonneg));
-        }
-        for &(_, dim) in cone_blocks {
-            cones.push(SupportedConeT::SecondOrderConeT(dim));
-        }
-        let ncols = n + n_e;
-        let (a_colptr, a_rowval, a_src) = to_csc(ncols, a_trip);
-        let a_vals = vec![0.0; a_src.len()];
-        // ---- P: upper triangle of B (transpose of the lower Hessian pattern) + diagonal,
-        // plus (augmented-Lagrangian convexification) the pattern of JᵀJ, so that
-        // P = H + δI + ρ_a·(J_AᵀJ_A + I_b) is exactly the matrix `Convexify` certified
-        // positive definite. The pattern of JᵀJ over all rows contains that of any active
-        // subset, so it is fixed. ----
-        let mut pat: Vec<(usize, usize)> = Vec::new(); // (col, row), row ≤ col
-        if dense {
-            for j in 0..n {
-                for i in 0..=j {
-                    pat.push((j, i));
-                }
-            }
-        } else {
-            for c in 0..n {
-                for p in hess.col_range(c) {
-                    let r = hess.row_idx()[p];
-                    pat.push((r.max(c), r.min(c)));
-                }
-                pat.push((c, c));
-            }
-        }
-        if aug {
-            for row in &jrows {
-                for (a, &(ca, _)) in row.iter().enumerate() {
-                    for &(cb, _) in &row[a..] {
-                        pat.push((ca.max(cb), ca.min(cb)));
-                    }
-                }
-            }
-        }
-        pat.sort_unstable();
-        pat.dedup();
-        let mut p_colptr = vec![0usize; ncols + 1];
-        for &(c, _) in &pat {
-            p_colptr[c + 1] += 1;
-        }
-        for c in 0..ncols {
-            p_colptr[c + 1] += p_colptr[c];
-        }
-        let p_rowval: Vec<usize> = pat.iter().map(|&(_, r)| r).collect();
-        let pos = |r: usize, c: usize| -> usize {
-            let (r, c) = (r.min(c), r.max(c));
-            let lo = p_colptr[c];
-            lo + p_rowval[lo..p_colptr[c + 1]]
-                .binary_search(&r)
-                .expect("entry in the pattern of P")
-        };
-        let mut h_pos = vec![0usize; hess.row_idx().len()];
-        let mut diag_pos = vec![0usize; n];
-        if !dense {
-            for c in 0..n {
-                for p in hess.col_range(c) {
-                    h_pos[p] = pos(hess.row_idx()[p], c);
-                }
-            }
-        }
-        for (j, dp) in diag_pos.iter_mut().enumerate() {
-            *dp = pos(j, j);
-        }
-        let mut jtj = Vec::new();
-        if aug {
-            for (i, row) in jrows.iter().enumerate() {
-                for (a, &(ca, pa)) in row.iter().enumerate() {
-                    for &(cb, pb) in &row[a..] {
-                        jtj.push((i, pa, pb, pos(ca, cb)));
-                    }
-                }
-            }
-        }
-        let p_vals = vec![0.0; p_rowval.len()];
-        let n_rows = rows.len();
+        let (n, m) = (st.x_l.len(), st.g_l.len());
+        let a = constraint_layout(st);
+        let ncols = n + a.n_e;
+        let pl = p_layout(hess, &a.jrows, n, ncols, aug, dense);
         Qp {
             n,
             m,
-            n_e,
-            rows,
-            cones,
-            p_colptr,
-            p_rowval,
-            p_vals,
-            h_pos,
-            diag_pos,
+            n_e: a.n_e,
+            b: vec![0.0; a.rows.len()],
+            rows: a.rows,
+            cones: a.cones,
+            p_vals: vec![0.0; pl.p_rowval.len()],
+            p_colptr: pl.p_colptr,
+            p_rowval: pl.p_rowval,
+            h_pos: pl.h_pos,
+            diag_pos: pl.diag_pos,
             dense,
-            a_colptr,
-            a_rowval,
-            a_vals,
-            a_src,
-            b: vec![0.0; n_rows],
+            a_vals: vec![0.0; a.a_src.len()],
+            a_colptr: a.a_colptr,
+            a_rowval: a.a_rowval,
+            a_src: a.a_src,
             q: vec![0.0; ncols],
             tol,
             max_iter,
             solver: None,
-            cone_blocks: cone_blocks.to_vec(),
+            cone_blocks: st.cone_blocks.to_vec(),
             aug,
-            jrows,
-            jtj,
+            jrows: a.jrows,
+            jtj: pl.jtj,
             jac_copy: Vec::new(),
             weight_copy: vec![0.0; m],
         }

@@ -1,0 +1,290 @@
+//! The user's problem as both back ends see it (IPOPT's `IpOrigIpoptNLP` with
+//! `IpNLPScaling`): the objective scaled by s_f and row i of g by s_g,i, every evaluation
+//! counted and timed, and the conversions of multipliers between the scaled problem and
+//! the user's units.
+//!
+//! The factors are chosen by each back end from [`ScaledNlp::unscaled_gradient_norms`]
+//! with the rules of `scaling.rs`; the IPM layers its removal of fixed variables and
+//! unbounded rows on top (`ipm/reduced.rs`).
+
+use std::time::Instant;
+
+use crate::numeric::NumericNlp;
+use crate::solution::Stats;
+
+/// Evaluation counters and time spent in user callbacks.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct EvalCounters {
+    pub f: usize,
+    pub grad_f: usize,
+    pub g: usize,
+    pub jac_g: usize,
+    pub hess_l: usize,
+    pub seconds: f64,
+}
+
+/// The user's NLP with scaling, counters and timing; x is always in the user's numbering
+/// and units (scaling changes only function values and multipliers).
+pub(crate) struct ScaledNlp<'a> {
+    user: &'a mut dyn NumericNlp,
+    /// Objective factor s_f.
+    pub obj_scale: f64,
+    /// Row factors s_g (one per row of g, 1 where not scaled).
+    pub g_scale: Vec<f64>,
+    pub counters: EvalCounters,
+    /// Scratch: the user's multipliers for the Hessian.
+    lam: Vec<f64>,
+}
+
+impl<'a> ScaledNlp<'a> {
+    /// The unscaled problem (all factors 1).
+    pub fn new(user: &'a mut dyn NumericNlp) -> Self {
+        let m = user.m();
+        ScaledNlp {
+            user,
+            obj_scale: 1.0,
+            g_scale: vec![1.0; m],
+            counters: EvalCounters::default(),
+            lam: vec![0.0; m],
+        }
+    }
+
+    /// The user's problem (evaluations through it are neither scaled nor counted).
+    pub fn user(&self) -> &dyn NumericNlp {
+        &*self.user
+    }
+
+    /// The user's problem, mutably (evaluations through it are neither scaled nor
+    /// counted: count them in `counters`).
+    pub fn user_mut(&mut self) -> &mut dyn NumericNlp {
+        self.user
+    }
+
+    /// Scaled objective s_f·f(x).
+    pub fn f(&mut self, x: &[f64]) -> f64 {
+        let t = Instant::now();
+        let v = self.user.eval_f(x) * self.obj_scale;
+        self.counters.f += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        v
+    }
+
+    /// Scaled gradient s_f·∇f(x).
+    pub fn grad(&mut self, x: &[f64], out: &mut [f64]) {
+        let t = Instant::now();
+        self.user.eval_grad_f(x, out);
+        out.iter_mut().for_each(|v| *v *= self.obj_scale);
+        self.counters.grad_f += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// Scaled rows s_g,i·g_i(x).
+    pub fn g(&mut self, x: &[f64], out: &mut [f64]) {
+        let t = Instant::now();
+        self.user.eval_g(x, out);
+        for (v, s) in out.iter_mut().zip(&self.g_scale) {
+            *v *= s;
+        }
+        self.counters.g += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// Scaled Jacobian values (row i times s_g,i), in the user's pattern order.
+    pub fn jac(&mut self, x: &[f64], out: &mut [f64]) {
+        let t = Instant::now();
+        self.user.eval_jac_g(x, out);
+        let rows = self.user.jac_g_sparsity().row_idx();
+        for (v, &r) in out.iter_mut().zip(rows) {
+            *v *= self.g_scale[r];
+        }
+        self.counters.jac_g += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// Hessian of the scaled Lagrangian σ·f̃ + λ̃ᵀg̃ for multipliers λ̃ of the scaled rows
+    /// (the user's Hessian with σ·s_f and λ̃_i·s_g,i).
+    pub fn hess(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], out: &mut [f64]) {
+        for ((l, &y), s) in self.lam.iter_mut().zip(lambda).zip(&self.g_scale) {
+            *l = y * s;
+        }
+        let t = Instant::now();
+        self.user
+            .eval_hess_l(x, obj_factor * self.obj_scale, &self.lam, out);
+        self.counters.hess_l += 1;
+        self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// The stacked affine-cone entries (not scaled; timed with the evaluations).
+    pub fn cone_entries(&mut self, x: &[f64], out: &mut [f64]) {
+        let t = Instant::now();
+        self.user.eval_cone_entries(x, out);
+        self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// The cone-entry Jacobian (not scaled; timed with the evaluations).
+    pub fn cone_jac(&mut self, x: &[f64], out: &mut [f64]) {
+        let t = Instant::now();
+        self.user.eval_cone_jac(x, out);
+        self.counters.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// Unscaled, counted evaluations for choosing the factors: max-norm of ∇f(x) over the
+    /// columns in `cols` (all when `None`) and of each row of the Jacobian over the same
+    /// columns (the Jacobian is not evaluated when there are no rows). A row with a
+    /// non-finite entry reports NaN (the gradient-based rule then leaves it unscaled).
+    pub fn unscaled_gradient_norms(&mut self, x: &[f64], cols: Option<&[bool]>) -> (f64, Vec<f64>) {
+        let (n, m) = (self.user.n(), self.user.m());
+        let keep = |j: usize| cols.is_none_or(|c| c[j]);
+        let t = Instant::now();
+        let mut grad = vec![0.0; n];
+        self.user.eval_grad_f(x, &mut grad);
+        self.counters.grad_f += 1;
+        let jp = self.user.jac_g_sparsity().clone();
+        let mut jv = vec![0.0; jp.row_idx().len()];
+        if m > 0 {
+            self.user.eval_jac_g(x, &mut jv);
+            self.counters.jac_g += 1;
+        }
+        self.counters.seconds += t.elapsed().as_secs_f64();
+        let gmax = (0..n)
+            .filter(|&j| keep(j))
+            .map(|j| grad[j].abs())
+            .fold(0.0, f64::max);
+        let mut rmax = vec![0.0f64; m];
+        for c in (0..n).filter(|&c| keep(c)) {
+            for p in jp.col_range(c) {
+                let (r, v) = (jp.row_idx()[p], jv[p].abs());
+                // NaN stays: `f64::max` would drop it at the row's next entry.
+                rmax[r] = if v.is_finite() && !rmax[r].is_nan() {
+                    rmax[r].max(v)
+                } else {
+                    f64::NAN
+                };
+            }
+        }
+        (gmax, rmax)
+    }
+
+    /// λ_i in the user's units from the multiplier `y` of scaled row i: y·s_g,i / s_f.
+    pub fn lambda_to_user(&self, i: usize, y: f64) -> f64 {
+        y * self.g_scale[i] / self.obj_scale
+    }
+
+    /// The multiplier of scaled row i from the user's λ_i: λ_i·s_f / s_g,i.
+    pub fn lambda_from_user(&self, i: usize, lambda: f64) -> f64 {
+        lambda * self.obj_scale / self.g_scale[i]
+    }
+
+    /// A bound (or cone) multiplier in the user's units: z / s_f.
+    pub fn z_to_user(&self, z: f64) -> f64 {
+        z / self.obj_scale
+    }
+
+    /// A bound multiplier of the scaled problem from the user's: z·s_f.
+    pub fn z_from_user(&self, z: f64) -> f64 {
+        z * self.obj_scale
+    }
+
+    /// Writes the evaluation counts, their time and s_f into `stats`.
+    pub fn write_stats(&self, stats: &mut Stats) {
+        let c = &self.counters;
+        stats.n_eval_f = c.f;
+        stats.n_eval_grad_f = c.grad_f;
+        stats.n_eval_g = c.g;
+        stats.n_eval_jac_g = c.jac_g;
+        stats.n_eval_hess_l = c.hess_l;
+        stats.eval_seconds = c.seconds;
+        stats.obj_scaling = self.obj_scale;
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::*;
+    use crate::{Problem, Relation};
+
+    /// f = 3x₀² + x₁, g₀ = x₀x₁ = 1, g₁ = 100x₀ + x₁ ≤ 500; derivatives by hand at
+    /// x = (2, 3): ∇f = (12, 1), J = [[3, 2], [100, 1]], ∇²f = diag(6, 0), ∇²g₀ = [[0, 1],
+    /// [1, 0]].
+    fn problem() -> crate::Compiled {
+        let mut pb = Problem::new();
+        let x = pb.variable("x", 2).unwrap();
+        pb.minimize(3.0 * x[0] * x[0] + x[1]);
+        pb.subject_to((x[0] * x[1]).eq(1.0)).unwrap();
+        pb.subject_to((100.0 * x[0] + x[1]).le(500.0)).unwrap();
+        pb.compile().unwrap()
+    }
+
+    /// Dense lower triangle of a 2×2 Hessian from pattern values.
+    fn dense(nlp: &dyn NumericNlp, v: &[f64]) -> [[f64; 2]; 2] {
+        let p = nlp.hess_l_sparsity();
+        let mut h = [[0.0; 2]; 2];
+        for c in 0..2 {
+            for q in p.col_range(c) {
+                h[p.row_idx()[q]][c] += v[q];
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn evaluations_are_scaled_counted_and_unscaled_back() {
+        let mut c = problem();
+        let mut sc = ScaledNlp::new(&mut c);
+        let x = [2.0, 3.0];
+        let (gmax, rmax) = sc.unscaled_gradient_norms(&x, None);
+        assert_eq!((gmax, rmax.clone()), (12.0, vec![3.0, 100.0]));
+        let (gmax, rmax) = sc.unscaled_gradient_norms(&x, Some(&[false, true]));
+        assert_eq!((gmax, rmax), (1.0, vec![2.0, 1.0]));
+        sc.obj_scale = 0.5;
+        sc.g_scale = vec![2.0, 0.01];
+        // Factors are powers of two or exact decimals times small integers: the scaled
+        // values below are exact, so equality is the test.
+        assert_eq!(sc.f(&x), 0.5 * 15.0);
+        let mut v = [0.0; 2];
+        sc.grad(&x, &mut v);
+        assert_eq!(v, [6.0, 0.5]);
+        sc.g(&x, &mut v);
+        assert_eq!(v, [12.0, 203.0 * 0.01]);
+        let jp = sc.user().jac_g_sparsity().clone();
+        let mut jv = vec![0.0; jp.row_idx().len()];
+        sc.jac(&x, &mut jv);
+        let want = [[3.0 * 2.0, 2.0 * 2.0], [100.0 * 0.01, 0.01]];
+        for col in 0..2 {
+            for q in jp.col_range(col) {
+                let r = jp.row_idx()[q];
+                assert_eq!(jv[q], want[r][col], "J[{r}][{col}]");
+            }
+        }
+        // σ = 2, λ̃ = (3, 7): ∇²(2·0.5·f + 3·2·g₀ + 7·0.01·g₁) = [[6, ·], [6, 0]].
+        let mut hv = vec![0.0; sc.user().hess_l_sparsity().row_idx().len()];
+        sc.hess(&x, 2.0, &[3.0, 7.0], &mut hv);
+        assert_eq!(dense(sc.user(), &hv), [[6.0, 0.0], [6.0, 0.0]]);
+        let c = &sc.counters;
+        assert_eq!((c.f, c.grad_f, c.g, c.jac_g, c.hess_l), (1, 3, 1, 3, 1));
+        // λ_user = λ̃·s_g/s_f and back; z_user = z/s_f and back.
+        assert_eq!(sc.lambda_to_user(0, 3.0), 12.0);
+        assert_eq!(sc.lambda_from_user(0, 12.0), 3.0);
+        assert_eq!(sc.z_to_user(1.5), 3.0);
+        assert_eq!(sc.z_from_user(3.0), 1.5);
+        let mut stats = Stats::default();
+        sc.write_stats(&mut stats);
+        assert_eq!((stats.n_eval_jac_g, stats.obj_scaling), (3, 0.5));
+    }
+
+    #[test]
+    fn a_row_with_a_non_finite_gradient_reports_nan() {
+        let mut pb = Problem::new();
+        let x = pb.variable("x", 2).unwrap();
+        pb.minimize(x[0] + x[1]);
+        // d/dx₀ (1/x₀) = −∞ at x₀ = 0; the second row stays finite.
+        pb.subject_to((1.0 / x[0] + x[1]).ge(0.0)).unwrap();
+        pb.subject_to((x[0] + 4.0 * x[1]).ge(0.0)).unwrap();
+        let mut c = pb.compile().unwrap();
+        let mut sc = ScaledNlp::new(&mut c);
+        let (_, rmax) = sc.unscaled_gradient_norms(&[0.0, 1.0], None);
+        assert!(rmax[0].is_nan(), "{rmax:?}");
+        assert_eq!(rmax[1], 4.0);
+    }
+}

@@ -1,0 +1,501 @@
+//! The state of one SQP solve ([`SqpState`]) — problem shape, geometry, the iterate, the
+//! Hessian's convexification, the QP, the penalty and the counters — with its set-up and
+//! the steps of an iteration that are not the QP (`subproblem.rs`) or the line search
+//! (`line_search.rs`): the stop tests, the convexified Hessian, rejecting or accepting a
+//! step.
+
+#![allow(clippy::needless_range_loop)]
+
+use std::time::Instant;
+
+use faer::sparse::SymbolicSparseColMat;
+
+use super::bfgs::bfgs_update;
+use super::convexify::{active_sets, Convexify};
+use super::geometry::Geometry;
+use super::iterate::{Iterate, Mult};
+use super::line_search::{LineSearch, Trial};
+use super::options::{HessianApproximation, SqpOptions};
+use super::qp::{Qp, QpResult, QpStructure};
+use super::stop::{StepError, Stop};
+use crate::callback::Observer;
+use crate::frontend::scaled::ScaledNlp;
+use crate::frontend::user_solution::{user_solution, ConeDuals, UserPoint};
+use crate::frontend::validate::Validated;
+use crate::frontend::{KktResiduals, Termination};
+use crate::kkt::Kkt;
+use crate::numeric::NumericNlp;
+use crate::scaling::gradient_scale;
+use crate::solution::{IterationRecord, Solution, Stats, Status};
+
+/// Sizes and sparsity patterns of the problem, fixed for the solve.
+pub(super) struct Shape {
+    pub n: usize,
+    pub m: usize,
+    /// Length of the stacked cone vector.
+    pub n_cone: usize,
+    pub jp: SymbolicSparseColMat<usize>,
+    pub hp: SymbolicSparseColMat<usize>,
+    /// Pattern of the cone Jacobian (rows: stacked cone entries).
+    pub cp: Option<SymbolicSparseColMat<usize>>,
+    /// (offset, dimension) of each cone in the stacked cone vector.
+    pub block: Vec<(usize, usize)>,
+    /// Dense damped BFGS instead of the exact Hessian.
+    pub dense: bool,
+}
+
+/// The Hessian term B of the QP and how it was convexified.
+pub(super) struct Curvature {
+    /// Lower-triangular ∇²L values.
+    pub hv: Vec<f64>,
+    /// Dense B, column-major (BFGS only; empty otherwise).
+    pub bfgs: Vec<f64>,
+    /// ρ_a on the active rows, 0 elsewhere.
+    pub row_weight: Vec<f64>,
+    /// ρ_a on the active bounds, 0 elsewhere.
+    pub bound_weight: Vec<f64>,
+    pub rho_a_last: f64,
+    pub delta_last: f64,
+    /// Proximal shift added after rejected or heavily cut steps.
+    pub extra_shift: f64,
+}
+
+/// Work counters for `Stats`.
+#[derive(Default)]
+pub(super) struct Work {
+    pub n_qp: usize,
+    pub qp_iterations: u64,
+    pub qp_seconds: f64,
+    pub factor_seconds: f64,
+    pub n_fact: usize,
+    pub n_polished: usize,
+}
+
+/// Everything one SQP solve carries from iteration to iteration.
+pub(super) struct SqpState<'a> {
+    pub o: &'a SqpOptions,
+    pub sc: ScaledNlp<'a>,
+    /// The user's bounds and starting point.
+    pub user: Validated,
+    pub shape: Shape,
+    pub geo: Geometry,
+    pub it: Iterate,
+    pub curv: Curvature,
+    /// KKT matrix for the convexity test and polishing (`None` with BFGS).
+    pub kkt: Option<Kkt>,
+    pub qp: Qp,
+    /// ℓ1 penalty ρ.
+    pub rho: f64,
+    /// Merit weights w_i.
+    pub merit_w: Vec<f64>,
+    pub work: Work,
+    pub stats: Stats,
+    /// The row of the iteration log being filled.
+    pub record: IterationRecord,
+    /// Consecutive rejected steps.
+    pub ls_failures: usize,
+    lgrad: Vec<f64>,
+}
+
+/// Scaled g and the cone entries (when there are cones) at x, counted as one evaluation.
+pub(super) fn eval_g(sc: &mut ScaledNlp<'_>, x: &[f64], g: &mut [f64], cone: &mut [f64]) {
+    sc.g(x, g);
+    if !cone.is_empty() {
+        sc.cone_entries(x, cone);
+    }
+}
+
+/// Scaled Jacobian and the cone Jacobian (when there are cones) at x.
+pub(super) fn eval_jac(sc: &mut ScaledNlp<'_>, x: &[f64], jv: &mut [f64], cv: &mut [f64]) {
+    sc.jac(x, jv);
+    if !cv.is_empty() {
+        sc.cone_jac(x, cv);
+    }
+}
+
+/// Gradient-based scaling at the starting point x (IPOPT's rule, option
+/// `gradient_scaling`; rows replaced by cones stay unscaled), and the row bounds of `geo`
+/// scaled with it.
+fn scale(sc: &mut ScaledNlp<'_>, geo: &mut Geometry, x: &[f64], o: &SqpOptions) {
+    let (max_gradient, min_value) = (o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
+    if o.gradient_scaling {
+        let (gmax, rmax) = sc.unscaled_gradient_norms(x, None);
+        sc.obj_scale = gradient_scale(gmax, max_gradient, min_value);
+        for (i, r) in rmax.into_iter().enumerate() {
+            if !geo.cone_row[i] {
+                sc.g_scale[i] = gradient_scale(r, max_gradient, min_value);
+            }
+        }
+    }
+    for (i, s) in sc.g_scale.iter().enumerate() {
+        geo.g_l[i] *= s;
+        geo.g_u[i] *= s;
+    }
+}
+
+/// A new QP laid out for `shape` and `geo` (`aug`: with the augmented term).
+pub(super) fn new_qp(shape: &Shape, geo: &Geometry, o: &SqpOptions, aug: bool) -> Qp {
+    let st = QpStructure {
+        jac: &shape.jp,
+        x_l: &geo.x_l,
+        x_u: &geo.x_u,
+        g_l: &geo.g_l,
+        g_u: &geo.g_u,
+        cone_blocks: &shape.block,
+        cone_jac: shape.cp.as_ref(),
+        skip_rows: &geo.cone_row,
+    };
+    Qp::new(&shape.hp, &st, aug, shape.dense, o.qp_tol, o.qp_max_iter)
+}
+
+impl<'a> SqpState<'a> {
+    /// Lays out the solve, scales the problem at the (clamped) starting point and
+    /// evaluates it there; `warm` supplies the first multipliers.
+    pub fn new(
+        o: &'a SqpOptions,
+        nlp: &'a mut dyn NumericNlp,
+        v: Validated,
+        warm: Option<&Solution>,
+    ) -> Self {
+        let (n, m) = (nlp.n(), nlp.m());
+        let cones = nlp.affine_cones().to_vec();
+        let n_cone = cones.iter().map(|c| c.offset + c.dim).max().unwrap_or(0);
+        let mut cone_row = vec![false; m];
+        for c in &cones {
+            cone_row[c.row] = true;
+        }
+        let shape = Shape {
+            n,
+            m,
+            n_cone,
+            jp: nlp.jac_g_sparsity().clone(),
+            hp: nlp.hess_l_sparsity().clone(),
+            cp: nlp.cone_jac_sparsity().cloned(),
+            block: cones.iter().map(|c| (c.offset, c.dim)).collect(),
+            dense: o.hessian_approximation == HessianApproximation::DampedBfgs,
+        };
+        let mut geo = Geometry {
+            x_l: v.x_l.clone(),
+            x_u: v.x_u.clone(),
+            g_l: v.g_l.clone(),
+            g_u: v.g_u.clone(),
+            cone_row,
+            cones,
+        };
+        let mut x = v.x0.clone();
+        for j in 0..n {
+            x[j] = x[j].clamp(geo.x_l[j], geo.x_u[j]);
+        }
+        let mut sc = ScaledNlp::new(nlp);
+        let mut grad = vec![0.0; n];
+        let mut jv = vec![0.0; shape.jp.row_idx().len()];
+        let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
+        scale(&mut sc, &mut geo, &x, o);
+        let stats = Stats {
+            obj_scaling: sc.obj_scale,
+            ..Stats::default()
+        };
+        let mut g = vec![0.0; m];
+        let mut cone = vec![0.0; n_cone];
+        let f = sc.f(&x);
+        eval_g(&mut sc, &x, &mut g, &mut cone);
+        sc.grad(&x, &mut grad);
+        eval_jac(&mut sc, &x, &mut jv, &mut cv);
+        let mut mult = Mult::zeros(n, m, n_cone);
+        if let Some(p) = warm {
+            for i in 0..m {
+                mult.lambda[i] = sc.lambda_from_user(i, p.lambda[i]);
+            }
+            for j in 0..n {
+                mult.z_l[j] = sc.z_from_user(p.z_l[j]);
+                mult.z_u[j] = sc.z_from_user(p.z_u[j]);
+            }
+        }
+        let curv = Curvature {
+            hv: vec![0.0; shape.hp.row_idx().len()],
+            bfgs: if shape.dense {
+                (0..n * n)
+                    .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+                    .collect()
+            } else {
+                vec![]
+            },
+            row_weight: vec![0.0; m],
+            bound_weight: vec![0.0; n],
+            rho_a_last: 0.0,
+            delta_last: 0.0,
+            extra_shift: 0.0,
+        };
+        let record = IterationRecord {
+            iter: 0,
+            restoration: false,
+            objective: f / sc.obj_scale,
+            inf_pr: 0.0,
+            inf_du: 0.0,
+            mu: 0.0,
+            d_norm: 0.0,
+            regularization: 0.0,
+            jacobian_regularization: 0.0,
+            alpha_du: 0.0,
+            alpha_pr: 0.0,
+            alpha_pr_char: ' ',
+            ls: 0,
+        };
+        let qp = new_qp(&shape, &geo, o, false);
+        SqpState {
+            o,
+            sc,
+            user: v,
+            it: Iterate {
+                x,
+                f,
+                g,
+                cone,
+                grad,
+                jv,
+                cv,
+                mult,
+                have_mult: warm.is_some(),
+            },
+            curv,
+            kkt: None,
+            qp,
+            rho: o.penalty_init,
+            merit_w: vec![0.0; m],
+            work: Work::default(),
+            stats,
+            record,
+            ls_failures: 0,
+            lgrad: vec![0.0; n],
+            shape,
+            geo,
+        }
+    }
+
+    /// Sets up the KKT matrix of the convexity test (not with BFGS).
+    pub fn setup_kkt(&mut self) -> Result<(), StepError> {
+        let s = &self.shape;
+        if !s.dense {
+            self.kkt = Some(Kkt::new(s.n, s.m, &s.hp, &s.jp)?);
+        }
+        Ok(())
+    }
+
+    /// Logs iteration `iter`, shows it to the callback and tests for convergence and the
+    /// other stop criteria; `Some` ends the solve.
+    pub fn check(
+        &mut self,
+        iter: usize,
+        termination: &mut Termination,
+        observer: Option<&mut Observer<'_>>,
+        start: Instant,
+    ) -> Option<Stop> {
+        let o = self.o;
+        let err = self
+            .it
+            .kkt_errors(o.s_max, &self.geo, &self.shape, &mut self.lgrad);
+        let os = self.sc.obj_scale;
+        let it = &self.it;
+        self.record.iter = iter;
+        self.record.objective = it.f / os;
+        self.record.inf_pr = err.inf_pr;
+        self.record.inf_du = err.inf_du;
+        self.stats.records.push(self.record);
+        if o.print_level >= 5 {
+            if iter % 10 == 0 {
+                println!("{}", crate::log::header());
+            }
+            println!("{}", crate::log::format_record(&self.record));
+        }
+        if let Some(obs) = observer {
+            let (l, sg, cones) = (&it.mult.lambda, &self.sc.g_scale, &self.geo.cones);
+            if obs.call_sqp(&self.record, &it.x, l, sg, os, cones, &it.mult.z_cone) {
+                return Some(Stop {
+                    status: Status::UserRequestedStop,
+                    message: "stopped by the iteration callback".into(),
+                });
+            }
+        }
+        let unscaled_pr = self
+            .geo
+            .unscaled_max(&self.sc.g_scale, &it.x, &it.g, &it.cone);
+        // Without multipliers (a cold start's iteration 0) the dual error is not
+        // measured: no test, and the streak of acceptable iterates restarts.
+        let residuals = KktResiduals {
+            overall: err.scaled,
+            dual: err.inf_du / os,
+            primal: unscaled_pr,
+            compl: err.compl / os,
+        };
+        if !it.have_mult {
+            *termination = Termination::default();
+            termination.set_last_objective(it.f);
+        } else if let Some(s) = termination.check(&residuals, it.f, &o.common) {
+            return Some(Stop::new(s));
+        }
+        let status = if iter >= o.max_iter {
+            Status::MaximumIterationsExceeded
+        } else if start.elapsed().as_secs_f64() > o.max_wall_time {
+            Status::MaximumWallTimeExceeded
+        } else if it.x.iter().any(|v| v.abs() > o.diverging_iterates_tol) {
+            Status::DivergingIterates
+        } else {
+            return None;
+        };
+        Some(Stop::new(status))
+    }
+
+    /// Evaluates ∇²L at the iterate and convexifies it ([`Convexify`]), setting the
+    /// augmented weights; returns the shift δ (0 with BFGS, whose B is positive definite).
+    pub fn convexify(&mut self) -> Result<f64, StepError> {
+        if self.shape.dense {
+            return Ok(0.0);
+        }
+        let (it, geo, curv) = (&self.it, &self.geo, &mut self.curv);
+        let lam: Vec<f64> = (0..self.shape.m)
+            .map(|i| {
+                if geo.cone_row[i] {
+                    0.0
+                } else {
+                    it.mult.lambda[i]
+                }
+            })
+            .collect();
+        self.sc.hess(&it.x, 1.0, &lam, &mut curv.hv);
+        if curv.hv.iter().any(|v| !v.is_finite()) {
+            return Err(StepError::NonFiniteHessian);
+        }
+        let (active_r, active_b) = active_sets(geo, &it.x, &it.g, &it.mult);
+        let conv = Convexify {
+            kkt: self
+                .kkt
+                .as_mut()
+                .expect("the KKT matrix is set up before iterating"),
+            hv: &curv.hv,
+            jv: &it.jv,
+            active_r: &active_r,
+            active_b: &active_b,
+        };
+        let (delta, rho_a) = conv
+            .run(
+                self.o,
+                curv.delta_last,
+                curv.rho_a_last,
+                curv.extra_shift,
+                &mut self.work.n_fact,
+            )
+            .ok_or(StepError::NoConvexification)?;
+        curv.rho_a_last = rho_a;
+        for (w, &a) in curv.row_weight.iter_mut().zip(&active_r) {
+            *w = if a { rho_a } else { 0.0 };
+        }
+        for (w, &a) in curv.bound_weight.iter_mut().zip(&active_b) {
+            *w = if a { rho_a } else { 0.0 };
+        }
+        if rho_a > 0.0 && !self.qp.has_aug() {
+            self.qp = new_qp(&self.shape, geo, self.o, true);
+        }
+        curv.delta_last = delta;
+        Ok(delta)
+    }
+
+    /// After a failed line search: stops when the step is negligible or the searches keep
+    /// failing, otherwise shifts the next Hessian and keeps the QP's multipliers.
+    pub fn reject(&mut self, ls: &LineSearch, res: &QpResult, delta: f64) -> Option<Stop> {
+        self.ls_failures += 1;
+        let x = &self.it.x;
+        let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if ls.d_norm <= 1e-14 * (1.0 + x_max) || self.ls_failures > 8 {
+            let it = &self.it;
+            let pr = self.geo.unscaled_max(&self.sc.g_scale, x, &it.g, &it.cone);
+            let status = if pr > self.o.constr_viol_tol {
+                Status::InfeasibleProblemDetected
+            } else {
+                Status::SearchDirectionBecomesTooSmall
+            };
+            let (pred, d_norm) = (ls.pred, ls.d_norm);
+            return Some(Stop {
+                status,
+                message: format!("line search failed (pred = {pred:.3e}, ‖d‖ = {d_norm:.3e})"),
+            });
+        }
+        // Shorter, more conservative steps next time (a trust-region-like reaction).
+        let c = &mut self.curv;
+        c.extra_shift = (c.extra_shift * 10.0).max(1e-2 * (1.0 + delta));
+        // Multipliers of the QP are still the best estimate.
+        self.it.mult = Mult::from_qp(res);
+        self.it.have_mult = true;
+        None
+    }
+
+    /// Takes the accepted trial point: adapts the proximal shift to the step length,
+    /// evaluates the derivatives there and updates a BFGS matrix.
+    pub fn accept(&mut self, trial: Trial, ls: &LineSearch) -> Result<(), StepError> {
+        self.ls_failures = 0;
+        // Levenberg–Marquardt-like safeguard: a heavily cut step means the model is
+        // poor at this length, so the next step is shortened by a proximal shift;
+        // full steps relax it again.
+        let c = &mut self.curv;
+        if ls.alpha < 0.1 && !ls.soc_used {
+            c.extra_shift = (c.extra_shift * 10.0).max(1e-1);
+        } else if ls.alpha == 1.0 {
+            c.extra_shift = if c.extra_shift > 1e-6 {
+                c.extra_shift / 10.0
+            } else {
+                0.0
+            };
+        }
+        let (it, shape, cone_row) = (&mut self.it, &self.shape, &self.geo.cone_row);
+        let x_old = std::mem::replace(&mut it.x, trial.x);
+        it.f = trial.f;
+        it.g = trial.g;
+        it.cone = trial.cone;
+        it.mult = Mult::from_qp(&trial.res);
+        it.have_mult = true;
+        // ∇L at the old point with the new multipliers (BFGS only).
+        let mut l_old = vec![0.0; if shape.dense { shape.n } else { 0 }];
+        if shape.dense {
+            it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_old);
+        }
+        self.sc.grad(&it.x, &mut it.grad);
+        eval_jac(&mut self.sc, &it.x, &mut it.jv, &mut it.cv);
+        if it.grad.iter().chain(&it.jv).any(|v| !v.is_finite()) {
+            return Err(StepError::NonFiniteDerivatives);
+        }
+        if shape.dense {
+            let mut l_new = vec![0.0; shape.n];
+            it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_new);
+            let s: Vec<f64> = it.x.iter().zip(&x_old).map(|(a, b)| a - b).collect();
+            let y: Vec<f64> = l_new.iter().zip(&l_old).map(|(a, b)| a - b).collect();
+            bfgs_update(&mut self.curv.bfgs, &s, &y);
+        }
+        Ok(())
+    }
+
+    /// The solution in the user's units at the iterate, ending with `stop`.
+    pub fn user_solution(&mut self, stop: Stop) -> Solution {
+        let (sc, it) = (&self.sc, &self.it);
+        let point = UserPoint {
+            x: it.x.clone(),
+            lambda: (0..self.shape.m)
+                .map(|i| sc.lambda_to_user(i, it.mult.lambda[i]))
+                .collect(),
+            z_l: it.mult.z_l.iter().map(|&z| sc.z_to_user(z)).collect(),
+            z_u: it.mult.z_u.iter().map(|&z| sc.z_to_user(z)).collect(),
+        };
+        let z_cone: Vec<f64> = it.mult.z_cone.iter().map(|&z| sc.z_to_user(z)).collect();
+        let cones = ConeDuals {
+            cones: &self.geo.cones,
+            cone_row: &self.geo.cone_row,
+            z_cone: &z_cone,
+        };
+        user_solution(
+            &mut self.sc,
+            &self.user,
+            point,
+            Some(cones),
+            stop.status,
+            stop.message,
+        )
+    }
+}
