@@ -110,3 +110,89 @@ fn default_free_gait_uses_the_earlier_back_crossing() {
     let f = out.file.solver.objective;
     assert!(f < 1.70683e5, "free gait {f:.6e}");
 }
+
+/// The walking horizon ends `TAIL_MARGIN` stances after the last move longer than
+/// `NULL_MOVE` (a 0.5 mm move does not count), and never beyond the plan.
+#[test]
+fn walking_horizon_counts_from_the_last_real_move() {
+    use gap_crossing::crossing_search::{walking_horizon, TAIL_MARGIN};
+    let s = Scenario::default();
+    let mut plan = gait::plan_for_footholds(&s, &vec![s.start.feet; 40]);
+    for k in 5..40 {
+        plan.stances[k].feet.get_mut(Foot::BR)[0] += 0.1;
+    }
+    for k in 12..40 {
+        plan.stances[k].feet.get_mut(Foot::FL)[1] += 5e-4;
+    }
+    assert_eq!(walking_horizon(&plan), 5 + 1 + TAIL_MARGIN);
+    plan.stances[39].feet.get_mut(Foot::BL)[0] += 0.01;
+    assert_eq!(walking_horizon(&plan), 40);
+}
+
+/// A plan extended by repeating its last stance: the first stances unchanged, every
+/// later stance equal to the last, and its cost (1) the short plan's plus one last
+/// stance's cost per added stance (computed here stance by stance).
+#[test]
+fn extended_plan_repeats_its_last_stance() {
+    use gap_crossing::crossing_search::extend;
+    use gap_crossing::schedule_search::stance_cost;
+    let short = Scenario {
+        n_step: 20,
+        ..Scenario::default()
+    };
+    let long = Scenario {
+        n_step: 35,
+        ..Scenario::default()
+    };
+    let plan = gait::crawl_plan(&short);
+    let flat = extend(&plan.to_flat(), long.n_step);
+    let ext = Plan::from_flat(&long, &flat).unwrap();
+    assert_eq!(ext.stances[..20], plan.stances[..]);
+    assert!(ext.stances[20..].iter().all(|st| *st == plan.stances[19]));
+    let expected = plan.cost(&short) + 15.0 * stance_cost(&long, &plan.stances[19]);
+    let got = ext.cost(&long);
+    // Sums of the same terms in another order: rounding only.
+    assert!(
+        (got - expected).abs() <= 1e-9 * expected,
+        "{got} vs {expected}"
+    );
+}
+
+/// A long horizon (n_step 200; the default plan walks about 45 stances): the crossing
+/// candidates are solved on the walking horizon, extended, and the plan built on them
+/// is solved, passes the checker, and is cheaper than the biped-pair plan it started
+/// from.
+#[test]
+fn long_horizon_candidates_are_solved_on_the_walking_horizon() {
+    let s = Scenario {
+        n_step: 200,
+        ..Scenario::default()
+    };
+    let out = solve::plan(&s, &Settings::default()).unwrap();
+    assert!(out.status.is_solved(), "{}", out.status);
+    let report = gap_crossing::check::check(&out.file);
+    assert!(report.ok(), "{report}");
+    let crossing: Vec<&str> = out
+        .phases
+        .iter()
+        .filter(|p| p.name.starts_with("crossing search"))
+        .map(|p| p.name.as_str())
+        .collect();
+    assert!(!crossing.is_empty());
+    for name in &crossing {
+        let n: usize = name
+            .rsplit_once("(on ")
+            .and_then(|(_, r)| r.strip_suffix(" stances)"))
+            .unwrap_or_else(|| panic!("{name}: not on a shorter horizon"))
+            .parse()
+            .unwrap();
+        assert!(n < 100, "{name}");
+    }
+    let pair = out
+        .phases
+        .iter()
+        .find(|p| p.name == "free gait: biped-pair schedule")
+        .unwrap();
+    let f = out.file.solver.objective;
+    assert!(f < pair.records.last().unwrap().objective);
+}
