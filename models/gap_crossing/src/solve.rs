@@ -510,7 +510,8 @@ pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanS
 
 /// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
 /// schedule and the schedule search from the better of the two; with the reference
-/// objective without (10) ([`objective_without_10`], from the better of the crawl and pair plans as solved).
+/// objective without (10) ([`objective_without_10`], from the better of the crawl and
+/// pair plans as solved).
 fn free_gait(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
