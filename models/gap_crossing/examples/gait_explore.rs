@@ -11,7 +11,8 @@
 //! cargo run --release -p gap_crossing --example gait_explore -- mpcc pair 1e7
 //! ```
 //!
-//! - `orders O...`: periodic schedules (comma-separated feet), guess by the landing rule;
+//! - `orders O...`: periodic schedules (comma-separated feet, optionally after a prefix:
+//!   `FR,FL|BR,BL,FR,FL`), guess by the landing rule;
 //! - `even O a mB mF [w]`: each foot walks `m` even moves straight to its final foothold
 //!   (`a` m behind its goal CoM, on the circle of radius 0.5 m about it; footholds in
 //!   the keep-out snapped to its nearer edge), feet `w` m apart laterally from their
@@ -91,9 +92,27 @@ fn search(
     (cost, flat, sched)
 }
 
+/// A schedule from `PREFIX|PERIOD` (or just `PERIOD`): the prefix once, then the period
+/// repeated.
 fn parse_sched(s: &str, n: usize) -> Vec<Foot> {
-    let order: Vec<Foot> = s
-        .split(',')
+    let (prefix, period) = s.split_once('|').unwrap_or(("", s));
+    let mut out = if prefix.is_empty() {
+        Vec::new()
+    } else {
+        parse_order(prefix)
+    };
+    let order = parse_order(period);
+    let mut k = 0;
+    while out.len() < n - 1 {
+        out.push(order[k % order.len()]);
+        k += 1;
+    }
+    out.truncate(n - 1);
+    out
+}
+
+fn parse_order(s: &str) -> Vec<Foot> {
+    s.split(',')
         .map(|w| match w.trim() {
             "BR" => Foot::BR,
             "BL" => Foot::BL,
@@ -101,8 +120,7 @@ fn parse_sched(s: &str, n: usize) -> Vec<Foot> {
             "FL" => Foot::FL,
             o => panic!("{o}"),
         })
-        .collect();
-    (0..n - 1).map(|k| order[k % order.len()]).collect()
+        .collect()
 }
 
 /// Per-foot foothold sequences: `m` even moves from start to target, keep-out snapped.
