@@ -11,7 +11,8 @@
 //!   schedule;
 //! - [`terrain`], [`terrain_spec`]: the ground (gap, step, several gaps, stepping stones,
 //!   height map) as expressions and numbers, its allowed regions, and its scenario table;
-//! - [`crossing`]: the crossing search (which move of each foot first lands beyond a gap);
+//! - [`crossing`]: the crossing search's candidates (which move of each foot first lands
+//!   beyond a gap), [`crossing_search`]: solving them, on the plan's walking horizon;
 //! - [`reach`]: geometric certificates that a goal is unreachable;
 //! - [`status`]: the typed outcome of planning (solved, gap not crossable, goal not
 //!   reached, solver failed, check failed) and its exit code;
@@ -30,6 +31,7 @@
 pub mod check;
 pub mod convergence;
 pub mod crossing;
+pub mod crossing_search;
 pub mod export;
 pub mod gait;
 pub mod limits;

@@ -7,17 +7,22 @@
 //!
 //! The estimate is [`BASE_BYTES`] + [`BYTES_PER_STANCE`] · `n_step`, fitted to the peak
 //! resident memory of the release CLI (free gait, the default scenario otherwise;
-//! `/usr/bin/time -f %M`, see docs/performance.md, "Limits"), rounded up. It is compared
+//! `/usr/bin/time -f %M`; figures at [`BYTES_PER_STANCE`] and in docs/gap-crossing.md,
+//! "Size limit"), rounded up. It is compared
 //! with the memory the system reports available (`MemAvailable` of `/proc/meminfo`; when
 //! that cannot be read, [`FALLBACK_AVAILABLE_BYTES`]).
 use crate::scenario::Scenario;
 
 /// Fixed part of the memory estimate (bytes).
-pub const BASE_BYTES: u64 = 200 << 20;
+pub const BASE_BYTES: u64 = 64 << 20;
 
-/// Memory per stance (bytes): 0.48 MB per stance measured between n_step 250 and 1000,
-/// rounded up to 1 MiB for the allocator's peaks.
-pub const BYTES_PER_STANCE: u64 = 1 << 20;
+/// Memory per stance (bytes), 0.75 MiB. Peak resident memory of the release CLI, free
+/// gait, default scenario (`/usr/bin/time -f %M`, 2026-11-25, branch s6-gait): 41.5 MiB
+/// at n_step 60, 135 at 250, 260 at 500, 513–621 at 1000 (two binaries; the peak
+/// depends on which solves overlap on the threads), 915 at 2000. This estimate is
+/// 1.3–2.6× those peaks (1.31–1.59× at 1000, 1.71× at 2000), never below; the
+/// previous 200 MiB + 1 MiB per stance was 1.9–6.3×.
+pub const BYTES_PER_STANCE: u64 = 3 << 18;
 
 /// Memory assumed available when the system does not say (bytes).
 pub const FALLBACK_AVAILABLE_BYTES: u64 = 4 << 30;
@@ -45,7 +50,7 @@ fn gib(b: u64) -> String {
 }
 
 fn mib(b: u64) -> String {
-    format!("{:.1} MiB", b as f64 / (1u64 << 20) as f64)
+    format!("{:.2} MiB", b as f64 / (1u64 << 20) as f64)
 }
 
 /// Estimated peak memory of planning `n_step` stances (bytes).

@@ -23,7 +23,7 @@
 //!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::convergence::ResidualProbe;
-use crate::crossing;
+use crate::crossing_search;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
@@ -265,17 +265,17 @@ fn step_sq(x: &[f64], k: usize, i: Foot) -> f64 {
 }
 
 /// A solved candidate of the plan.
-struct Run {
-    solution: Solution,
-    flat: Vec<f64>,
-    schedule: Vec<Foot>,
+pub(crate) struct Run {
+    pub(crate) solution: Solution,
+    pub(crate) flat: Vec<f64>,
+    pub(crate) schedule: Vec<Foot>,
     /// Index of its [`Phase`].
-    phase: usize,
+    pub(crate) phase: usize,
 }
 
 impl Run {
     /// Whether this run succeeded with a lower objective than `other` (or `other` failed).
-    fn beats(&self, other: &Run) -> bool {
+    pub(crate) fn beats(&self, other: &Run) -> bool {
         self.solution.status.is_success()
             && (!other.solution.status.is_success()
                 || self.solution.objective < other.solution.objective)
@@ -284,16 +284,16 @@ impl Run {
 
 /// One scheduled solve, not yet recorded: what [`solve_scheduled`] returns, so that
 /// independent solves can run on separate threads and be logged in a fixed order.
-struct Solved {
-    name: String,
-    run: Run,
-    phase: Phase,
+pub(crate) struct Solved {
+    pub(crate) name: String,
+    pub(crate) run: Run,
+    pub(crate) phase: Phase,
 }
 
 /// Solves the scheduled problem with `schedule` from `guess` (which also fixes the sides
 /// of the keep-out zones, see [`model::build`]). Prints nothing: the solver's log is
 /// printed by [`record`], from the iteration records.
-fn solve_scheduled(
+pub(crate) fn solve_scheduled(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     schedule: &[Foot],
@@ -369,7 +369,7 @@ fn in_fresh_arena<R: Send>(f: impl FnOnce() -> R + Send) -> R {
 
 /// Appends a solve's [`Phase`] and prints its log (at the settings' print level: the
 /// iteration table from 5, the summary from 3).
-fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
+pub(crate) fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
     let level = settings.print_level();
     if level > 0 {
         println!("\n== {}", solved.name);
@@ -430,7 +430,7 @@ pub fn plan_on(
                 "crawl gait",
             )?;
             (
-                crossing_search(s, terrain, settings, first, &mut phases)?,
+                crossing_search::search(s, terrain, settings, first, &mut phases)?,
                 None,
             )
         }
@@ -519,7 +519,8 @@ pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanS
 
 /// The free gait (see the module docs): the best of the crawl schedule, the biped-pair
 /// schedule and the schedule search from the better of the two; with the reference
-/// objective without (10) ([`objective_without_10`], from the search's starting plan).
+/// objective without (10) ([`objective_without_10`], from the better of the crawl and
+/// pair plans as solved).
 fn free_gait(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
@@ -559,13 +560,21 @@ fn free_gait(
     );
     let crawl_run = record(crawl_run?, settings, phases);
     let pair_run = record(pair_run?, settings, phases);
+    // The reference without (10) starts from the better of the two plans as solved (a
+    // crossing-search plan ends in exact copies of its last stance, from which the
+    // reference stalled at n_step 300 and 1000).
+    let reference_start = if pair_run.beats(&crawl_run) {
+        pair_run.flat.clone()
+    } else {
+        crawl_run.flat.clone()
+    };
     // The crossing search ([`crossing_search`]) from the better of the two plans; the
     // schedule searches below start from its result.
     let (crawl_run, pair_run) = if pair_run.beats(&crawl_run) {
-        let pair_run = crossing_search(s, terrain, &candidate, pair_run, phases)?;
+        let pair_run = crossing_search::search(s, terrain, &candidate, pair_run, phases)?;
         (crawl_run, pair_run)
     } else {
-        let crawl_run = crossing_search(s, terrain, &candidate, crawl_run, phases)?;
+        let crawl_run = crossing_search::search(s, terrain, &candidate, crawl_run, phases)?;
         (crawl_run, pair_run)
     };
     let start = if pair_run.beats(&crawl_run) {
@@ -583,7 +592,7 @@ fn free_gait(
         || {
             rayon::join(
                 || search_from(s, terrain, &candidate, &pair_run, "biped-pair"),
-                || objective_without_10(s, terrain, &start.flat, &candidate),
+                || objective_without_10(s, terrain, &reference_start, &candidate),
             )
         },
     );
@@ -698,72 +707,6 @@ fn objective_without_10_here(
     }
     let flat = model.problem.evaluate(&model.layout, &solution.x)?;
     Ok(Some(Plan::from_flat(s, &flat)?.cost(s)))
-}
-
-/// Whether the final CoMs of a flat plan are within [`GOAL_TOL`] of their goals.
-fn reaches_goal(s: &Scenario, flat: &[f64]) -> bool {
-    Plan::from_flat(s, flat).is_ok_and(|p| {
-        p.stances.last().is_some_and(|last| {
-            Biped::ALL
-                .iter()
-                .all(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt() <= GOAL_TOL)
-        })
-    })
-}
-
-/// The crossing search ([`crate::crossing`]) from a solved run: each round solves, in
-/// parallel, every candidate in which one foot crosses a keep-out zone one move earlier,
-/// and keeps the best that succeeds with a lower objective (and reaches the goal when
-/// `best` does), for up to [`CROSSING_ROUNDS`] rounds.
-fn crossing_search(
-    s: &Scenario,
-    terrain: &(dyn Terrain + Sync),
-    settings: &Settings,
-    mut best: Run,
-    phases: &mut Vec<Phase>,
-) -> Result<Run, PlanningError> {
-    use rayon::prelude::*;
-    for round in 1..=CROSSING_ROUNDS {
-        if !best.solution.status.is_success() {
-            break;
-        }
-        let plan = Plan::from_flat(s, &best.flat)?;
-        let candidates = crossing::earlier_crossings(s, terrain, &plan, &best.schedule);
-        if candidates.is_empty() {
-            break;
-        }
-        let solved: Vec<Result<Solved, PlanningError>> = candidates
-            .par_iter()
-            .map(|c| {
-                solve_scheduled(
-                    s,
-                    terrain,
-                    &best.schedule,
-                    &c.plan.to_flat(),
-                    settings,
-                    &format!(
-                        "crossing search {round}: {} crosses at transition {}",
-                        c.foot,
-                        c.transition + 1
-                    ),
-                    false,
-                )
-            })
-            .collect();
-        let needs_goal = reaches_goal(s, &best.flat);
-        let mut improved = false;
-        for r in solved {
-            let next = record(r?, settings, phases);
-            if next.beats(&best) && (!needs_goal || reaches_goal(s, &next.flat)) {
-                best = next;
-                improved = true;
-            }
-        }
-        if !improved {
-            break;
-        }
-    }
-    Ok(best)
 }
 
 /// The solver's own status as a word (for logs and examples; the solution file holds

@@ -79,6 +79,11 @@ pub trait Terrain: Send + Sync {
     fn slope_at(&self, x: f64, y: f64) -> [f64; 2];
     /// The boxes where a foot may stand (their union; everything else is keep-out).
     fn regions(&self) -> Vec<Region>;
+    /// An upper bound on the height `h(x, y)` over the whole plane, when one is known
+    /// (`reach::stances_needed` uses it; `None`: no bound).
+    fn height_bound(&self) -> Option<f64> {
+        None
+    }
 
     /// Unit surface normal `(−h_x, −h_y, 1)/‖·‖` at a point (points up, out of the ground).
     fn normal_at(&self, x: f64, y: f64) -> [f64; 3] {
@@ -175,6 +180,10 @@ impl Terrain for GapTerrain {
     fn slope_at(&self, x: f64, _y: f64) -> [f64; 2] {
         [self.gap.slope(x), 0.0]
     }
+    /// h < 0 for a gap (depth > 0); a negative depth (a ridge) rises to at most −depth.
+    fn height_bound(&self) -> Option<f64> {
+        Some((-self.gap.depth).max(0.0))
+    }
     fn regions(&self) -> Vec<Region> {
         let (lo, hi) = self.gap.keep_out();
         vec![
@@ -212,6 +221,10 @@ impl Terrain for GapsTerrain {
     }
     fn slope_at(&self, x: f64, _y: f64) -> [f64; 2] {
         [self.gaps.iter().map(|g| g.slope(x)).sum(), 0.0]
+    }
+    /// Each gap's term is below 0, or below −depth for a ridge.
+    fn height_bound(&self) -> Option<f64> {
+        Some(self.gaps.iter().map(|g| (-g.depth).max(0.0)).sum())
     }
     fn regions(&self) -> Vec<Region> {
         let mut outs: Vec<(f64, f64)> = self.gaps.iter().map(Gap::keep_out).collect();
@@ -260,6 +273,10 @@ impl Terrain for StepTerrain {
         let a = self.steepness * (x - self.edge);
         [self.rise / PI * self.steepness / (1.0 + a * a), 0.0]
     }
+    /// h lies strictly between 0 and `rise`.
+    fn height_bound(&self) -> Option<f64> {
+        Some(self.rise.max(0.0))
+    }
     fn regions(&self) -> Vec<Region> {
         vec![
             Region::strip(f64::NEG_INFINITY, self.edge - self.margin),
@@ -287,6 +304,9 @@ impl Terrain for StonesTerrain {
     }
     fn slope_at(&self, _x: f64, _y: f64) -> [f64; 2] {
         [0.0, 0.0]
+    }
+    fn height_bound(&self) -> Option<f64> {
+        Some(0.0)
     }
     fn regions(&self) -> Vec<Region> {
         self.stones.clone()

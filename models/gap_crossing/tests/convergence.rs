@@ -26,22 +26,28 @@ fn free_gait_history_has_every_iteration_and_the_checkers_residual() {
     let out = solve::plan(&s, &Settings::default()).unwrap();
     let report = check::check(&out.file);
     assert!(report.ok(), "{report}");
-    // The runs of the free gait: crawl schedule, biped-pair schedule, then the schedule
-    // search's rounds from each (two from each on the default scenario).
+    // The runs of the free gait: crawl schedule, biped-pair schedule, the crossing
+    // search from the better of the two (on the default scenario three runs: both back
+    // feet crossing one move earlier, then the back right again), then the schedule
+    // search's rounds from each (two from the crawl plan, one from the pair plan).
     let names: Vec<&str> = out.phases.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(names.len(), 6, "{names:?}");
+    assert_eq!(names.len(), 8, "{names:?}");
     assert_eq!(names[0], "free gait: crawl schedule");
     assert_eq!(names[1], "free gait: biped-pair schedule");
     assert!(
-        names[2].starts_with("free gait: search from crawl 1"),
+        names[2..5].iter().all(|n| n.starts_with("crossing search")),
         "{names:?}"
     );
     assert!(
-        names[4].starts_with("free gait: search from biped-pair 1"),
+        names[5].starts_with("free gait: search from crawl 1"),
+        "{names:?}"
+    );
+    assert!(
+        names[7].starts_with("free gait: search from biped-pair 1"),
         "{names:?}"
     );
     let history = Convergence::from_phases(&out.phases);
-    assert_eq!(history.phases.len(), 6);
+    assert_eq!(history.phases.len(), 8);
     let mut total = 0;
     for (k, p) in out.phases.iter().enumerate() {
         // One entry per iteration (and per restoration start), in the solver's order.
@@ -86,8 +92,8 @@ fn free_gait_history_has_every_iteration_and_the_checkers_residual() {
     let svg = render::convergence_svg(&history, "t");
     assert_eq!(
         svg.matches("stroke-dasharray").count(),
-        5,
-        "five run boundaries"
+        7,
+        "seven run boundaries"
     );
     assert!(svg.contains("≡ 0"));
 }

@@ -189,7 +189,7 @@ fn uncrossable_and_too_few_stances_through_the_binary() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // 20 stances: the lower bound is 33 (8 moves per foot), the guess needs 45.
+    // 20 stances: the lower bound is 37 (9 moves per foot), the guess needs 45.
     let short = dir.join("short");
     let out = run(&[
         "solve",
@@ -205,7 +205,7 @@ fn uncrossable_and_too_few_stances_through_the_binary() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(4), "{err}");
     assert!(
-        err.contains("goal_not_reached") && err.contains("at least 33 stances"),
+        err.contains("goal_not_reached") && err.contains("at least 37 stances"),
         "{err}"
     );
     assert!(!short.join("solution.json").exists());
