@@ -17,8 +17,9 @@
 //!      improved plan, until nothing improves or [`SEARCH_ROUNDS`] rounds have run; a
 //!      re-solve that stalls ([`STALL_ITERATIONS`]) counts as failed.
 //!
-//!   Every model is built on a fresh thread, so that its symx arena is empty and freed
-//!   after the solve (`in_fresh_arena`).
+//!   Every model is built in a fresh symx arena ([`symx::with_fresh_arena`]), emptied
+//!   and freed after the solve: at n_step 1000 each build adds 1.8 million nodes, which
+//!   would otherwise stay allocated for the rest of the run.
 //!
 //!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
@@ -302,7 +303,7 @@ pub(crate) fn solve_scheduled(
     name: &str,
     stop_on_stall: bool,
 ) -> Result<Solved, PlanningError> {
-    in_fresh_arena(|| {
+    symx::with_fresh_arena(|| {
         solve_scheduled_here(s, terrain, schedule, guess, settings, name, stop_on_stall)
     })
 }
@@ -352,18 +353,6 @@ fn solve_scheduled_here(
             phase: 0,
         },
         phase,
-    })
-}
-
-/// Runs `f` on a new thread, so that the models it builds go to a fresh, empty symx
-/// expression arena (arenas are per thread and only grow), freed when it returns. At
-/// n_step 1000 each build adds 1.8 million nodes; built on the same thread, the searches'
-/// and the reference's builds worked in an arena (and hash-consing table) of up to 5.5
-/// million nodes, and the memory of every earlier model stayed allocated.
-fn in_fresh_arena<R: Send>(f: impl FnOnce() -> R + Send) -> R {
-    std::thread::scope(|scope| match scope.spawn(f).join() {
-        Ok(r) => r,
-        Err(panic) => std::panic::resume_unwind(panic),
     })
 }
 
@@ -679,7 +668,7 @@ pub fn objective_without_10(
     plan: &[f64],
     settings: &Settings,
 ) -> Result<Option<f64>, PlanningError> {
-    in_fresh_arena(|| objective_without_10_here(s, terrain, plan, settings))
+    symx::with_fresh_arena(|| objective_without_10_here(s, terrain, plan, settings))
 }
 
 /// [`objective_without_10`] on the calling thread's expression arena.
