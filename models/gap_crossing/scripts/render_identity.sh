@@ -82,6 +82,41 @@ for case in default crawl step stones hills; do
         run "render-$case" render "$out/$case/solution.json" --out "$out/render-$case"
     fi
 done
+# Convergence figures from made-up histories (the solves above have no restoration
+# phase and only scheduled runs): restoration spans, runs whose (10) residual is
+# positive, not recorded, or 0 throughout, and an empty history.
+if [ -f "$out/crawl/convergence.json" ]; then
+    for case in conv-mixed conv-empty; do
+        mkdir -p "$out/$case"
+        cp "$out/crawl/solution.json" "$out/$case/solution.json"
+    done
+    python3 - "$out/crawl/convergence.json" "$out" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+rows = c["iterations"]
+n = len(rows)
+cuts = [0, n // 3, 2 * n // 3, n - 3, n]
+c["phases"] = [
+    {"name": f"run {k} <&>", "status": "SolveSucceeded", "scheduled": k == 3,
+     "first": cuts[k], "len": cuts[k + 1] - cuts[k], "iterations": cuts[k + 1] - cuts[k] - 1}
+    for k in range(4)
+]
+for r in rows:
+    i = r["index"]
+    r["restoration"] = 10 <= i < 20 or 40 <= i < 43
+    r["residual_10"] = (1e-3 / (1 + i) if i < cuts[1] else None if i < cuts[2] else 0.0)
+    if i == 5:
+        r["objective"] = -r["objective"]
+    if i == 6:
+        r["inf_pr"] = 0.0
+json.dump(c, open(f"{sys.argv[2]}/conv-mixed/convergence.json", "w"))
+json.dump({"version": 2, "phases": [], "iterations": []},
+          open(f"{sys.argv[2]}/conv-empty/convergence.json", "w"))
+PY
+    for case in conv-mixed conv-empty; do
+        run "render-$case" render "$out/$case/solution.json" --out "$out/render-$case"
+    done
+fi
 # Sweep heat maps from fixed inputs: the small sweep above, and made-up outcomes on
 # the 3-axis grid of scenarios/sweep-gap.toml and on a 1-axis grid (every status,
 # missing objectives, a spread of times).
