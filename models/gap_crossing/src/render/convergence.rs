@@ -6,7 +6,7 @@
 //! scheduled runs the (10) residual is exactly 0 by construction; the panel says so in
 //! that run's span instead of drawing a made-up floor.
 
-use super::{esc, nice_step, ticks, FONT, MARGIN_L, WIDTH};
+use super::{esc, nice_step, svg_open, ticks, FONT, MARGIN_L, WIDTH};
 use crate::convergence::{Convergence, Iteration};
 use std::fmt::Write;
 
@@ -177,11 +177,7 @@ impl LogPanel {
 
 /// The opening `<svg>`, background, title and subtitle.
 fn header(svg: &mut String, x: &XAxis, height: f64, title: &str) {
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{height:.0}" viewBox="0 0 {WIDTH} {height:.0}">"#
-    );
-    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    svg_open(svg, WIDTH, height, "");
     let _ = writeln!(
         svg,
         r#"<text x="{:.1}" y="24" font-size="16" font-weight="bold" {FONT}>{}</text>"#,

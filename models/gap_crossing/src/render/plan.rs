@@ -1,6 +1,6 @@
 //! The plan figure: top view (x–y) above side view (x–z) of every stance.
 
-use super::{esc, fmt_tick, nice_step, ramp, ticks, FONT, MARGIN_L, MARGIN_R, WIDTH};
+use super::{esc, fmt_tick, nice_step, ramp, svg_open, ticks, FONT, MARGIN_L, MARGIN_R, WIDTH};
 use crate::plan::SolutionFile;
 use crate::scenario::{Biped, Foot, Gap, Scenario, TerrainSpec, Vec3};
 use crate::terrain::{self, Terrain};
@@ -430,12 +430,7 @@ fn ground_text(s: &Scenario) -> String {
 /// The opening `<svg>`, background, title, subtitle and both panels' clip paths.
 fn header(svg: &mut String, file: &SolutionFile, l: &Layout) {
     let s = &file.scenario;
-    let height = l.height;
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{height:.0}" viewBox="0 0 {WIDTH} {height:.0}">"#
-    );
-    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    svg_open(svg, WIDTH, l.height, "");
     let _ = writeln!(
         svg,
         r#"<text x="{MARGIN_L}" y="24" font-size="16" font-weight="bold" {FONT}>Gap crossing: {} stances, gait {}, solver {} ({}), objective {:.4e}</text>"#,

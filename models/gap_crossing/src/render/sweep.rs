@@ -1,6 +1,6 @@
 //! The sweep figure (`sweep.svg`): a heat map of a parameter sweep's points.
 
-use super::{esc, ramp, FONT};
+use super::{esc, ramp, svg_open, FONT};
 use crate::sweep::{label, Grid, PointResult};
 use std::fmt::Write as _;
 
@@ -138,12 +138,7 @@ fn cells<'a>(grid: &Grid, l: &Layout, results: &'a [PointResult]) -> Vec<Vec<&'a
 
 /// The opening `<svg>`, background, title and subtitle.
 fn header(svg: &mut String, grid: &Grid, l: &Layout, results: &[PointResult]) {
-    let (width, height) = (l.width, l.height);
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.0} {height:.0}" {FONT} font-size="12">"#
-    );
-    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    svg_open(svg, l.width, l.height, &format!(" {FONT} font-size=\"12\""));
     let ok = results.iter().filter(|r| r.ok()).count();
     let _ = writeln!(
         svg,
