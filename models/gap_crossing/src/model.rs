@@ -24,7 +24,7 @@
 //! (Leyffer, López-Calva & Nocedal 2006) with `π` a parameter of the compiled problem.
 use crate::plan::{foot_offset, STANCE_LEN};
 use crate::scenario::{Biped, Foot, Scenario};
-use crate::terrain::Terrain;
+use crate::terrain::{Region, Terrain};
 use nlp::{BuildError, Problem, Relation};
 use symx::{Expr, Matrix};
 
@@ -96,15 +96,17 @@ fn constant3(v: [f64; 3]) -> Matrix {
     Matrix::from_f64(&v)
 }
 
-/// Builds the planner for scenario `s` on `terrain`, with the variables initialised (and
-/// keep-out sides assigned) from `guess` (flat layout, 30 numbers per stance).
-pub fn build(
-    s: &Scenario,
-    terrain: &dyn Terrain,
-    formulation: &Formulation,
-    guess: &[f64],
-) -> Result<Model, ModelError> {
-    let n = s.n_step;
+/// The variables of every stance (stance 1's CoMs and feet are constants).
+struct Vars {
+    coms: Vec<[Matrix; 2]>,
+    feet: Vec<[Matrix; 4]>,
+    forces: Vec<[Matrix; 4]>,
+    /// Whether foot i got new variables at stance k (never at stance 1).
+    moved: Vec<[bool; 4]>,
+}
+
+/// Refuses a guess or a schedule of the wrong length.
+fn check_sizes(n: usize, formulation: &Formulation, guess: &[f64]) -> Result<(), ModelError> {
     if guess.len() != n * STANCE_LEN {
         return Err(ModelError::GuessLength {
             expected: n * STANCE_LEN,
@@ -119,30 +121,79 @@ pub fn build(
             });
         }
     }
-    let mut pb = Problem::new();
-    let regions = terrain.regions();
+    Ok(())
+}
 
-    // Variables, stance by stance. Stance 1: CoMs and feet are the start (constants).
-    let mut coms: Vec<[Matrix; 2]> = Vec::with_capacity(n);
-    let mut feet: Vec<[Matrix; 4]> = Vec::with_capacity(n);
-    let mut forces: Vec<[Matrix; 4]> = Vec::with_capacity(n);
-    // Whether foot i got new variables at stance k (k ≥ 1).
-    let mut moved: Vec<[bool; 4]> = Vec::with_capacity(n);
+/// The variables r_i^k of foot `i` at stance `k` (0-based), initialised from the guess
+/// and kept in the allowed region holding the guess (the keep-out as bounds on x, y).
+fn foot_variable(
+    pb: &mut Problem,
+    regions: &[Region],
+    guess: &[f64],
+    k: usize,
+    i: Foot,
+) -> Result<Matrix, ModelError> {
+    let label = k + 1;
+    let r = pb.variable(&format!("r_{}^{label}", i.name()), 3)?;
+    let off = foot_offset(k, i);
+    let g = &guess[off..off + 3];
+    pb.set_initial(&r, g)?;
+    // The region holding the guess (a guess on a region's edge, e.g. a previous solution
+    // at its bound up to the solver's bound relaxation, belongs to it): the foot stays
+    // in it, as bounds on its x and y.
+    let Some(region) = regions
+        .iter()
+        .find(|q| q.contains(g[0], g[1], KEEP_OUT_SNAP))
+    else {
+        return Err(ModelError::GuessInKeepOut {
+            foot: i.name(),
+            stance: label,
+            x: g[0],
+            y: g[1],
+        });
+    };
+    for (c, [lo, hi]) in [(0, region.x), (1, region.y)] {
+        if lo.is_finite() || hi.is_finite() {
+            pb.set_bounds(&r[c..c + 1], lo, hi)?;
+        }
+    }
+    Ok(r)
+}
+
+/// Declares the variables stance by stance — CoMs, the feet that may move (the others
+/// share the previous stance's), forces — initialised from `guess`.
+fn variables(
+    pb: &mut Problem,
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    formulation: &Formulation,
+    guess: &[f64],
+) -> Result<Vars, ModelError> {
+    let n = s.n_step;
+    let regions = terrain.regions();
+    let mut v = Vars {
+        coms: Vec::with_capacity(n),
+        feet: Vec::with_capacity(n),
+        forces: Vec::with_capacity(n),
+        moved: Vec::with_capacity(n),
+    };
     for k in 0..n {
         let label = k + 1;
         let at = |offset: usize| &guess[offset..offset + 3];
         if k == 0 {
-            coms.push([constant3(s.start.com.b), constant3(s.start.com.f)]);
-            feet.push(Foot::ALL.map(|i| constant3(s.start.feet.get(i))));
-            moved.push([false; 4]);
+            v.coms
+                .push([constant3(s.start.com.b), constant3(s.start.com.f)]);
+            v.feet
+                .push(Foot::ALL.map(|i| constant3(s.start.feet.get(i))));
+            v.moved.push([false; 4]);
         } else {
             let c = Biped::ALL.map(|j| {
-                let v = pb.variable(&format!("r_{}^{label}", j.name()), 3)?;
+                let r = pb.variable(&format!("r_{}^{label}", j.name()), 3)?;
                 let off = k * STANCE_LEN + if j == Biped::B { 0 } else { 3 };
-                pb.set_initial(&v, at(off)).map(|_| v)
+                pb.set_initial(&r, at(off)).map(|_| r)
             });
             let [cb, cf] = c;
-            coms.push([cb?, cf?]);
+            v.coms.push([cb?, cf?]);
             let mut fk: Vec<Matrix> = Vec::with_capacity(4);
             let mut mk = [false; 4];
             for i in Foot::ALL {
@@ -150,54 +201,72 @@ pub fn build(
                     Formulation::Scheduled(schedule) => schedule[k - 1] == i,
                     Formulation::Complementarity => true,
                 };
-                if !may_move {
-                    fk.push(feet[k - 1][i.index()].clone());
-                    continue;
+                if may_move {
+                    mk[i.index()] = true;
+                    fk.push(foot_variable(pb, &regions, guess, k, i)?);
+                } else {
+                    fk.push(v.feet[k - 1][i.index()].clone());
                 }
-                mk[i.index()] = true;
-                let r = pb.variable(&format!("r_{}^{label}", i.name()), 3)?;
-                let g = at(foot_offset(k, i));
-                pb.set_initial(&r, g)?;
-                // The region holding the guess (a guess on a region's edge, e.g. a
-                // previous solution at its bound up to the solver's bound relaxation,
-                // belongs to it): the foot stays in it, as bounds on its x and y.
-                let Some(region) = regions
-                    .iter()
-                    .find(|q| q.contains(g[0], g[1], KEEP_OUT_SNAP))
-                else {
-                    return Err(ModelError::GuessInKeepOut {
-                        foot: i.name(),
-                        stance: label,
-                        x: g[0],
-                        y: g[1],
-                    });
-                };
-                for (c, [lo, hi]) in [(0, region.x), (1, region.y)] {
-                    if lo.is_finite() || hi.is_finite() {
-                        pb.set_bounds(&r[c..c + 1], lo, hi)?;
-                    }
-                }
-                fk.push(r);
             }
-            feet.push([fk[0].clone(), fk[1].clone(), fk[2].clone(), fk[3].clone()]);
-            moved.push(mk);
+            v.feet
+                .push([fk[0].clone(), fk[1].clone(), fk[2].clone(), fk[3].clone()]);
+            v.moved.push(mk);
         }
         let f = Foot::ALL.map(|i| {
-            let v = pb.variable(&format!("F_{}^{label}", i.name()), 3)?;
-            pb.set_initial(&v, at(k * STANCE_LEN + 18 + 3 * i.index()))
-                .map(|_| v)
+            let r = pb.variable(&format!("F_{}^{label}", i.name()), 3)?;
+            pb.set_initial(&r, at(k * STANCE_LEN + 18 + 3 * i.index()))
+                .map(|_| r)
         });
         let [f0, f1, f2, f3] = f;
-        forces.push([f0?, f1?, f2?, f3?]);
+        v.forces.push([f0?, f1?, f2?, f3?]);
     }
+    Ok(v)
+}
 
-    for k in 0..n {
+/// (6)–(9) distances between the feet of one stance, skipped for a pair both still at
+/// the start (which the scenario validated).
+fn foot_distances(
+    pb: &mut Problem,
+    s: &Scenario,
+    label: usize,
+    feet: &[Matrix; 4],
+) -> Result<(), BuildError> {
+    let foot = |i: Foot| &feet[i.index()];
+    let pairs = [
+        ("(6) same side BR-FR", Foot::BR, Foot::FR, s.same_side_sq),
+        ("(7) same side BL-FL", Foot::BL, Foot::FL, s.same_side_sq),
+        ("(8) same biped BR-BL", Foot::BR, Foot::BL, s.same_biped_sq),
+        ("(9) same biped FR-FL", Foot::FR, Foot::FL, s.same_biped_sq),
+    ];
+    for (name, a, b, bounds) in pairs {
+        let d2 = (foot(a) - foot(b)).sumsqr();
+        if d2.value().is_some() {
+            continue;
+        }
+        pb.subject_to_named(
+            &format!("{name}, stance {label}"),
+            nlp::bounded(bounds.min, d2, bounds.max),
+        )?;
+    }
+    Ok(())
+}
+
+/// The constraints of every stance: (2), (4) for every foot, (3) and (5) for a foot
+/// that moved, (6)–(9) and (11) from stance 2 on.
+fn stance_constraints(
+    pb: &mut Problem,
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    formulation: &Formulation,
+    v: &Vars,
+) -> Result<(), BuildError> {
+    for k in 0..s.n_step {
         let label = k + 1;
-        force_balance(&mut pb, s, label, &coms[k], &feet[k], &forces[k])?;
+        force_balance(pb, s, label, &v.coms[k], &v.feet[k], &v.forces[k])?;
         for i in Foot::ALL {
-            let r = &feet[k][i.index()];
-            friction_cone(&mut pb, s, terrain, label, i, r, &forces[k][i.index()])?;
-            if k == 0 || !moved[k][i.index()] {
+            let r = &v.feet[k][i.index()];
+            friction_cone(pb, s, terrain, label, i, r, &v.forces[k][i.index()])?;
+            if k == 0 || !v.moved[k][i.index()] {
                 continue;
             }
             // (3) the foot is on the terrain: f_env = h(x, y) − z = 0.
@@ -208,7 +277,7 @@ pub fn build(
             // (5) step length, for a foot that may move (the free gait states it through
             // the bounds of its lifted step length instead).
             if let Formulation::Scheduled(_) = formulation {
-                let step = (r - &feet[k - 1][i.index()]).sumsqr();
+                let step = (r - &v.feet[k - 1][i.index()]).sumsqr();
                 pb.subject_to_named(
                     &format!("(5) step {}, stance {label}", i.name()),
                     step.le(s.step_radius_sq),
@@ -218,86 +287,111 @@ pub fn build(
         if k == 0 {
             continue;
         }
-        let foot = |i: Foot| &feet[k][i.index()];
-        let pairs = [
-            ("(6) same side BR-FR", Foot::BR, Foot::FR, s.same_side_sq),
-            ("(7) same side BL-FL", Foot::BL, Foot::FL, s.same_side_sq),
-            ("(8) same biped BR-BL", Foot::BR, Foot::BL, s.same_biped_sq),
-            ("(9) same biped FR-FL", Foot::FR, Foot::FL, s.same_biped_sq),
-        ];
-        for (name, a, b, bounds) in pairs {
-            let d2 = (foot(a) - foot(b)).sumsqr();
-            if d2.value().is_some() {
-                // Both feet still at the start, which the scenario validated.
-                continue;
-            }
-            pb.subject_to_named(
-                &format!("{name}, stance {label}"),
-                nlp::bounded(bounds.min, d2, bounds.max),
-            )?;
-        }
-        rigid_legs(&mut pb, s, label, &coms[k], &feet[k])?;
+        foot_distances(pb, s, label, &v.feet[k])?;
+        rigid_legs(pb, s, label, &v.coms[k], &v.feet[k])?;
     }
+    Ok(())
+}
 
-    // (10) in lifted form, free gait only.
+/// (10) in lifted form (free gait): per transition, step lengths
+/// `s_i^k ≥ ‖r_i^{k+1} − r_i^k‖²` bounded by (5), initialised from `guess`. Returns the
+/// step lengths and the products `s_i^k s_j^k` (i < j) for the penalty.
+fn complementarity(
+    pb: &mut Problem,
+    s: &Scenario,
+    feet: &[[Matrix; 4]],
+    guess: &[f64],
+) -> Result<(Vec<[Expr; 4]>, Vec<Expr>), BuildError> {
     let mut step_lengths = Vec::new();
-    let mut complementarity = Vec::new();
-    if *formulation == Formulation::Complementarity {
-        for k in 1..n {
-            let label = k + 1;
-            let sk = pb.variable(&format!("s^{label}"), 4)?;
-            pb.set_bounds(&sk, 0.0, s.step_radius_sq)?;
-            let mut init = [0.0; 4];
-            for i in Foot::ALL {
-                let step = (&feet[k][i.index()] - &feet[k - 1][i.index()]).sumsqr();
-                pb.subject_to_named(
-                    &format!("(10) lifted step length {}, stance {label}", i.name()),
-                    (sk[i.index()] - step).ge(0.0),
-                )?;
-                let (a, b) = (foot_offset(k - 1, i), foot_offset(k, i));
-                init[i.index()] = (0..3)
-                    .map(|d| (guess[b + d] - guess[a + d]).powi(2))
-                    .sum::<f64>();
-            }
-            pb.set_initial(&sk, &init)?;
-            for a in 0..4 {
-                for b in a + 1..4 {
-                    complementarity.push(sk[a] * sk[b]);
-                }
-            }
-            step_lengths.push([sk[0], sk[1], sk[2], sk[3]]);
+    let mut products = Vec::new();
+    for k in 1..s.n_step {
+        let label = k + 1;
+        let sk = pb.variable(&format!("s^{label}"), 4)?;
+        pb.set_bounds(&sk, 0.0, s.step_radius_sq)?;
+        let mut init = [0.0; 4];
+        for i in Foot::ALL {
+            let step = (&feet[k][i.index()] - &feet[k - 1][i.index()]).sumsqr();
+            pb.subject_to_named(
+                &format!("(10) lifted step length {}, stance {label}", i.name()),
+                (sk[i.index()] - step).ge(0.0),
+            )?;
+            let (a, b) = (foot_offset(k - 1, i), foot_offset(k, i));
+            init[i.index()] = (0..3)
+                .map(|d| (guess[b + d] - guess[a + d]).powi(2))
+                .sum::<f64>();
         }
+        pb.set_initial(&sk, &init)?;
+        for a in 0..4 {
+            for b in a + 1..4 {
+                products.push(sk[a] * sk[b]);
+            }
+        }
+        step_lengths.push([sk[0], sk[1], sk[2], sk[3]]);
     }
+    Ok((step_lengths, products))
+}
 
-    // (1) cost.
+/// (1) the cost, plus the penalty `π Σ products` when there are products (free gait);
+/// returns whether the penalty parameter [`PENALTY`] was declared.
+fn objective(
+    pb: &mut Problem,
+    s: &Scenario,
+    v: &Vars,
+    products: Vec<Expr>,
+) -> Result<bool, BuildError> {
     let mut terms = Vec::new();
-    for k in 0..n {
-        stance_cost(s, &coms[k], &forces[k], &mut terms);
+    for k in 0..s.n_step {
+        stance_cost(s, &v.coms[k], &v.forces[k], &mut terms);
     }
     let mut cost: Expr = terms.into_iter().sum();
-    let has_penalty = !complementarity.is_empty();
+    let has_penalty = !products.is_empty();
     if has_penalty {
         let penalty = pb.scalar_parameter(PENALTY)?;
         pb.set_value(penalty, &[1.0])?;
-        cost += penalty * complementarity.into_iter().sum::<Expr>();
+        cost += penalty * products.into_iter().sum::<Expr>();
     }
     pb.minimize(cost);
+    Ok(has_penalty)
+}
 
-    let mut layout = Vec::with_capacity(n * STANCE_LEN);
-    for k in 0..n {
-        for c in &coms[k] {
+/// The 30 expressions of every stance in the flat layout of [`crate::plan`].
+fn flat_layout(v: &Vars) -> Vec<Expr> {
+    let mut layout = Vec::with_capacity(v.coms.len() * STANCE_LEN);
+    for k in 0..v.coms.len() {
+        for c in &v.coms[k] {
             layout.extend_from_slice(c);
         }
-        for r in &feet[k] {
+        for r in &v.feet[k] {
             layout.extend_from_slice(r);
         }
-        for f in &forces[k] {
+        for f in &v.forces[k] {
             layout.extend_from_slice(f);
         }
     }
+    layout
+}
+
+/// Builds the planner for scenario `s` on `terrain`, with the variables initialised (and
+/// keep-out sides assigned) from `guess` (flat layout, 30 numbers per stance).
+pub fn build(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    formulation: &Formulation,
+    guess: &[f64],
+) -> Result<Model, ModelError> {
+    check_sizes(s.n_step, formulation, guess)?;
+    let mut pb = Problem::new();
+    let vars = variables(&mut pb, s, terrain, formulation, guess)?;
+    stance_constraints(&mut pb, s, terrain, formulation, &vars)?;
+    let (step_lengths, products) = if *formulation == Formulation::Complementarity {
+        complementarity(&mut pb, s, &vars.feet, guess)?
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let has_penalty = objective(&mut pb, s, &vars, products)?;
     Ok(Model {
+        layout: flat_layout(&vars),
         problem: pb,
-        layout,
         step_lengths,
         has_penalty,
     })

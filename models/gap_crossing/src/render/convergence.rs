@@ -6,7 +6,7 @@
 //! scheduled runs the (10) residual is exactly 0 by construction; the panel says so in
 //! that run's span instead of drawing a made-up floor.
 
-use super::{esc, nice_step, ticks, FONT, MARGIN_L, WIDTH};
+use super::{esc, nice_step, svg_open, ticks, FONT, MARGIN_L, WIDTH};
 use crate::convergence::{Convergence, Iteration};
 use std::fmt::Write;
 
@@ -175,32 +175,9 @@ impl LogPanel {
     }
 }
 
-/// The convergence figure of a planning run's history.
-pub fn convergence_svg(c: &Convergence, title: &str) -> String {
-    let rows = &c.iterations;
-    let x = XAxis {
-        x0: MARGIN_L + 10.0,
-        w: WIDTH - MARGIN_L - 10.0 - RIGHT,
-        n: rows.len().saturating_sub(1) as f64,
-    };
-    let panels: Vec<LogPanel> = SERIES
-        .iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let y0 = TOP + k as f64 * (PANEL_H + PANEL_GAP);
-            LogPanel::fit(y0, rows.iter().filter_map(s.get))
-        })
-        .collect();
-    let bottom = TOP + 3.0 * PANEL_H + 2.0 * PANEL_GAP;
-    let legend_y = bottom + 52.0;
-    let height = legend_y + 18.0 * (c.phases.len() + 1) as f64 + 10.0;
-
-    let mut svg = String::new();
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{height:.0}" viewBox="0 0 {WIDTH} {height:.0}">"#
-    );
-    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+/// The opening `<svg>`, background, title and subtitle.
+fn header(svg: &mut String, x: &XAxis, height: f64, title: &str) {
+    svg_open(svg, WIDTH, height, "");
     let _ = writeln!(
         svg,
         r#"<text x="{:.1}" y="24" font-size="16" font-weight="bold" {FONT}>{}</text>"#,
@@ -212,10 +189,10 @@ pub fn convergence_svg(c: &Convergence, title: &str) -> String {
         r##"<text x="{:.1}" y="42" font-size="12" fill="#555" {FONT}>per iteration of every solver run, log scales; dashed lines separate the runs (numbered, listed below)</text>"##,
         x.x0
     );
-    for (p, s) in panels.iter().zip(&SERIES) {
-        p.axes(&mut svg, &x, s.title);
-    }
-    // Restoration iterations, shaded in every panel.
+}
+
+/// Restoration iterations, shaded in every panel.
+fn restoration_shading(svg: &mut String, x: &XAxis, panels: &[LogPanel], rows: &[Iteration]) {
     let mut k = 0;
     while k < rows.len() {
         if !rows[k].restoration {
@@ -228,7 +205,7 @@ pub fn convergence_svg(c: &Convergence, title: &str) -> String {
         }
         let a = x.px(start as f64 - 0.5).max(x.x0);
         let b = x.px(k as f64 - 0.5).min(x.x0 + x.w);
-        for p in &panels {
+        for p in panels {
             let _ = writeln!(
                 svg,
                 r##"<rect x="{a:.1}" y="{:.1}" width="{:.1}" height="{PANEL_H}" fill="#f5b041" fill-opacity="0.18"/>"##,
@@ -237,14 +214,18 @@ pub fn convergence_svg(c: &Convergence, title: &str) -> String {
             );
         }
     }
-    // Iteration ticks under the last panel, grid lines through all.
+}
+
+/// Iteration ticks under the last panel (whose bottom is at `bottom`), grid lines
+/// through all, and the axis name.
+fn iteration_axis(svg: &mut String, x: &XAxis, panels: &[LogPanel], bottom: f64) {
     let step = nice_step(x.n.max(1.0), 10.0).max(1.0);
     for t in ticks(0.0, x.n.max(1.0), 10.0) {
         if (t / step).fract().abs() > 1e-9 || t > x.n {
             continue;
         }
         let px = x.px(t);
-        for p in &panels {
+        for p in panels {
             let _ = writeln!(
                 svg,
                 r##"<line x1="{px:.1}" y1="{:.1}" x2="{px:.1}" y2="{:.1}" stroke="#eee" stroke-width="0.6"/>"##,
@@ -266,7 +247,12 @@ pub fn convergence_svg(c: &Convergence, title: &str) -> String {
         x.x0 + x.w / 2.0,
         bottom + 36.0
     );
-    // Runs: boundaries, numbers, and the (10) panel's notes.
+}
+
+/// The runs: dashed boundaries, numbers above the panels, and the (10) panel's note
+/// for a run with nothing to draw there.
+fn runs(svg: &mut String, x: &XAxis, resid: &LogPanel, c: &Convergence, bottom: f64) {
+    let rows = &c.iterations;
     for (k, span) in c.phases.iter().enumerate() {
         let a = x.px(span.first as f64);
         let b = x.px((span.first + span.len).saturating_sub(1) as f64);
@@ -285,24 +271,25 @@ pub fn convergence_svg(c: &Convergence, title: &str) -> String {
             k + 1
         );
         let rows_k = &rows[span.first.min(rows.len())..(span.first + span.len).min(rows.len())];
-        let resid = &panels[2];
         if span.scheduled {
             let text = if b - a > 130.0 {
                 "≡ 0: schedule fixed"
             } else {
                 "≡ 0"
             };
-            resid.note(&mut svg, &x, (a + b) / 2.0, text);
+            resid.note(svg, x, (a + b) / 2.0, text);
         } else if rows_k.iter().all(|r| r.residual_10.is_none()) {
-            resid.note(&mut svg, &x, (a + b) / 2.0, "not recorded");
+            resid.note(svg, x, (a + b) / 2.0, "not recorded");
         } else if !rows_k.iter().any(|r| r.residual_10.is_some_and(drawable)) {
-            resid.note(&mut svg, &x, (a + b) / 2.0, "0 at every iterate");
+            resid.note(svg, x, (a + b) / 2.0, "0 at every iterate");
         }
     }
-    for (p, s) in panels.iter().zip(&SERIES) {
-        p.line(&mut svg, &x, rows, s);
-    }
-    // Legend of the runs.
+}
+
+/// The list of runs under the figure from `legend_y` down, the restoration key when
+/// there was any, and a note when nothing was recorded.
+fn legend(svg: &mut String, x: &XAxis, c: &Convergence, legend_y: f64) {
+    let rows = &c.iterations;
     for (k, span) in c.phases.iter().enumerate() {
         let _ = writeln!(
             svg,
@@ -338,6 +325,40 @@ pub fn convergence_svg(c: &Convergence, title: &str) -> String {
             TOP + PANEL_H / 2.0
         );
     }
+}
+
+/// The convergence figure of a planning run's history.
+pub fn convergence_svg(c: &Convergence, title: &str) -> String {
+    let rows = &c.iterations;
+    let x = XAxis {
+        x0: MARGIN_L + 10.0,
+        w: WIDTH - MARGIN_L - 10.0 - RIGHT,
+        n: rows.len().saturating_sub(1) as f64,
+    };
+    let panels: Vec<LogPanel> = SERIES
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let y0 = TOP + k as f64 * (PANEL_H + PANEL_GAP);
+            LogPanel::fit(y0, rows.iter().filter_map(s.get))
+        })
+        .collect();
+    let bottom = TOP + 3.0 * PANEL_H + 2.0 * PANEL_GAP;
+    let legend_y = bottom + 52.0;
+    let height = legend_y + 18.0 * (c.phases.len() + 1) as f64 + 10.0;
+
+    let mut svg = String::new();
+    header(&mut svg, &x, height, title);
+    for (p, s) in panels.iter().zip(&SERIES) {
+        p.axes(&mut svg, &x, s.title);
+    }
+    restoration_shading(&mut svg, &x, &panels, rows);
+    iteration_axis(&mut svg, &x, &panels, bottom);
+    runs(&mut svg, &x, &panels[2], c, bottom);
+    for (p, s) in panels.iter().zip(&SERIES) {
+        p.line(&mut svg, &x, rows, s);
+    }
+    legend(&mut svg, &x, c, legend_y);
     let _ = writeln!(svg, "</svg>");
     svg
 }

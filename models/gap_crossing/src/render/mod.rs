@@ -23,11 +23,23 @@ pub use html::plan_html;
 pub use plan::plan_svg;
 pub use sweep::sweep_svg;
 
+use std::fmt::Write;
+
 /// Width of every figure (px).
 pub(crate) const WIDTH: f64 = 1000.0;
 pub(crate) const MARGIN_L: f64 = 70.0;
 pub(crate) const MARGIN_R: f64 = 170.0;
 pub(crate) const FONT: &str = "font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\"";
+
+/// Opens a figure `width` × `height` px (whole pixels) with `attrs` on the `<svg>`
+/// element (empty, or starting with a space) and paints its background white.
+pub(crate) fn svg_open(svg: &mut String, width: f64, height: f64, attrs: &str) {
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.0} {height:.0}"{attrs}>"#
+    );
+    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
+}
 
 /// Viridis-like colour ramp, t in [0, 1] → `#rrggbb`.
 pub fn ramp(t: f64) -> String {

@@ -1,6 +1,6 @@
 //! The plan figure: top view (x–y) above side view (x–z) of every stance.
 
-use super::{esc, fmt_tick, nice_step, ramp, ticks, FONT, MARGIN_L, MARGIN_R, WIDTH};
+use super::{esc, fmt_tick, nice_step, ramp, svg_open, ticks, FONT, MARGIN_L, MARGIN_R, WIDTH};
 use crate::plan::SolutionFile;
 use crate::scenario::{Biped, Foot, Gap, Scenario, TerrainSpec, Vec3};
 use crate::terrain::{self, Terrain};
@@ -323,86 +323,92 @@ fn side_y(s: &Scenario) -> f64 {
     s.start.feet.to_array().iter().map(|p| p[1]).sum::<f64>() / 4.0
 }
 
-/// The plan figure (top view above side view) of a solution file.
-pub fn plan_svg(file: &SolutionFile) -> String {
-    let s = &file.scenario;
-    let st = &file.stances;
-    let n = st.len().max(1);
-    let colour = |k: usize| {
-        ramp(if n > 1 {
-            k as f64 / (n - 1) as f64
-        } else {
-            0.0
-        })
-    };
+/// The colour of stance `k` of `n`: the ramp from first to last.
+fn stance_colour(k: usize, n: usize) -> String {
+    ramp(if n > 1 {
+        k as f64 / (n - 1) as f64
+    } else {
+        0.0
+    })
+}
 
-    // Data ranges over every point drawn.
-    let mut pts: Vec<Vec3> = Vec::new();
-    for x in st {
-        pts.extend(x.feet.to_array());
-        pts.push(x.com.b);
-        pts.push(x.com.f);
+/// The two panels of the figure and what sets their vertical extent.
+struct Layout {
+    top: Panel,
+    side: Panel,
+    /// Height of the whole figure (px).
+    height: f64,
+    /// The deepest gap's depth (m), and the part of it the side view shows.
+    depth: f64,
+    shown_depth: f64,
+}
+
+impl Layout {
+    /// Ranges over every point drawn (stances, start feet, goals) and the terrain; one
+    /// scale for both panels, so x lines up between them.
+    fn of(file: &SolutionFile, terrain: &dyn Terrain) -> Layout {
+        let s = &file.scenario;
+        let mut pts: Vec<Vec3> = Vec::new();
+        for x in &file.stances {
+            pts.extend(x.feet.to_array());
+            pts.push(x.com.b);
+            pts.push(x.com.f);
+        }
+        pts.extend(s.start.feet.to_array());
+        pts.push(s.goal.b);
+        pts.push(s.goal.f);
+        let finite = |v: &f64| v.is_finite();
+        let xs: Vec<f64> = pts.iter().map(|p| p[0]).filter(finite).collect();
+        let ys: Vec<f64> = pts.iter().map(|p| p[1]).filter(finite).collect();
+        let zs: Vec<f64> = pts.iter().map(|p| p[2]).filter(finite).collect();
+        let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let depth = match &s.terrain {
+            TerrainSpec::Gap => s.gap.depth,
+            TerrainSpec::Gaps { gaps } => gaps.iter().map(|g| g.depth).fold(0.0, f64::max),
+            _ => 0.0,
+        };
+        let xr = (min(&xs) - 0.4, max(&xs) + 0.4);
+        let yr = (min(&ys) - 0.3, max(&ys) + 0.3);
+        let shown_depth = depth.min(1.0);
+        let (t_lo, t_hi) = terrain_range(s, terrain);
+        let zr = (
+            min(&zs)
+                .min(t_lo.max(-1.0))
+                .max(-shown_depth - 0.2)
+                .min(-shown_depth)
+                - 0.1,
+            max(&zs).max(t_hi) + 0.15,
+        );
+        let scale = (WIDTH - MARGIN_L - MARGIN_R) / (xr.1 - xr.0);
+        let top = Panel {
+            x0: MARGIN_L,
+            y0: 70.0,
+            xr,
+            yr,
+            scale,
+        };
+        let side = Panel {
+            x0: MARGIN_L,
+            y0: top.y0 + top.h() + 80.0,
+            xr,
+            yr: zr,
+            scale,
+        };
+        let height = side.y0 + side.h() + 50.0;
+        Layout {
+            top,
+            side,
+            height,
+            depth,
+            shown_depth,
+        }
     }
-    pts.extend(s.start.feet.to_array());
-    pts.push(s.goal.b);
-    pts.push(s.goal.f);
-    let finite = |v: &f64| v.is_finite();
-    let xs: Vec<f64> = pts.iter().map(|p| p[0]).filter(finite).collect();
-    let ys: Vec<f64> = pts.iter().map(|p| p[1]).filter(finite).collect();
-    let zs: Vec<f64> = pts.iter().map(|p| p[2]).filter(finite).collect();
-    let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
-    let max = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let terrain = terrain::of(s);
-    let depth = match &s.terrain {
-        TerrainSpec::Gap => s.gap.depth,
-        TerrainSpec::Gaps { gaps } => gaps.iter().map(|g| g.depth).fold(0.0, f64::max),
-        _ => 0.0,
-    };
-    let xr = (min(&xs) - 0.4, max(&xs) + 0.4);
-    let yr = (min(&ys) - 0.3, max(&ys) + 0.3);
-    let shown_depth = depth.min(1.0);
-    let (t_lo, t_hi) = terrain_range(s, &*terrain);
-    let zr = (
-        min(&zs)
-            .min(t_lo.max(-1.0))
-            .max(-shown_depth - 0.2)
-            .min(-shown_depth)
-            - 0.1,
-        max(&zs).max(t_hi) + 0.15,
-    );
-    let scale = (WIDTH - MARGIN_L - MARGIN_R) / (xr.1 - xr.0);
-    let top = Panel {
-        x0: MARGIN_L,
-        y0: 70.0,
-        xr,
-        yr,
-        scale,
-    };
-    let side = Panel {
-        x0: MARGIN_L,
-        y0: top.y0 + top.h() + 80.0,
-        xr,
-        yr: zr,
-        scale,
-    };
-    let height = side.y0 + side.h() + 50.0;
+}
 
-    let mut svg = String::new();
-    let _ = writeln!(
-        svg,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{height:.0}" viewBox="0 0 {WIDTH} {height:.0}">"#
-    );
-    let _ = writeln!(svg, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(
-        svg,
-        r#"<text x="{MARGIN_L}" y="24" font-size="16" font-weight="bold" {FONT}>Gap crossing: {} stances, gait {}, solver {} ({}), objective {:.4e}</text>"#,
-        st.len(),
-        s.gait,
-        esc(&file.solver.name),
-        esc(&file.solver.status),
-        file.solver.objective
-    );
-    let ground = match &s.terrain {
+/// One line describing the ground, for the subtitle.
+fn ground_text(s: &Scenario) -> String {
+    match &s.terrain {
         TerrainSpec::Gap => format!(
             "gap x ∈ ({}, {}) m, depth {} m, margin {} m",
             s.gap.min, s.gap.max, s.gap.depth, s.gap.margin
@@ -418,97 +424,108 @@ pub fn plan_svg(file: &SolutionFile) -> String {
             heights.first().map_or(0, Vec::len),
             heights.len()
         ),
-    };
+    }
+}
+
+/// The opening `<svg>`, background, title, subtitle and both panels' clip paths.
+fn header(svg: &mut String, file: &SolutionFile, l: &Layout) {
+    let s = &file.scenario;
+    svg_open(svg, WIDTH, l.height, "");
+    let _ = writeln!(
+        svg,
+        r#"<text x="{MARGIN_L}" y="24" font-size="16" font-weight="bold" {FONT}>Gap crossing: {} stances, gait {}, solver {} ({}), objective {:.4e}</text>"#,
+        file.stances.len(),
+        s.gait,
+        esc(&file.solver.name),
+        esc(&file.solver.status),
+        file.solver.objective
+    );
     let _ = writeln!(
         svg,
         r##"<text x="{MARGIN_L}" y="42" font-size="12" fill="#555" {FONT}>{}; pale red = keep-out; squares = front feet, circles = back feet, diamonds = CoMs; colour = stance</text>"##,
-        esc(&ground)
+        esc(&ground_text(s))
     );
     let _ = writeln!(svg, "<defs>");
-    top.clip(&mut svg, "clip-top");
-    side.clip(&mut svg, "clip-side");
+    l.top.clip(svg, "clip-top");
+    l.side.clip(svg, "clip-side");
     let _ = writeln!(svg, "</defs>");
+}
 
-    // ---- Top view.
-    top.axes(&mut svg, "x (m)", "y (m)", "Top view (x–y)");
+/// `x,y x,y …` (px, one decimal) of points already mapped to the figure.
+fn points_attr(points: impl Iterator<Item = (f64, f64)>) -> String {
+    points
+        .map(|(x, y)| format!("{x:.1},{y:.1}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Every stance's feet and CoMs as markers, then the goal CoMs; `at` maps a point to px.
+fn stance_markers(svg: &mut String, file: &SolutionFile, at: impl Fn(Vec3) -> (f64, f64)) {
+    let n = file.stances.len().max(1);
+    for (k, x) in file.stances.iter().enumerate() {
+        let c = stance_colour(k, n);
+        for i in Foot::ALL {
+            let (px, py) = at(x.feet.get(i));
+            foot_marker(svg, px, py, i, &c);
+        }
+        for j in Biped::ALL {
+            let (px, py) = at(x.com.get(j));
+            com_marker(svg, px, py, &c);
+        }
+    }
+    for j in Biped::ALL {
+        let (px, py) = at(file.scenario.goal.get(j));
+        goal_marker(svg, px, py, &format!("goal {j}"));
+    }
+}
+
+/// The top view: terrain, foot trails, CoM paths, support polygons, markers.
+fn top_view(svg: &mut String, file: &SolutionFile, top: &Panel, terrain: &dyn Terrain) {
+    let st = &file.stances;
+    let at = |p: Vec3| (top.px(p[0]), top.py(p[1]));
+    top.axes(svg, "x (m)", "y (m)", "Top view (x–y)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-top)">"##);
-    terrain_top(&mut svg, &top, s, &*terrain);
+    terrain_top(svg, top, &file.scenario, terrain);
     // Foot trails (thin grey) and CoM paths.
     for i in Foot::ALL {
-        let path: Vec<String> = st
-            .iter()
-            .map(|x| {
-                format!(
-                    "{:.1},{:.1}",
-                    top.px(x.feet.get(i)[0]),
-                    top.py(x.feet.get(i)[1])
-                )
-            })
-            .collect();
         let _ = writeln!(
             svg,
             r##"<polyline points="{}" fill="none" stroke="#999" stroke-width="0.8"/>"##,
-            path.join(" ")
+            points_attr(st.iter().map(|x| at(x.feet.get(i))))
         );
     }
     for j in Biped::ALL {
-        let path: Vec<String> = st
-            .iter()
-            .map(|x| {
-                format!(
-                    "{:.1},{:.1}",
-                    top.px(x.com.get(j)[0]),
-                    top.py(x.com.get(j)[1])
-                )
-            })
-            .collect();
         let _ = writeln!(
             svg,
             r##"<polyline points="{}" fill="none" stroke="#444" stroke-width="1" stroke-dasharray="3,2"/>"##,
-            path.join(" ")
+            points_attr(st.iter().map(|x| at(x.com.get(j))))
         );
     }
     // Support polygons BR → FR → FL → BL.
+    let n = st.len().max(1);
     for (k, x) in st.iter().enumerate() {
-        let poly: Vec<String> = [Foot::BR, Foot::FR, Foot::FL, Foot::BL]
-            .iter()
-            .map(|&i| {
-                format!(
-                    "{:.1},{:.1}",
-                    top.px(x.feet.get(i)[0]),
-                    top.py(x.feet.get(i)[1])
-                )
-            })
-            .collect();
+        let corners = [Foot::BR, Foot::FR, Foot::FL, Foot::BL];
         let _ = writeln!(
             svg,
             r#"<polygon points="{}" fill="{c}" fill-opacity="0.02" stroke="{c}" stroke-opacity="0.5" stroke-width="0.8"/>"#,
-            poly.join(" "),
-            c = colour(k)
+            points_attr(corners.iter().map(|&i| at(x.feet.get(i)))),
+            c = stance_colour(k, n)
         );
     }
-    for (k, x) in st.iter().enumerate() {
-        for i in Foot::ALL {
-            let p = x.feet.get(i);
-            foot_marker(&mut svg, top.px(p[0]), top.py(p[1]), i, &colour(k));
-        }
-        for j in Biped::ALL {
-            let p = x.com.get(j);
-            com_marker(&mut svg, top.px(p[0]), top.py(p[1]), &colour(k));
-        }
-    }
-    for j in Biped::ALL {
-        let g = s.goal.get(j);
-        goal_marker(&mut svg, top.px(g[0]), top.py(g[1]), &format!("goal {j}"));
-    }
+    stance_markers(svg, file, at);
     let _ = writeln!(svg, "</g>");
+}
 
-    // ---- Side view.
-    side.axes(&mut svg, "x (m)", "z (m)", "Side view (x–z)");
+/// The side view: terrain profile, legs (CoM to foot), markers, and a note when the
+/// gap is deeper than shown.
+fn side_view(svg: &mut String, file: &SolutionFile, l: &Layout, terrain: &dyn Terrain) {
+    let (s, side) = (&file.scenario, &l.side);
+    let (xr, zr) = (side.xr, side.yr);
+    side.axes(svg, "x (m)", "z (m)", "Side view (x–z)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-side)">"##);
     let y_side = side_y(s);
     let tx = terrain_xs(s, xr.0, xr.1);
-    terrain_side(&mut svg, &side, s, &*terrain, &tx);
+    terrain_side(svg, side, s, terrain, &tx);
     let mut d = format!("M{:.1},{:.1}", side.px(xr.0), side.py(zr.0));
     for &x in &tx {
         let _ = write!(
@@ -523,8 +540,9 @@ pub fn plan_svg(file: &SolutionFile) -> String {
         svg,
         r##"<path d="{d}" fill="#c8b08a" stroke="#6b4f2a" stroke-width="1.2"/>"##
     );
-    for (k, x) in st.iter().enumerate() {
-        let c = colour(k);
+    let n = file.stances.len().max(1);
+    for (k, x) in file.stances.iter().enumerate() {
+        let c = stance_colour(k, n);
         for i in Foot::ALL {
             let (p, q) = (x.com.get(i.biped()), x.feet.get(i));
             let _ = writeln!(
@@ -537,35 +555,23 @@ pub fn plan_svg(file: &SolutionFile) -> String {
             );
         }
     }
-    for (k, x) in st.iter().enumerate() {
-        let c = colour(k);
-        for i in Foot::ALL {
-            let p = x.feet.get(i);
-            foot_marker(&mut svg, side.px(p[0]), side.py(p[2]), i, &c);
-        }
-        for j in Biped::ALL {
-            let p = x.com.get(j);
-            com_marker(&mut svg, side.px(p[0]), side.py(p[2]), &c);
-        }
-    }
-    for j in Biped::ALL {
-        let g = s.goal.get(j);
-        goal_marker(&mut svg, side.px(g[0]), side.py(g[2]), &format!("goal {j}"));
-    }
-    if depth > shown_depth {
+    stance_markers(svg, file, |p| (side.px(p[0]), side.py(p[2])));
+    if l.depth > l.shown_depth {
         let _ = writeln!(
             svg,
             r#"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="middle" {FONT}>depth {} m (cut)</text>"#,
             side.px(edges(s).first().map_or(xr.0, |e| e.0)),
             side.py(zr.0) - 4.0,
-            depth
+            l.depth
         );
     }
     let _ = writeln!(svg, "</g>");
+}
 
-    // ---- Legend: colour bar and markers.
+/// The legend right of the top view: the stance colour bar (1 to `n_stances`) and the
+/// marker key.
+fn legend(svg: &mut String, ly: f64, n_stances: usize) {
     let lx = WIDTH - MARGIN_R + 25.0;
-    let ly = top.y0;
     let _ = writeln!(
         svg,
         r#"<text x="{lx}" y="{:.1}" font-size="12" font-weight="bold" {FONT}>stance</text>"#,
@@ -595,11 +601,15 @@ pub fn plan_svg(file: &SolutionFile) -> String {
         r#"<text x="{:.1}" y="{:.1}" font-size="11" {FONT}>{}</text><text x="{:.1}" y="{:.1}" font-size="11" {FONT}>1</text>"#,
         lx + 22.0,
         ly + 24.0,
-        st.len(),
+        n_stances,
         lx + 22.0,
         ly + 14.0 + bar_h
     );
-    let mut y = ly + bar_h + 40.0;
+    marker_key(svg, lx, ly + bar_h + 40.0);
+}
+
+/// The legend's marker key, one row per kind of mark, from `y` down.
+fn marker_key(svg: &mut String, lx: f64, mut y: f64) {
     let grey = "#bbbbbb";
     let items: [(&str, u8); 5] = [
         ("back foot (BR, BL)", 0),
@@ -610,9 +620,9 @@ pub fn plan_svg(file: &SolutionFile) -> String {
     ];
     for (label, kind) in items {
         match kind {
-            0 => foot_marker(&mut svg, lx + 8.0, y, Foot::BR, grey),
-            1 => foot_marker(&mut svg, lx + 8.0, y, Foot::FR, grey),
-            2 => com_marker(&mut svg, lx + 8.0, y, grey),
+            0 => foot_marker(svg, lx + 8.0, y, Foot::BR, grey),
+            1 => foot_marker(svg, lx + 8.0, y, Foot::FR, grey),
+            2 => com_marker(svg, lx + 8.0, y, grey),
             3 => {
                 let _ = writeln!(
                     svg,
@@ -638,6 +648,17 @@ pub fn plan_svg(file: &SolutionFile) -> String {
         );
         y += 22.0;
     }
+}
+
+/// The plan figure (top view above side view) of a solution file.
+pub fn plan_svg(file: &SolutionFile) -> String {
+    let terrain = terrain::of(&file.scenario);
+    let layout = Layout::of(file, &*terrain);
+    let mut svg = String::new();
+    header(&mut svg, file, &layout);
+    top_view(&mut svg, file, &layout.top, &*terrain);
+    side_view(&mut svg, file, &layout, &*terrain);
+    legend(&mut svg, layout.top.y0, file.stances.len());
     let _ = writeln!(svg, "</svg>");
     svg
 }
