@@ -600,7 +600,8 @@ mod tests {
     #[test]
     fn every_relation_names_its_field() {
         assert!(IpmOptions::default().validate().is_ok());
-        let cases: [(&str, fn(&mut IpmOptions)); 12] = [
+        type Case = (&'static str, fn(&mut IpmOptions));
+        let cases: [Case; 12] = [
             ("tau_min", |o| o.tau_min = 1.0),
             ("mu_min", |o| o.mu_min = 2.0 * o.mu_init),
             ("mu_max", |o| o.mu_max = 0.5 * o.mu_init),
