@@ -115,38 +115,28 @@ pub trait SolverOptions: Send + Sync + std::fmt::Debug {
     fn solver(&self) -> Box<dyn Solver>;
 }
 
-impl SolverOptions for IpmOptions {
-    fn set_options_by_name(&mut self, assignments: &[&str]) -> Result<(), OptionError> {
-        self.set_by_name(assignments)
-    }
+/// `SolverOptions` for an options struct with a `common` field, whose solver is built
+/// by `$solver::new`.
+macro_rules! impl_solver_options {
+    ($($options:ty => $solver:ident),*) => {$(
+        impl SolverOptions for $options {
+            fn set_options_by_name(&mut self, assignments: &[&str]) -> Result<(), OptionError> {
+                self.set_by_name(assignments)
+            }
 
-    fn common(&self) -> &CommonOptions {
-        &self.common
-    }
+            fn common(&self) -> &CommonOptions {
+                &self.common
+            }
 
-    fn common_mut(&mut self) -> &mut CommonOptions {
-        &mut self.common
-    }
+            fn common_mut(&mut self) -> &mut CommonOptions {
+                &mut self.common
+            }
 
-    fn solver(&self) -> Box<dyn Solver> {
-        Box::new(Ipm::new(self.clone()))
-    }
+            fn solver(&self) -> Box<dyn Solver> {
+                Box::new($solver::new(self.clone()))
+            }
+        }
+    )*};
 }
 
-impl SolverOptions for SqpOptions {
-    fn set_options_by_name(&mut self, assignments: &[&str]) -> Result<(), OptionError> {
-        self.set_by_name(assignments)
-    }
-
-    fn common(&self) -> &CommonOptions {
-        &self.common
-    }
-
-    fn common_mut(&mut self) -> &mut CommonOptions {
-        &mut self.common
-    }
-
-    fn solver(&self) -> Box<dyn Solver> {
-        Box::new(Sqp::new(self.clone()))
-    }
-}
+impl_solver_options!(IpmOptions => Ipm, SqpOptions => Sqp);
