@@ -14,7 +14,7 @@ use crate::options::IpmOptions;
 use crate::solution::Solution;
 use crate::sqp::{Sqp, SqpOptions};
 
-/// A solver of [`NumericNlp`]s: [`Ipm`](crate::Ipm) or [`Sqp`](crate::Sqp).
+/// A solver of [`NumericNlp`]s: [`Ipm`] or [`Sqp`].
 ///
 /// Implementors provide [`Solver::solve_dyn`]; the other methods are provided.
 /// ```
