@@ -35,6 +35,7 @@
 
 use std::ops::ControlFlow;
 
+use crate::frontend::scaled::ScaledNlp;
 use crate::numeric::AffineCone;
 use crate::solution::IterationRecord;
 
@@ -160,25 +161,22 @@ impl<'c> Observer<'c> {
         self.stopped
     }
 
-    /// The SQP's iterate (x already in user space, no fixed-variable reduction):
-    /// λ = λ_scaled·s_g/s_f, cone rows report the cone multiplier (as `Solution` does).
-    #[allow(clippy::too_many_arguments)]
-    pub fn call_sqp(
+    /// The SQP's iterate (x already in user space, no fixed-variable reduction) with the
+    /// multipliers of the scaled problem, unscaled by `sc`; cone rows report the cone
+    /// multiplier (as `Solution` does).
+    pub fn call_scaled(
         &mut self,
         record: &IterationRecord,
         x: &[f64],
+        sc: &ScaledNlp<'_>,
         lambda_scaled: &[f64],
-        g_scale: &[f64],
-        obj_scale: f64,
         cones: &[AffineCone],
         z_cone: &[f64],
     ) -> bool {
         self.x.copy_from_slice(x);
-        for ((l, ls), s) in self.lambda.iter_mut().zip(lambda_scaled).zip(g_scale) {
-            *l = ls * s / obj_scale;
-        }
+        sc.lambdas_to_user(lambda_scaled, &mut self.lambda);
         for c in cones {
-            self.lambda[c.row] = z_cone[c.offset] / obj_scale;
+            self.lambda[c.row] = sc.z_to_user(z_cone[c.offset]);
         }
         self.call(record)
     }

@@ -29,7 +29,7 @@ pub use constraint::{bounded, Constraint, Relation};
 pub use derivative_check::{check_derivatives, DerivativeCheckOptions, DerivativeReport};
 pub use dump::{DumpError, DumpVerification, ProblemDump};
 pub use error::SolveError;
-pub use frontend::{CommonOptions, Solver};
+pub use frontend::{CommonOptions, Solver, SolverOptions};
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;
 pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};

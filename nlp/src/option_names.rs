@@ -12,7 +12,7 @@
 //! o.set_by_name(&["tol=1e-10", "max_iter=500", "mu_strategy=adaptive"]).unwrap();
 //! assert_eq!((o.tol, o.max_iter), (1e-10, 500));
 //! let err = o.set_by_name(&["toll=1"]).unwrap_err();
-//! assert!(err.to_string().contains("unknown option 'toll'"));
+//! assert!(err.to_string().starts_with("unknown option 'toll' (did you mean 'tol'?)"));
 //! ```
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -28,8 +28,9 @@ pub enum OptionError {
     /// Not of the form `KEY=VALUE`.
     #[error("'{0}': expected KEY=VALUE")]
     Syntax(String),
-    /// No option of that name.
-    #[error("unknown option '{key}'; valid options: {valid}")]
+    /// No option of that name; the message first names the valid options nearest to it
+    /// (edit distance), if any is close.
+    #[error("unknown option '{key}'{}; valid options: {valid}", near_names(.key, .valid))]
     Unknown {
         /// The name given.
         key: String,
@@ -49,6 +50,27 @@ pub enum OptionError {
     /// The value has the right type but is out of range ([`NamedOptions::check`]).
     #[error(transparent)]
     Invalid(#[from] SolveError),
+}
+
+/// " (did you mean 'a' or 'b'?)" for the names in the comma-separated `valid` within
+/// Damerau–Levenshtein distance max(1, len/3) of `key` (nearest first, at most 3), or "".
+fn near_names(key: &str, valid: &str) -> String {
+    let limit = (key.chars().count() / 3).max(1);
+    let mut near: Vec<(usize, &str)> = valid
+        .split(", ")
+        .map(|v| (strsim::damerau_levenshtein(key, v), v))
+        .filter(|&(d, _)| d <= limit)
+        .collect();
+    near.sort();
+    near.truncate(3);
+    match near.as_slice() {
+        [] => String::new(),
+        [only] => format!(" (did you mean '{}'?)", only.1),
+        [first @ .., last] => {
+            let first: Vec<String> = first.iter().map(|(_, v)| format!("'{v}'")).collect();
+            format!(" (did you mean {} or '{}'?)", first.join(", "), last.1)
+        }
+    }
 }
 
 /// Options that can be set by name from text.
@@ -143,5 +165,33 @@ impl NamedOptions for IpmOptions {
 impl NamedOptions for SqpOptions {
     fn check(&self) -> Result<(), SolveError> {
         self.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::near_names;
+
+    #[test]
+    fn near_names_are_close_and_nearest_first() {
+        let valid = "acceptable_tol, max_iter, max_wall_time, mu_init, tol";
+        assert_eq!(near_names("toll", valid), " (did you mean 'tol'?)");
+        assert_eq!(near_names("max_itr", valid), " (did you mean 'max_iter'?)");
+        assert_eq!(near_names("mu_inti", valid), " (did you mean 'mu_init'?)");
+        assert_eq!(near_names("zzz", valid), "");
+        let valid = "bound_frac, bound_push, slack_bound_frac";
+        assert_eq!(
+            near_names("bound_fracc", valid),
+            " (did you mean 'bound_frac'?)"
+        );
+        assert_eq!(
+            near_names("bound_pash", valid),
+            " (did you mean 'bound_push'?)"
+        );
+        let valid = "tol, tal, til";
+        assert_eq!(
+            near_names("tul", valid),
+            " (did you mean 'tal', 'til' or 'tol'?)"
+        );
     }
 }

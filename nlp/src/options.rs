@@ -401,6 +401,20 @@ impl IpmOptions {
     /// Checks every option; the error names the first bad field.
     pub fn validate(&self) -> Result<(), SolveError> {
         self.common.validate()?;
+        self.check_ranges()?;
+        self.check_barrier()?;
+        self.check_globalisation()?;
+        self.check_initial_point()?;
+        self.check_linear_algebra()?;
+        self.check_quasi_newton()?;
+        if !(self.nlp_scaling_max_value >= 1.0) {
+            return Err(bad("nlp_scaling_max_value", "must be >= 1"));
+        }
+        Ok(())
+    }
+
+    /// Every number that must be positive, non-negative or in (0, 1).
+    fn check_ranges(&self) -> Result<(), SolveError> {
         macro_rules! positive {
             ($($f:ident),*) => {$(
                 if !(self.$f > 0.0) || !self.$f.is_finite() {
@@ -485,14 +499,13 @@ impl IpmOptions {
             perturb_dec_fact,
             required_infeasibility_reduction
         );
+        Ok(())
+    }
+
+    /// The barrier parameter's range and update.
+    fn check_barrier(&self) -> Result<(), SolveError> {
         if !(self.mu_superlinear_decrease_power > 1.0 && self.mu_superlinear_decrease_power < 2.0) {
             return Err(bad("mu_superlinear_decrease_power", "must be in (1, 2)"));
-        }
-        if !(self.s_phi > 1.0) || !self.s_phi.is_finite() {
-            return Err(bad("s_phi", "must be > 1"));
-        }
-        if !(self.s_theta > 1.0) || !self.s_theta.is_finite() {
-            return Err(bad("s_theta", "must be > 1"));
         }
         if self.mu_min > self.mu_init {
             return Err(bad("mu_min", "must not exceed mu_init"));
@@ -500,6 +513,25 @@ impl IpmOptions {
         if self.mu_max < self.mu_init {
             return Err(bad("mu_max", "must not be below mu_init"));
         }
+        if self.adaptive_mu_kkterror_red_iters == 0 {
+            return Err(bad("adaptive_mu_kkterror_red_iters", "must be >= 1"));
+        }
+        Ok(())
+    }
+
+    /// The filter's switching condition.
+    fn check_globalisation(&self) -> Result<(), SolveError> {
+        if !(self.s_phi > 1.0) || !self.s_phi.is_finite() {
+            return Err(bad("s_phi", "must be > 1"));
+        }
+        if !(self.s_theta > 1.0) || !self.s_theta.is_finite() {
+            return Err(bad("s_theta", "must be > 1"));
+        }
+        Ok(())
+    }
+
+    /// The push of the starting point (cold and warm) into the bounds.
+    fn check_initial_point(&self) -> Result<(), SolveError> {
         if self.bound_frac > 0.5 {
             return Err(bad("bound_frac", "must be <= 0.5"));
         }
@@ -518,6 +550,11 @@ impl IpmOptions {
                 "bound_push and bound_frac cannot both be 0",
             ));
         }
+        Ok(())
+    }
+
+    /// The inertia correction and iterative refinement of the KKT solves.
+    fn check_linear_algebra(&self) -> Result<(), SolveError> {
         if self.min_hessian_perturbation > self.max_hessian_perturbation {
             return Err(bad(
                 "min_hessian_perturbation",
@@ -530,15 +567,17 @@ impl IpmOptions {
         if self.perturb_inc_fact_first <= 1.0 {
             return Err(bad("perturb_inc_fact_first", "must be > 1"));
         }
-        if self.adaptive_mu_kkterror_red_iters == 0 {
-            return Err(bad("adaptive_mu_kkterror_red_iters", "must be >= 1"));
-        }
         if self.min_refinement_steps > self.max_refinement_steps {
             return Err(bad(
                 "min_refinement_steps",
                 "must not exceed max_refinement_steps",
             ));
         }
+        Ok(())
+    }
+
+    /// The limited-memory Hessian approximation.
+    fn check_quasi_newton(&self) -> Result<(), SolveError> {
         if self.limited_memory_init_val_min > self.limited_memory_init_val_max {
             return Err(bad(
                 "limited_memory_init_val_min",
@@ -548,9 +587,52 @@ impl IpmOptions {
         if self.limited_memory_max_skipping == 0 {
             return Err(bad("limited_memory_max_skipping", "must be >= 1"));
         }
-        if !(self.nlp_scaling_max_value >= 1.0) {
-            return Err(bad("nlp_scaling_max_value", "must be >= 1"));
-        }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each relation between options, broken alone, is refused and named: one case per
+    /// concern of `validate`.
+    #[test]
+    fn every_relation_names_its_field() {
+        assert!(IpmOptions::default().validate().is_ok());
+        type Case = (&'static str, fn(&mut IpmOptions));
+        let cases: [Case; 12] = [
+            ("tau_min", |o| o.tau_min = 1.0),
+            ("mu_min", |o| o.mu_min = 2.0 * o.mu_init),
+            ("mu_max", |o| o.mu_max = 0.5 * o.mu_init),
+            ("adaptive_mu_kkterror_red_iters", |o| {
+                o.adaptive_mu_kkterror_red_iters = 0
+            }),
+            ("s_theta", |o| o.s_theta = 1.0),
+            ("warm_start_bound_frac", |o| o.warm_start_bound_frac = 0.6),
+            ("bound_push", |o| {
+                o.bound_push = 0.0;
+                o.bound_frac = 0.0
+            }),
+            ("min_hessian_perturbation", |o| {
+                o.min_hessian_perturbation = 2.0 * o.max_hessian_perturbation
+            }),
+            ("min_refinement_steps", |o| {
+                o.min_refinement_steps = o.max_refinement_steps + 1
+            }),
+            ("limited_memory_max_skipping", |o| {
+                o.limited_memory_max_skipping = 0
+            }),
+            ("nlp_scaling_max_value", |o| o.nlp_scaling_max_value = 0.5),
+            ("kappa_d", |o| o.kappa_d = f64::NAN),
+        ];
+        for (want, set) in cases {
+            let mut o = IpmOptions::default();
+            set(&mut o);
+            match o.validate() {
+                Err(SolveError::InvalidOption { field, .. }) => assert_eq!(field, want),
+                other => panic!("{want}: {other:?}"),
+            }
+        }
     }
 }

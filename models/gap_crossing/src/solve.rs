@@ -33,10 +33,9 @@ use crate::scenario::{dist2, Biped, Foot, Gait, Scenario};
 use crate::schedule_search::{self, StanceSolver};
 use crate::status::{GoalShortfall, PlanStatus};
 use crate::terrain::{self, Terrain};
-use nlp::ipm::Ipm;
 use nlp::{
-    BuildError, IpmOptions, IterationRecord, IterationView, NamedOptions, NumericNlp, OptionError,
-    Solution, SolveError, Solver, Sqp, SqpOptions, Status,
+    BuildError, IpmOptions, IterationRecord, IterationView, NumericNlp, OptionError, Solution,
+    SolveError, Solver, SolverOptions, SqpOptions, Status,
 };
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -104,13 +103,28 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// Applies `KEY=VALUE` option assignments (IPOPT-style names, see
-    /// [`NamedOptions`]) to the chosen back end's options; on error nothing changes.
-    pub fn set_by_name<S: AsRef<str>>(&mut self, assignments: &[S]) -> Result<(), OptionError> {
+    /// The chosen back end's options (the one place that maps [`Backend`] to them).
+    pub fn options(&self) -> &dyn SolverOptions {
         match self.backend {
-            Backend::Ipm => self.ipm.set_by_name(assignments),
-            Backend::Sqp => self.sqp.set_by_name(assignments),
+            Backend::Ipm => &self.ipm,
+            Backend::Sqp => &self.sqp,
         }
+    }
+
+    /// The chosen back end's options, mutably.
+    pub fn options_mut(&mut self) -> &mut dyn SolverOptions {
+        match self.backend {
+            Backend::Ipm => &mut self.ipm,
+            Backend::Sqp => &mut self.sqp,
+        }
+    }
+
+    /// Applies `KEY=VALUE` option assignments (IPOPT-style names, see
+    /// [`nlp::NamedOptions`]) to the chosen back end's options; on error nothing
+    /// changes, and the error names the option (and the nearest valid names).
+    pub fn set_by_name<S: AsRef<str>>(&mut self, assignments: &[S]) -> Result<(), OptionError> {
+        let assignments: Vec<&str> = assignments.iter().map(AsRef::as_ref).collect();
+        self.options_mut().set_options_by_name(&assignments)
     }
 
     /// Sets the iteration-log verbosity of both back ends.
@@ -151,18 +165,12 @@ impl Settings {
     }
 
     fn print_level(&self) -> u8 {
-        match self.backend {
-            Backend::Ipm => self.ipm.print_level,
-            Backend::Sqp => self.sqp.print_level,
-        }
+        self.options().common().print_level
     }
 
     /// The chosen back end with its options.
     pub fn solver(&self) -> Box<dyn Solver> {
-        match self.backend {
-            Backend::Ipm => Box::new(Ipm::new(self.ipm.clone())),
-            Backend::Sqp => Box::new(Sqp::new(self.sqp.clone())),
-        }
+        self.options().solver()
     }
 
     fn solve(

@@ -421,12 +421,15 @@ fn solve_opt_sets_backend_options() {
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
 
-    // Unknown key: exit 2, the key named, the valid keys listed.
+    // Unknown key: exit 2, the key named, the nearest and all valid keys listed.
     let out = solve(&["--opt", "toll=1e-9"]);
     assert_eq!(out.status.code(), Some(2));
     let err = text(&out.stderr);
     assert!(
-        err.contains("toll") && err.contains("valid options") && err.contains("max_iter"),
+        err.contains("toll")
+            && err.contains("did you mean 'tol'?")
+            && err.contains("valid options")
+            && err.contains("max_iter"),
         "{err}"
     );
     // An IPM-only option with the SQP back end is unknown there.

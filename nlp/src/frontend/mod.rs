@@ -11,7 +11,8 @@
 //! - `termination`: the KKT error of an iterate (`KktResiduals`) and one
 //!   convergence test (`tol` and the `acceptable_*` options);
 //! - [`solver`]: the [`Solver`] trait both implement, through which drivers
-//!   ([`solve_mpcc`](crate::solve_mpcc), the planner) dispatch.
+//!   ([`solve_mpcc`](crate::solve_mpcc), the planner) dispatch, and [`SolverOptions`],
+//!   the same for their options (set by name, common part, solver).
 
 pub mod common_options;
 pub(crate) mod scaled;
@@ -22,5 +23,5 @@ pub(crate) mod validate;
 
 pub(crate) use common_options::strict_options_serde;
 pub use common_options::CommonOptions;
-pub use solver::Solver;
+pub use solver::{Solver, SolverOptions};
 pub(crate) use termination::{KktResiduals, Termination};

@@ -170,6 +170,26 @@ impl<'a> ScaledNlp<'a> {
         y * self.g_scale[i] / self.obj_scale
     }
 
+    /// Every λ in the user's units from the multipliers of the scaled rows
+    /// ([`ScaledNlp::lambda_to_user`] row by row) into `out`.
+    pub fn lambdas_to_user(&self, scaled: &[f64], out: &mut [f64]) {
+        for (i, (l, &y)) in out.iter_mut().zip(scaled).enumerate() {
+            *l = self.lambda_to_user(i, y);
+        }
+    }
+
+    /// A quantity in units of the objective (its value, a gradient or dual-infeasibility
+    /// entry, complementarity) in the user's units: v / s_f.
+    pub fn objective_to_user(&self, v: f64) -> f64 {
+        v / self.obj_scale
+    }
+
+    /// A quantity in units of scaled row i (its value, its violation) in the user's
+    /// units: v / s_g,i.
+    pub fn row_to_user(&self, i: usize, v: f64) -> f64 {
+        v / self.g_scale[i]
+    }
+
     /// The multiplier of scaled row i from the user's λ_i: λ_i·s_f / s_g,i.
     pub fn lambda_from_user(&self, i: usize, lambda: f64) -> f64 {
         lambda * self.obj_scale / self.g_scale[i]
@@ -268,6 +288,14 @@ mod tests {
         assert_eq!(sc.lambda_from_user(0, 12.0), 3.0);
         assert_eq!(sc.z_to_user(1.5), 3.0);
         assert_eq!(sc.z_from_user(3.0), 1.5);
+        let mut lam = [0.0; 2];
+        sc.lambdas_to_user(&[3.0, 7.0], &mut lam);
+        assert_eq!(lam, [12.0, 7.0 * 0.01 / 0.5]);
+        assert_eq!(sc.objective_to_user(1.5), 3.0);
+        assert_eq!(
+            (sc.row_to_user(0, 3.0), sc.row_to_user(1, 0.5)),
+            (1.5, 50.0)
+        );
         let mut stats = Stats::default();
         sc.write_stats(&mut stats);
         assert_eq!((stats.n_eval_jac_g, stats.obj_scaling), (3, 0.5));

@@ -4,6 +4,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use crate::frontend::scaled::ScaledNlp;
 use crate::numeric::AffineCone;
 
 /// Violation of `lo ≤ v ≤ hi`.
@@ -61,12 +62,12 @@ impl Geometry {
         s
     }
 
-    /// Max-norm violation in the user's (unscaled) units.
-    pub fn unscaled_max(&self, g_scale: &[f64], x: &[f64], g: &[f64], cone: &[f64]) -> f64 {
+    /// Max-norm violation in the user's (unscaled) units (rows unscaled by `sc`).
+    pub fn unscaled_max(&self, sc: &ScaledNlp<'_>, x: &[f64], g: &[f64], cone: &[f64]) -> f64 {
         let mut s: f64 = 0.0;
         for i in 0..g.len() {
             if !self.cone_row[i] {
-                s = s.max(viol(g[i], self.g_l[i], self.g_u[i]) / g_scale[i]);
+                s = s.max(sc.row_to_user(i, viol(g[i], self.g_l[i], self.g_u[i])));
             }
         }
         for c in &self.cones {

@@ -229,7 +229,7 @@ impl<'a> SqpState<'a> {
         let record = IterationRecord {
             iter: 0,
             restoration: false,
-            objective: f / sc.obj_scale,
+            objective: sc.objective_to_user(f),
             inf_pr: 0.0,
             inf_du: 0.0,
             mu: 0.0,
@@ -294,10 +294,9 @@ impl<'a> SqpState<'a> {
         let err = self
             .it
             .kkt_errors(o.s_max, &self.geo, &self.shape, &mut self.lgrad);
-        let os = self.sc.obj_scale;
-        let it = &self.it;
+        let (it, sc) = (&self.it, &self.sc);
         self.record.iter = iter;
-        self.record.objective = it.f / os;
+        self.record.objective = sc.objective_to_user(it.f);
         self.record.inf_pr = err.inf_pr;
         self.record.inf_du = err.inf_du;
         self.stats.records.push(self.record);
@@ -308,24 +307,22 @@ impl<'a> SqpState<'a> {
             println!("{}", crate::log::format_record(&self.record));
         }
         if let Some(obs) = observer {
-            let (l, sg, cones) = (&it.mult.lambda, &self.sc.g_scale, &self.geo.cones);
-            if obs.call_sqp(&self.record, &it.x, l, sg, os, cones, &it.mult.z_cone) {
+            let (l, cones) = (&it.mult.lambda, &self.geo.cones);
+            if obs.call_scaled(&self.record, &it.x, sc, l, cones, &it.mult.z_cone) {
                 return Some(Stop {
                     status: Status::UserRequestedStop,
                     message: "stopped by the iteration callback".into(),
                 });
             }
         }
-        let unscaled_pr = self
-            .geo
-            .unscaled_max(&self.sc.g_scale, &it.x, &it.g, &it.cone);
+        let unscaled_pr = self.geo.unscaled_max(sc, &it.x, &it.g, &it.cone);
         // Without multipliers (a cold start's iteration 0) the dual error is not
         // measured: no test, and the streak of acceptable iterates restarts.
         let residuals = KktResiduals {
             overall: err.scaled,
-            dual: err.inf_du / os,
+            dual: sc.objective_to_user(err.inf_du),
             primal: unscaled_pr,
-            compl: err.compl / os,
+            compl: sc.objective_to_user(err.compl),
         };
         if !it.have_mult {
             *termination = Termination::default();
@@ -407,7 +404,7 @@ impl<'a> SqpState<'a> {
         let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if ls.d_norm <= 1e-14 * (1.0 + x_max) || self.ls_failures > 8 {
             let it = &self.it;
-            let pr = self.geo.unscaled_max(&self.sc.g_scale, x, &it.g, &it.cone);
+            let pr = self.geo.unscaled_max(&self.sc, x, &it.g, &it.cone);
             let status = if pr > self.o.constr_viol_tol {
                 Status::InfeasibleProblemDetected
             } else {
@@ -475,11 +472,11 @@ impl<'a> SqpState<'a> {
     /// The solution in the user's units at the iterate, ending with `stop`.
     pub fn user_solution(&mut self, stop: Stop) -> Solution {
         let (sc, it) = (&self.sc, &self.it);
+        let mut lambda = vec![0.0; self.shape.m];
+        sc.lambdas_to_user(&it.mult.lambda, &mut lambda);
         let point = UserPoint {
             x: it.x.clone(),
-            lambda: (0..self.shape.m)
-                .map(|i| sc.lambda_to_user(i, it.mult.lambda[i]))
-                .collect(),
+            lambda,
             z_l: it.mult.z_l.iter().map(|&z| sc.z_to_user(z)).collect(),
             z_u: it.mult.z_u.iter().map(|&z| sc.z_to_user(z)).collect(),
         };
