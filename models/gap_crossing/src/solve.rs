@@ -435,11 +435,7 @@ pub fn plan_on(
     };
     let plan = Plan::from_flat(s, &last.flat)?;
     let solver = SolverInfo {
-        name: match settings.backend {
-            Backend::Ipm => "ipm",
-            Backend::Sqp => "sqp",
-        }
-        .into(),
+        name: settings.options().solver().name().into(),
         status: String::new(),
         iterations: phases.iter().map(|p| p.iterations).sum(),
         objective: plan.cost(s),
