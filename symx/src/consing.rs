@@ -7,7 +7,8 @@
 //! before, so the anchor's list and the nodes on it are still in cache; a global hash table
 //! would instead cost a cache and TLB miss per lookup once the graph outgrows the caches
 //! (millions of nodes: an OCP's Hessian, issue 13). Nodes without operands (constants,
-//! symbols' kin) and nodes whose anchor's list is full go into a hash table, so that a
+//! calls) and nodes whose anchor's list is full go into a hash table (symbols are always
+//! new and not indexed), so that a
 //! popular operand (a multiplier shared by thousands of products) costs no long walks.
 //!
 //! Invariant: a node with operands is on its anchor's list if that list held fewer than

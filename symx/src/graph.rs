@@ -1,10 +1,11 @@
 //! The expression arena: nodes stored in a thread-local vector, children before parents.
 //!
 //! Every node is identified by a `u32` index. Nodes are hash-consed when created (a
-//! structurally identical node is never stored twice), so common subexpressions are shared
-//! by construction and constants are interned. Because a node can only refer to nodes that
-//! already exist, ascending index order is a topological order of the whole graph; every
-//! traversal in this crate relies on that and none of them recurses.
+//! structurally identical node is never stored twice; the index is in `consing.rs`), so
+//! common subexpressions are shared by construction and constants are interned. Because a
+//! node can only refer to nodes that already exist, ascending index order is a topological
+//! order of the whole graph; every traversal in this crate relies on that and none of them
+//! recurses.
 use crate::call::CallSite;
 use crate::consing::NodeIndex;
 use crate::op::Op;
