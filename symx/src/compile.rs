@@ -4,7 +4,7 @@ use crate::call::CallInstr;
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::function::{next_uid, Function, Instr};
-use crate::graph::Graph;
+use crate::graph::{Graph, Node};
 use crate::op::Op;
 use crate::table::Table;
 use rustc_hash::FxHashMap;
@@ -13,6 +13,9 @@ use std::sync::{Arc, OnceLock};
 /// The nodes to compute, in depth-first post-order from the outputs, and the constants met.
 struct Order {
     steps: Vec<u32>,
+    /// The node of each step (read again in step order below: a copy here saves a cache
+    /// miss per read in a graph of millions of nodes).
+    step_nodes: Vec<Node>,
     const_ids: Vec<u32>,
     constants: Vec<f64>,
 }
@@ -22,11 +25,14 @@ struct Order {
 struct Locals {
     seen: Vec<u32>,
     register: Vec<u32>,
+    /// Whether the node's register may go back to the scalar free list (not a call's).
+    freeable: Vec<bool>,
 }
 
 impl Locals {
-    fn visit(&mut self, id: u32, reg: u32) {
+    fn visit(&mut self, id: u32, reg: u32, op: Op) {
         self.register.push(reg);
+        self.freeable.push(!matches!(op, Op::Call | Op::CallOutput));
         self.seen[id as usize] = self.register.len() as u32;
     }
     fn is_seen(&self, id: u32) -> bool {
@@ -40,6 +46,7 @@ impl Locals {
 fn order(g: &Graph, outputs: &[&[Expr]], loc: &mut Locals) -> Result<Order, SymxError> {
     let mut o = Order {
         steps: Vec::new(),
+        step_nodes: Vec::new(),
         const_ids: Vec::new(),
         constants: Vec::new(),
     };
@@ -58,7 +65,7 @@ fn order(g: &Graph, outputs: &[&[Expr]], loc: &mut Locals) -> Result<Order, Symx
                         Op::Const => {
                             o.const_ids.push(id);
                             o.constants.push(node.value().unwrap_or(f64::NAN));
-                            loc.visit(id, u32::MAX);
+                            loc.visit(id, u32::MAX, Op::Const);
                             stack.pop();
                             continue;
                         }
@@ -79,8 +86,9 @@ fn order(g: &Graph, outputs: &[&[Expr]], loc: &mut Locals) -> Result<Order, Symx
                         stack.push((c, 0));
                     }
                 } else {
-                    loc.visit(id, u32::MAX);
+                    loc.visit(id, u32::MAX, node.op);
                     o.steps.push(id);
+                    o.step_nodes.push(node);
                     stack.pop();
                 }
             }
@@ -116,25 +124,28 @@ pub(crate) fn compile(
     let mut loc = Locals {
         seen: vec![0u32; g.len()],
         register: Vec::new(),
+        freeable: Vec::new(),
     };
 
     // Inputs occupy the first registers.
     let input_sizes: Vec<usize> = inputs.iter().map(|x| x.len()).collect();
     let output_sizes: Vec<usize> = outputs.iter().map(|y| y.len()).collect();
     let mut input_offsets = Vec::with_capacity(inputs.len());
-    let mut input_of: FxHashMap<u32, usize> = FxHashMap::default();
+    // Input number of each input entry, by local index (inputs are the first locals).
+    let mut input_of: Vec<usize> = Vec::new();
     let mut next = 0usize;
     for (k, x) in inputs.iter().enumerate() {
         input_offsets.push(next);
         for e in x.iter() {
-            input_of.insert(e.id, k);
-            loc.visit(e.id, next as u32);
+            input_of.push(k);
+            loc.visit(e.id, next as u32, Op::Sym);
             next += 1;
         }
     }
     let mut input_used = vec![false; inputs.len()];
     let Order {
         steps,
+        step_nodes,
         const_ids,
         constants,
     } = order(g, outputs, &mut loc)?;
@@ -172,7 +183,7 @@ pub(crate) fn compile(
                 // An input or a node already written to another slot: copy at the end.
                 template.push(0.0);
                 if node.op == Op::Sym {
-                    input_used[input_of[&e.id]] = true;
+                    input_used[input_of[l]] = true;
                 }
                 copies.push(Instr {
                     op: Op::Sym,
@@ -188,11 +199,17 @@ pub(crate) fn compile(
 
     // Last step reading each node (by local index).
     let mut last_use: Vec<usize> = vec![usize::MAX; loc.register.len()];
-    for (s, &id) in steps.iter().enumerate() {
-        for &a in g.operands(id) {
-            last_use[loc.local(a)] = s;
-            if g.node(a).op == Op::Sym {
-                input_used[input_of[&a]] = true;
+    for (s, (&id, node)) in steps.iter().zip(&step_nodes).enumerate() {
+        let operands = if node.op == Op::Call {
+            g.operands(id)
+        } else {
+            node.operands()
+        };
+        for &a in operands {
+            let l = loc.local(a);
+            last_use[l] = s;
+            if let Some(&k) = input_of.get(l) {
+                input_used[k] = true;
             }
         }
     }
@@ -200,6 +217,7 @@ pub(crate) fn compile(
     let temp_start = slot as u32;
     let mut ext = Externals::default();
     let plan = Plan {
+        step_nodes: &step_nodes,
         pinned: &pinned,
         last_use: &last_use,
         call_copies: &call_copies,
@@ -240,6 +258,8 @@ pub(crate) fn compile(
 
 /// What register allocation needs to know about the nodes (by local index).
 struct Plan<'a> {
+    /// The node of each step.
+    step_nodes: &'a [Node],
     /// Nodes computed straight into their output slot.
     pinned: &'a [bool],
     /// Last step reading each node (`usize::MAX`: none).
@@ -263,6 +283,7 @@ fn allocate(
     ext: &mut Externals,
 ) -> (Vec<Instr>, u32) {
     let Plan {
+        step_nodes,
         pinned,
         last_use,
         call_copies,
@@ -274,16 +295,17 @@ fn allocate(
     // Registers inside call blocks are never put on the scalar free list; whole blocks
     // are freed after their last reader (`block_ends[s]`: blocks whose last reader is
     // step s) into free lists by size.
-    let freeable = |g: &Graph, id: u32| !matches!(g.node(id).op, Op::Call | Op::CallOutput);
-    let mut block_ends: Vec<Vec<(u32, u32)>> = vec![Vec::new(); steps.len()];
+    // (A map, not a vector per step: most tapes have no calls, and a vector per step of a
+    // Hessian's millions would be 24 bytes each.)
+    let mut block_ends: FxHashMap<usize, Vec<(u32, u32)>> = FxHashMap::default();
     let mut free_blocks: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for (s, &id) in steps.iter().enumerate() {
-        if s > 0 {
-            for (block, size) in std::mem::take(&mut block_ends[s - 1]) {
+        if s > 0 && !block_ends.is_empty() {
+            for (block, size) in block_ends.remove(&(s - 1)).into_iter().flatten() {
                 free_blocks.entry(size).or_default().push(block);
             }
         }
-        let node = g.node(id);
+        let node = step_nodes[s];
         let l = loc.local(id);
         match node.op {
             Op::CallOutput => {
@@ -301,7 +323,7 @@ fn allocate(
                 let mut dying: Vec<u32> = site
                     .inputs
                     .iter()
-                    .filter(|&&a| last_use[loc.local(a)] == s && freeable(g, a))
+                    .filter(|&&a| last_use[loc.local(a)] == s && loc.freeable[loc.local(a)])
                     .map(|&a| loc.register[loc.local(a)])
                     .filter(|&r| r >= temp_start)
                     .collect();
@@ -328,7 +350,7 @@ fn allocate(
                     })
                     .max()
                     .unwrap_or(s);
-                block_ends[end].push((block, size));
+                block_ends.entry(end).or_default().push((block, size));
                 loc.register[l] = block;
                 tape.push(Instr {
                     op: Op::Call,
@@ -370,7 +392,7 @@ fn allocate(
             let a = node.args[k];
             if last_use[loc.local(a)] == s
                 && regs[k] >= temp_start
-                && freeable(g, a)
+                && loc.freeable[loc.local(a)]
                 && !regs[..k].contains(&regs[k])
             {
                 free.push(regs[k]);

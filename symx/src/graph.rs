@@ -1,11 +1,13 @@
 //! The expression arena: nodes stored in a thread-local vector, children before parents.
 //!
 //! Every node is identified by a `u32` index. Nodes are hash-consed when created (a
-//! structurally identical node is never stored twice), so common subexpressions are shared
-//! by construction and constants are interned. Because a node can only refer to nodes that
-//! already exist, ascending index order is a topological order of the whole graph; every
-//! traversal in this crate relies on that and none of them recurses.
+//! structurally identical node is never stored twice; the index is in `consing.rs`), so
+//! common subexpressions are shared by construction and constants are interned. Because a
+//! node can only refer to nodes that already exist, ascending index order is a topological
+//! order of the whole graph; every traversal in this crate relies on that and none of them
+//! recurses.
 use crate::call::CallSite;
+use crate::consing::NodeIndex;
 use crate::op::Op;
 use crate::table::Table;
 use rustc_hash::FxHashMap;
@@ -55,7 +57,8 @@ impl Node {
 /// The arena of one thread.
 pub(crate) struct Graph {
     pub nodes: Vec<Node>,
-    index: FxHashMap<Node, u32>,
+    /// The hash-consing index (`consing.rs`).
+    index: NodeIndex,
     pub symbol_names: Vec<Box<str>>,
     /// Node index of each symbol, by symbol number.
     pub symbol_nodes: Vec<u32>,
@@ -89,7 +92,7 @@ impl Graph {
     fn new() -> Graph {
         let mut g = Graph {
             nodes: Vec::new(),
-            index: FxHashMap::default(),
+            index: NodeIndex::new(),
             symbol_names: Vec::new(),
             symbol_nodes: Vec::new(),
             tables: Vec::new(),
@@ -107,23 +110,17 @@ impl Graph {
 
     /// Adds `node` unless an identical one exists; returns its index.
     pub fn intern(&mut self, node: Node) -> u32 {
-        if let Some(&id) = self.index.get(&node) {
-            return id;
-        }
-        let id = u32::try_from(self.nodes.len()).expect("symx graph exceeds 2^32 nodes");
-        self.nodes.push(node);
-        self.index.insert(node, id);
-        id
+        self.index.intern(&mut self.nodes, node)
     }
 
     /// Creates a new, distinct symbol.
     pub fn symbol(&mut self, name: &str) -> u32 {
         let number = self.symbol_names.len() as u32;
-        let id = u32::try_from(self.nodes.len()).expect("symx graph exceeds 2^32 nodes");
-        self.nodes.push(Node {
+        let node = Node {
             op: Op::Sym,
             args: [number, 0, 0],
-        });
+        };
+        let id = self.index.push(&mut self.nodes, node);
         self.symbol_names.push(name.into());
         self.symbol_nodes.push(id);
         id

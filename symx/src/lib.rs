@@ -24,6 +24,7 @@ mod ad;
 mod assemble;
 mod call;
 mod compile;
+mod consing;
 mod display;
 mod error;
 mod expr;
