@@ -298,6 +298,13 @@ pub struct IpmOptions {
     pub constr_mult_reset_threshold: f64,
     /// Start with a restoration phase. Default false.
     pub start_with_resto: bool,
+    /// IPOPT's `recalc_y`: after every accepted step whose constraint violation (max-norm,
+    /// scaled problem) is below `recalc_y_feas_tol`, replace the constraint multipliers by
+    /// the least-squares estimate. `None` (default) follows IPOPT: on with
+    /// `hessian_approximation = limited-memory`, off with the exact Hessian.
+    pub recalc_y: Option<bool>,
+    /// Feasibility threshold of `recalc_y`. Default 1e-6.
+    pub recalc_y_feas_tol: f64,
 }
 
 crate::frontend::strict_options_serde!(IpmOptions);
@@ -385,6 +392,8 @@ impl Default for IpmOptions {
             max_resto_iter: 3000,
             bound_mult_reset_threshold: 1e3,
             constr_mult_reset_threshold: 1e3,
+            recalc_y: None,
+            recalc_y_feas_tol: 1e-6,
             start_with_resto: false,
         }
     }
@@ -447,6 +456,7 @@ impl IpmOptions {
             resto_penalty_parameter,
             bound_mult_reset_threshold,
             residual_ratio_max,
+            recalc_y_feas_tol,
             kkt_static_regularization,
             limited_memory_init_val,
             limited_memory_init_val_max,

@@ -212,12 +212,23 @@ impl Core<'_> {
         res
     }
 
+    /// IPOPT's `recalc_y`: y ← the least-squares estimate at the current point, kept
+    /// unchanged when the estimate cannot be computed (IPOPT skips the update when its
+    /// calculator fails; there is no size limit).
+    pub(super) fn recalc_multipliers(&mut self) {
+        let y = self.it.y.clone();
+        if !self.least_squares_multipliers(f64::INFINITY) {
+            self.it.y = y;
+        }
+    }
+
     /// y = argmin ‖∇f + Aᵀy − z_L + z_U‖₂ (IPOPT's least-squares estimate), set to 0 if
-    /// larger than `max_norm` (max-norm) or not computable.
-    pub(crate) fn least_squares_multipliers(&mut self, max_norm: f64) {
+    /// larger than `max_norm` (max-norm) or not computable. True when the estimate was
+    /// taken.
+    pub(crate) fn least_squares_multipliers(&mut self, max_norm: f64) -> bool {
         let (n, m) = (self.lay.n, self.lay.m);
         if m == 0 {
-            return;
+            return false;
         }
         let xreg = self.opts.kkt_static_hessian_regularization;
         self.kw.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
@@ -324,9 +335,10 @@ impl Core<'_> {
             let ymax = inf_norm(&self.kw.rhs[n..]);
             if ymax <= max_norm && ymax.is_finite() {
                 self.it.y.copy_from_slice(&self.kw.rhs[n..]);
-                return;
+                return true;
             }
         }
         self.it.y.iter_mut().for_each(|v| *v = 0.0);
+        false
     }
 }
