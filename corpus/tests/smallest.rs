@@ -269,3 +269,28 @@ fn rocket_with_soft_restoration_within_twice_ipopt() {
     );
     assert!(out.iterations <= 54, "{} iterations", out.iterations);
 }
+
+/// catmix_colloc_100 with IPOPT's `residual_ratio_singular` (1e-5): the refinement of
+/// iterations 16–17 ends at residual ratios 1.7e-10 and 5.2e-10, just above
+/// `residual_ratio_max` (1e-10); by default such a solve counts as singular and δ_w is
+/// raised (27 iterations, 9 regularised), with 1e-5 it is taken as it is and the solve
+/// takes IPOPT's 20 iterations (corpus.jsonl) with no δ_w. Not the default: race_car_rk4_400
+/// then takes 580 iterations instead of 61 (docs/solvers.md §6).
+#[test]
+fn catmix_with_ipopts_residual_ratio_singular_takes_ipopts_count() {
+    use nlp::NamedOptions;
+    let inst = corpus::instance("catmix_colloc_100").expect("instance exists");
+    let mut o = run::options(120.0);
+    o.set_by_name(&["residual_ratio_singular=1e-5"]).unwrap();
+    let mut compiled = inst.build().unwrap().compile().unwrap();
+    let sol = nlp::Ipm::new(o).solve(&mut compiled).unwrap();
+    assert_eq!(sol.status, nlp::Status::SolveSucceeded);
+    let f_ipopt = -0.04805538299701119_f64;
+    assert!((sol.objective - f_ipopt).abs() < 1e-6, "{}", sol.objective);
+    assert!(
+        sol.stats.iterations <= 20,
+        "{} iterations",
+        sol.stats.iterations
+    );
+    assert!(sol.stats.records.iter().all(|r| r.regularization == 0.0));
+}

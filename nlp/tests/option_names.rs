@@ -82,3 +82,20 @@ fn recalc_y_takes_ipopts_words_and_its_tolerance_is_checked() {
     let e = bad.validate().unwrap_err().to_string();
     assert!(e.contains("recalc_y_feas_tol"), "{e}");
 }
+
+/// `residual_ratio_singular` (IPOPT's name) is optional: None means `residual_ratio_max`;
+/// a value below `residual_ratio_max` is refused by name.
+#[test]
+fn residual_ratio_singular_is_checked_against_residual_ratio_max() {
+    let mut o = IpmOptions::default();
+    assert_eq!(o.singular_residual_ratio(), o.residual_ratio_max);
+    o.set_by_name(&["residual_ratio_singular=1e-5"]).unwrap();
+    assert_eq!(o.residual_ratio_singular, Some(1e-5));
+    assert_eq!(o.singular_residual_ratio(), 1e-5);
+    let bad = IpmOptions {
+        residual_ratio_singular: Some(1e-12),
+        ..IpmOptions::default()
+    };
+    let e = bad.validate().unwrap_err().to_string();
+    assert!(e.contains("residual_ratio_singular"), "{e}");
+}
