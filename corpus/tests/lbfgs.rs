@@ -23,10 +23,51 @@ fn lm_options(max_wall: f64) -> IpmOptions {
 /// within 1.5× of IPOPT; the others are listed in docs/solvers.md.
 const CASES: &[(&str, f64, usize)] = &[
     ("robot_trap_200", 9.141396951323673, 22),
+    ("catmix_colloc_100", -0.04805538299701119, 115),
     ("vdp_rk4_20", 3.7324355529062423, 11),
     ("vdp_trap_50", 3.6734170050089268, 17),
+    ("cartpole_trap_50", 59.14775732337834, 32),
     ("cartpole_rk4_50", 59.13194620767747, 28),
+    ("quadrotor_rk4_50", 194.8824168265576, 28),
 ];
+
+/// IPOPT's `recalc_y` (on by default with the limited-memory Hessian): least-squares
+/// multipliers after every step with constraint violation below `recalc_y_feas_tol`.
+/// Without it quadrotor_rk4_50 takes 421 iterations (IPOPT's limited-memory mode 28,
+/// benches/reference/results/corpus_lbfgs_ipopt.jsonl); with it, at most 1.5× IPOPT's.
+/// Set by name as IPOPT spells it.
+#[test]
+fn recalc_y_is_what_brings_quadrotor_to_ipopt() {
+    use nlp::NamedOptions;
+    let inst = corpus::instance("quadrotor_rk4_50").expect("instance exists");
+    let mut off = lm_options(120.0);
+    off.set_by_name(&["recalc_y=no"]).unwrap();
+    assert_eq!(off.recalc_y, Some(false));
+    let mut on = lm_options(120.0);
+    on.set_by_name(&["recalc_y=yes", "recalc_y_feas_tol=1e-6"])
+        .unwrap();
+    let off = run::solve(&inst, &off).expect("solves");
+    let on_out = run::solve(&inst, &on).expect("solves");
+    let default = run::solve(&inst, &lm_options(120.0)).expect("solves");
+    assert!(on_out.success && off.success);
+    assert_eq!(
+        on_out.iterations, default.iterations,
+        "default = on with limited memory"
+    );
+    assert!(
+        2 * on_out.iterations <= 3 * 28,
+        "{} iterations",
+        on_out.iterations
+    );
+    assert!(
+        off.iterations > 3 * on_out.iterations,
+        "off: {}",
+        off.iterations
+    );
+    // Never with the exact Hessian unless asked for.
+    let exact = run::solve(&inst, &run::options(120.0)).expect("solves");
+    assert_eq!(exact.iterations, 12);
+}
 
 /// Solved, at IPOPT's exact-Hessian optimum to 1e-6 relative (the criterion), in
 /// at most 1.5× IPOPT's limited-memory iterations (the target).

@@ -143,6 +143,8 @@ fn parse_value(fields: &Map<String, Value>, key: &str, value: &str) -> Result<Va
             }
         }
         Value::String(_) => Some(Value::String(value.to_string())),
+        // An optional switch (default None), set with IPOPT's words too.
+        Value::Null if matches!(value, "yes" | "no") => Some(Value::Bool(value == "yes")),
         _ => serde_json::from_str(value).ok(),
     };
     parsed.ok_or_else(|| OptionError::BadValue {

@@ -265,6 +265,13 @@ pub struct IpmOptions {
     pub max_refinement_steps: usize,
     /// Target relative residual of the linear solves. Default 1e-10.
     pub residual_ratio_max: f64,
+    /// IPOPT's `residual_ratio_singular`: a solve whose refinement ends above
+    /// `residual_ratio_max` is taken as it is if its residual ratio is at most this, and
+    /// treated as singular (δ_c, then δ_w) only above it. Default `None`: the value of
+    /// `residual_ratio_max`, so every failed refinement counts as singular (IPOPT's
+    /// default is 1e-5, after first refactorising with a stricter pivot tolerance, which
+    /// faer's unpivoted LDLᵀ cannot; measured in docs/solvers.md §6).
+    pub residual_ratio_singular: Option<f64>,
     // ---------- Hessian ----------
     /// Exact Hessian or limited-memory quasi-Newton approximation. Default exact.
     pub hessian_approximation: IpmHessian,
@@ -298,6 +305,13 @@ pub struct IpmOptions {
     pub constr_mult_reset_threshold: f64,
     /// Start with a restoration phase. Default false.
     pub start_with_resto: bool,
+    /// IPOPT's `recalc_y`: after every accepted step whose constraint violation (max-norm,
+    /// scaled problem) is below `recalc_y_feas_tol`, replace the constraint multipliers by
+    /// the least-squares estimate. `None` (default) follows IPOPT: on with
+    /// `hessian_approximation = limited-memory`, off with the exact Hessian.
+    pub recalc_y: Option<bool>,
+    /// Feasibility threshold of `recalc_y`. Default 1e-6.
+    pub recalc_y_feas_tol: f64,
 }
 
 crate::frontend::strict_options_serde!(IpmOptions);
@@ -371,6 +385,7 @@ impl Default for IpmOptions {
             min_refinement_steps: 1,
             max_refinement_steps: 10,
             residual_ratio_max: 1e-10,
+            residual_ratio_singular: None,
             hessian_approximation: IpmHessian::Exact,
             limited_memory_max_history: 6,
             limited_memory_update_type: LimitedMemoryUpdate::Bfgs,
@@ -385,6 +400,8 @@ impl Default for IpmOptions {
             max_resto_iter: 3000,
             bound_mult_reset_threshold: 1e3,
             constr_mult_reset_threshold: 1e3,
+            recalc_y: None,
+            recalc_y_feas_tol: 1e-6,
             start_with_resto: false,
         }
     }
@@ -398,6 +415,13 @@ fn bad(field: &'static str, reason: impl Into<String>) -> SolveError {
 }
 
 impl IpmOptions {
+    /// The residual ratio above which a solve counts as singular
+    /// (`residual_ratio_singular`, by default `residual_ratio_max`).
+    pub fn singular_residual_ratio(&self) -> f64 {
+        self.residual_ratio_singular
+            .unwrap_or(self.residual_ratio_max)
+    }
+
     /// Checks every option; the error names the first bad field.
     pub fn validate(&self) -> Result<(), SolveError> {
         self.common.validate()?;
@@ -461,6 +485,7 @@ impl IpmOptions {
             resto_penalty_parameter,
             bound_mult_reset_threshold,
             residual_ratio_max,
+            recalc_y_feas_tol,
             kkt_static_regularization,
             limited_memory_init_val,
             limited_memory_init_val_max,
@@ -572,6 +597,14 @@ impl IpmOptions {
                 "min_refinement_steps",
                 "must not exceed max_refinement_steps",
             ));
+        }
+        if let Some(r) = self.residual_ratio_singular {
+            if !(r >= self.residual_ratio_max) || !r.is_finite() {
+                return Err(bad(
+                    "residual_ratio_singular",
+                    format!("must be finite and not smaller than residual_ratio_max, got {r}"),
+                ));
+            }
         }
         Ok(())
     }

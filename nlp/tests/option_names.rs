@@ -59,3 +59,43 @@ fn errors_name_the_option_and_leave_the_options_unchanged() {
         .unwrap_err();
     assert!(matches!(err, OptionError::Unknown { .. }), "{err}");
 }
+
+/// IPOPT's `recalc_y` is an optional switch (None: on with the limited-memory Hessian,
+/// as IPOPT decides); yes/no set it as IPOPT spells it, a non-positive
+/// `recalc_y_feas_tol` is refused by name.
+#[test]
+fn recalc_y_takes_ipopts_words_and_its_tolerance_is_checked() {
+    let mut o = IpmOptions::default();
+    assert_eq!(o.recalc_y, None);
+    o.set_by_name(&["recalc_y=yes"]).unwrap();
+    assert_eq!(o.recalc_y, Some(true));
+    o.set_by_name(&["recalc_y=no"]).unwrap();
+    assert_eq!(o.recalc_y, Some(false));
+    assert!(matches!(
+        o.set_by_name(&["recalc_y=maybe"]),
+        Err(OptionError::BadValue { key, .. }) if key == "recalc_y"
+    ));
+    let bad = IpmOptions {
+        recalc_y_feas_tol: 0.0,
+        ..IpmOptions::default()
+    };
+    let e = bad.validate().unwrap_err().to_string();
+    assert!(e.contains("recalc_y_feas_tol"), "{e}");
+}
+
+/// `residual_ratio_singular` (IPOPT's name) is optional: None means `residual_ratio_max`;
+/// a value below `residual_ratio_max` is refused by name.
+#[test]
+fn residual_ratio_singular_is_checked_against_residual_ratio_max() {
+    let mut o = IpmOptions::default();
+    assert_eq!(o.singular_residual_ratio(), o.residual_ratio_max);
+    o.set_by_name(&["residual_ratio_singular=1e-5"]).unwrap();
+    assert_eq!(o.residual_ratio_singular, Some(1e-5));
+    assert_eq!(o.singular_residual_ratio(), 1e-5);
+    let bad = IpmOptions {
+        residual_ratio_singular: Some(1e-12),
+        ..IpmOptions::default()
+    };
+    let e = bad.validate().unwrap_err().to_string();
+    assert!(e.contains("residual_ratio_singular"), "{e}");
+}

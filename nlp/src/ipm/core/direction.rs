@@ -75,7 +75,8 @@ impl Core<'_> {
         let t = Instant::now();
         self.kw.rhs_copy.copy_from_slice(&self.kw.rhs);
         let mut res = self.kw.solve_rhs();
-        if self.pert.delta_c == 0.0 && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
+        let singular_ratio = self.opts.singular_residual_ratio();
+        if self.pert.delta_c == 0.0 && !matches!(res, Ok(r) if r <= singular_ratio) {
             // The system without the static regularisation is (numerically) singular:
             // a rank-deficient Jacobian of the equality rows with inconsistent
             // linearised constraints. Take IPOPT's regularised step: refactorise with
@@ -107,7 +108,7 @@ impl Core<'_> {
             res = self.kw.solve_rhs();
             shared.stats.factor_seconds += t.elapsed().as_secs_f64();
             let mut dw = self.pert.delta_w;
-            while ok && !matches!(res, Ok(r) if r <= self.opts.residual_ratio_max) {
+            while ok && !matches!(res, Ok(r) if r <= singular_ratio) {
                 // Still singular (singular reduced Hessian): IPOPT increases δ_w.
                 dw = self.pert.next_delta_w(&self.opts, dw);
                 if dw > self.opts.max_hessian_perturbation {

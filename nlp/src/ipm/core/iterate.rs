@@ -100,17 +100,18 @@ impl Core<'_> {
         if !all_finite(&self.trial.jac) {
             return false;
         }
-        if let Some(lm) = self.kw.lm.as_mut() {
-            let (g, j, pat) = (&self.trial.grad, &self.trial.jac, self.nlp.jac_g_sparsity());
-            lm.update(x, g, j, pat, &self.trial.y);
-            return true; // the Hessian values stay 0: W = the low-rank approximation
+        if self.kw.lm.is_some() {
+            // The Hessian values stay 0: W = the low-rank approximation, updated in
+            // `accept_trial` (after `recalc_y` may have changed y, as in IPOPT).
+            return true;
         }
         self.nlp
             .eval_hess_l(x, 1.0, &self.trial.y, &mut self.trial.hess);
         all_finite(&self.trial.hess)
     }
 
-    /// Makes the trial point current (swapping buffers).
+    /// Makes the trial point current (swapping buffers), then applies `recalc_y` and the
+    /// limited-memory update at the new point (IPOPT's AcceptTrialPoint and UpdateHessian).
     pub(super) fn accept_trial(&mut self) {
         std::mem::swap(&mut self.it.w, &mut self.trial.w);
         std::mem::swap(&mut self.it.y, &mut self.trial.y);
@@ -120,6 +121,14 @@ impl Core<'_> {
         std::mem::swap(&mut self.it.jac, &mut self.trial.jac);
         std::mem::swap(&mut self.it.hess, &mut self.trial.hess);
         self.it.f = self.trial.f;
+        if self.recalc_y && inf_norm(&self.it.c) < self.opts.recalc_y_feas_tol {
+            self.recalc_multipliers();
+        }
+        if let Some(lm) = self.kw.lm.as_mut() {
+            let x = &self.it.w[..self.lay.n];
+            let (g, j, pat) = (&self.it.grad, &self.it.jac, self.nlp.jac_g_sparsity());
+            lm.update(x, g, j, pat, &self.it.y);
+        }
     }
 
     /// Evaluates everything at the current w, y. Err names the callback on NaN/Inf.

@@ -11,6 +11,10 @@ use std::time::Instant;
 
 use super::*;
 
+/// Lower bound of the lowered equality-row regularisation, relative to `eq_reg` (see
+/// `Core::step_eq_reg`).
+const EQ_REG_FLOOR: f64 = 1e-9;
+
 /// Assembly and factorisation workspace of the KKT system.
 pub(super) struct KktWork {
     pub(super) kkt: Kkt,
@@ -86,11 +90,20 @@ impl Core<'_> {
     /// links (rows scaled up to gradient 0.8) the Schur diagonal is ≈ 1e-4 against
     /// `eq_reg` = 6.4e-9, and its smooth modes are (π/N)² ≈ 4e-9 times smaller still,
     /// so refinement could not remove `eq_reg` and the solve did not converge (40 s);
-    /// with the lowering it takes 8 iterations. The 1e-3 bound: without it (or with
-    /// 1e-6) the Wächter–Biegler example of nlp/tests/ipm_mechanisms.rs ends its
-    /// restoration at a point of local infeasibility (1e-4 … 1e-2 pass). With δ_w > 0
-    /// (inertia correction) `eq_reg` is kept: lowering it there too took the 5000-link
-    /// chain 14 iterations (IPOPT's count) instead of 11.
+    /// with the lowering it takes 8 iterations. The lower bound `EQ_REG_FLOOR` × `eq_reg`
+    /// only keeps the pivot away from 0. The regularised matrix [[H, Jᵀ], [J, −R]] has
+    /// IPOPT's inertia (n, m, 0) iff H + Jᵀ R⁻¹ J is positive definite, so an R larger
+    /// than the squared small singular values of J hides negative curvature of the
+    /// reduced Hessian (no δ_w where IPOPT takes one): with the former bound 1e-3 the
+    /// rocket OCP (corpus `rocket_trap_*`) took Newton steps that ascend the barrier
+    /// function at θ ≈ 1e-7 (∇φᵀd = +5e-3) and crawled for 150 iterations with α ≈ 1e-4;
+    /// 183 / 96 / 166 iterations against IPOPT's 27 / 26 / 34. Bounds 1e-4, 1e-5, 1e-6,
+    /// 1e-7, 1e-9 gave 53 / 82 / 72, 35 / 38 / 54, 34 / 46 / 53, 34 / 27 / 36 and
+    /// 34 / 27 / 35; the other 39 OCP instances and the 73 HS problems are unchanged
+    /// (docs/solvers.md §6). With δ_w > 0 (inertia correction) `eq_reg` is kept:
+    /// lowering it there too took the 5000-link chain 14 iterations (IPOPT's count)
+    /// instead of 11, and `kkt_static_regularization` = 1e-14 for every factorisation
+    /// made glider_trap_100 fail after 701 iterations (556 with this rule).
     pub(super) fn step_eq_reg(&mut self, delta_w: f64) {
         let mut out = std::mem::take(&mut self.kw.eq_reg_step);
         if delta_w == 0.0 {
@@ -115,7 +128,7 @@ impl Core<'_> {
             for (o, &e) in out.iter_mut().zip(&self.kw.eq_reg) {
                 let r = reg * *o;
                 *o = if r > 0.0 && r.is_finite() {
-                    r.min(e).max(1e-3 * e)
+                    r.min(e).max(EQ_REG_FLOOR * e)
                 } else {
                     e
                 };
@@ -199,12 +212,23 @@ impl Core<'_> {
         res
     }
 
+    /// IPOPT's `recalc_y`: y ← the least-squares estimate at the current point, kept
+    /// unchanged when the estimate cannot be computed (IPOPT skips the update when its
+    /// calculator fails; there is no size limit).
+    pub(super) fn recalc_multipliers(&mut self) {
+        let y = self.it.y.clone();
+        if !self.least_squares_multipliers(f64::INFINITY) {
+            self.it.y = y;
+        }
+    }
+
     /// y = argmin ‖∇f + Aᵀy − z_L + z_U‖₂ (IPOPT's least-squares estimate), set to 0 if
-    /// larger than `max_norm` (max-norm) or not computable.
-    pub(crate) fn least_squares_multipliers(&mut self, max_norm: f64) {
+    /// larger than `max_norm` (max-norm) or not computable. True when the estimate was
+    /// taken.
+    pub(crate) fn least_squares_multipliers(&mut self, max_norm: f64) -> bool {
         let (n, m) = (self.lay.n, self.lay.m);
         if m == 0 {
-            return;
+            return false;
         }
         let xreg = self.opts.kkt_static_hessian_regularization;
         self.kw.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
@@ -311,9 +335,10 @@ impl Core<'_> {
             let ymax = inf_norm(&self.kw.rhs[n..]);
             if ymax <= max_norm && ymax.is_finite() {
                 self.it.y.copy_from_slice(&self.kw.rhs[n..]);
-                return;
+                return true;
             }
         }
         self.it.y.iter_mut().for_each(|v| *v = 0.0);
+        false
     }
 }

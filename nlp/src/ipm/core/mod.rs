@@ -153,6 +153,8 @@ pub(crate) struct Core<'p> {
     /// The convergence test's state (acceptable streak, previous objective).
     termination: Termination,
     setup_in_resto: bool,
+    /// IPOPT's `recalc_y` in effect (see `Core::recalc_multipliers`).
+    recalc_y: bool,
     obj_scale: f64,
     g_scale: Vec<f64>,
     mu_strategy: MuStrategy,
@@ -344,6 +346,11 @@ impl<'p> Core<'p> {
             kkt_refs: Vec::new(),
             termination: Termination::default(),
             setup_in_resto: setup.in_resto,
+            recalc_y: !setup.in_resto
+                && m > 0
+                && opts
+                    .recalc_y
+                    .unwrap_or(opts.hessian_approximation == crate::IpmHessian::LimitedMemory),
             obj_scale: setup.obj_scale,
             g_scale: setup.g_scale.clone(),
             mu_strategy: setup.mu_strategy,
