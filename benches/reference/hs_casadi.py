@@ -939,13 +939,15 @@ def hs118():
     return p
 
 
-def solve(name):
+def solve(name, extra_opts=None):
+    """IPOPT on one problem: tol 1e-8, IPOPT's defaults otherwise, plus `extra_opts`."""
     build, f_star = PROBLEMS[name]
     p = build()
     nlp = {"x": p.x, "f": p.f}
     if p.g:
         nlp["g"] = ca.vertcat(*p.g)
     opts = {"ipopt.tol": 1e-8, "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes"}
+    opts.update(extra_opts or {})
     solver = ca.nlpsol(name, "ipopt", nlp, opts)
     args = {"x0": p.x0, "lbx": p.lb, "ubx": p.ub}
     if p.g:

@@ -25,45 +25,17 @@ import json
 import math
 import os
 import sys
-import time
 
-import casadi as ca
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import hs_casadi  # noqa: E402
 from hs_casadi import PROBLEMS  # noqa: E402
 
 
 def solve(name):
-    build, f_star = PROBLEMS[name]
-    p = build()
-    nlp = {"x": p.x, "f": p.f}
-    if p.g:
-        nlp["g"] = ca.vertcat(*p.g)
-    opts = {
-        "ipopt.tol": 1e-8,
-        "ipopt.hessian_approximation": "limited-memory",
-        "ipopt.print_level": 0,
-        "print_time": False,
-        "ipopt.sb": "yes",
-    }
-    solver = ca.nlpsol(name, "ipopt", nlp, opts)
-    args = {"x0": p.x0, "lbx": p.lb, "ubx": p.ub}
-    if p.g:
-        args["lbg"] = p.lbg
-        args["ubg"] = p.ubg
-    t0 = time.perf_counter()
-    res = solver(**args)
-    seconds = time.perf_counter() - t0
-    stats = solver.stats()
-    return {
-        "name": name,
-        "status": stats["return_status"],
-        "success": stats["return_status"] == "Solve_Succeeded",
-        "iterations": int(stats["iter_count"]),
-        "objective": float(res["f"]),
-        "f_star": f_star,
-        "seconds": seconds,
-    }
+    r = hs_casadi.solve(name, {"ipopt.hessian_approximation": "limited-memory"})
+    r["success"] = r["status"] == "Solve_Succeeded"
+    return r
 
 
 def compare(ours_path, ipopt_path):
