@@ -26,7 +26,6 @@ import math
 import os
 import sys
 
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hs_casadi  # noqa: E402
 from hs_casadi import PROBLEMS  # noqa: E402
