@@ -269,8 +269,9 @@ pub struct IpmOptions {
     /// `residual_ratio_max` is taken as it is if its residual ratio is at most this, and
     /// treated as singular (δ_c, then δ_w) only above it. Default `None`: the value of
     /// `residual_ratio_max`, so every failed refinement counts as singular (IPOPT's
-    /// default is 1e-5, after first refactorising with a stricter pivot tolerance, which
-    /// faer's unpivoted LDLᵀ cannot; measured in docs/solvers.md §6).
+    /// default is 1e-5, after first refactorising with a stricter pivot tolerance; symnlp
+    /// first refactorises with lowered static regularisation near the solution; measured
+    /// in docs/solvers.md §6).
     pub residual_ratio_singular: Option<f64>,
     // ---------- Hessian ----------
     /// Exact Hessian or limited-memory quasi-Newton approximation. Default exact.

@@ -72,10 +72,20 @@ impl Core<'_> {
             };
         }
         // Refine against the system without the static regularisation.
-        let t = Instant::now();
+        let mut t = Instant::now();
         self.kw.rhs_copy.copy_from_slice(&self.kw.rhs);
         let mut res = self.kw.solve_rhs();
         let singular_ratio = self.opts.singular_residual_ratio();
+        if self.quality_retry_allowed(&res, singular_ratio) {
+            // Refinement failed near the solution: first try a more accurate factor
+            // (IPOPT's IncreaseQuality); if that fails too, the singular-matrix
+            // treatment below refactorises.
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            if let Some(r) = self.solve_with_higher_quality(shared, self.pert.delta_w) {
+                res = if r <= singular_ratio { Ok(r) } else { res };
+            }
+            t = Instant::now();
+        }
         if self.pert.delta_c == 0.0 && !matches!(res, Ok(r) if r <= singular_ratio) {
             // The system without the static regularisation is (numerically) singular:
             // a rank-deficient Jacobian of the equality rows with inconsistent

@@ -40,7 +40,25 @@ pub(super) struct KktWork {
     pub(super) work_nw: Vec<f64>,
     /// The limited-memory Hessian (`hessian_approximation = limited-memory`).
     pub(super) lm: Option<crate::lbfgs::LimitedMemoryHessian>,
+    /// Factor applied to both static regularisations (1, or `QUALITY_REG_SCALE` while
+    /// `Core::solve_with_higher_quality` refactorises).
+    pub(super) reg_scale: f64,
 }
+
+/// How much `Core::solve_with_higher_quality` lowers the static regularisations.
+const QUALITY_REG_SCALE: f64 = 1e-2;
+
+/// How many times a solve may refactorise with lowered static regularisation after a
+/// failed refinement: IPOPT's `IncreaseQuality` raises the pivot tolerance for good, and
+/// from MUMPS' default 1e-6 (×√ per call, at most 0.1) it succeeds three times.
+const QUALITY_RETRIES: usize = 3;
+
+/// The retry is tried only once μ ≤ this. Near the solution refinement fails from the
+/// ill-conditioning of Σ ~ 1/μ (catmix_colloc at μ = 2.5e-9: ratio 1.7e-10 → 1e-15 after
+/// the retry); early failures mark a nearly rank-deficient Jacobian, where δ_c is the
+/// better step (race_car_rk4_400 at μ = 2e-2: with the retry 196 iterations instead of
+/// 61; measured in docs/solvers.md §6).
+const QUALITY_MU_MAX: f64 = 1e-6;
 
 impl KktWork {
     /// Solves the factorised system for `rhs` in place (refined against K + diag(shift)).
@@ -54,6 +72,48 @@ impl KktWork {
 
 impl Core<'_> {
     // ------------------------------------------------------------------ linear algebra
+
+    /// Whether a solve with residual ratio `res` gets `solve_with_higher_quality`: its
+    /// refinement failed (ratio above `singular_ratio`) with δ_c = δ_w = 0, μ ≤
+    /// `QUALITY_MU_MAX`, and fewer than `QUALITY_RETRIES` retries so far.
+    pub(super) fn quality_retry_allowed(
+        &self,
+        res: &Result<f64, crate::kkt::KktError>,
+        singular_ratio: f64,
+    ) -> bool {
+        self.pert.delta_c == 0.0
+            && self.pert.delta_w == 0.0
+            && self.mu <= QUALITY_MU_MAX
+            && self.count.quality_retries < QUALITY_RETRIES
+            && matches!(res, Ok(r) if *r > singular_ratio)
+    }
+
+    /// symnlp's counterpart of IPOPT's `IncreaseQuality` after a failed iterative
+    /// refinement: faer's LDLᵀ has no pivot tolerance to raise, so the matrix is
+    /// refactorised once with δ_w = `delta_w` and both static regularisations lowered
+    /// by `QUALITY_REG_SCALE` (a factor closer to K, so refinement against K converges
+    /// faster), and `rhs_copy` is solved again. Returns the new residual ratio if the
+    /// factorisation has the inertia (n, m, 0); otherwise None, with the matrix left
+    /// factorised with the lowered values (the caller must refactorise before using it).
+    pub(super) fn solve_with_higher_quality(
+        &mut self,
+        shared: &mut Shared,
+        delta_w: f64,
+    ) -> Option<f64> {
+        let (n, m) = (self.lay.n, self.lay.m);
+        self.count.quality_retries += 1;
+        self.kw.reg_scale = QUALITY_REG_SCALE;
+        let fact = self.factor_kkt(shared, delta_w);
+        self.kw.reg_scale = 1.0;
+        if !matches!(fact, Ok(i) if i.positive == n && i.negative == m && i.zero == 0) {
+            return None;
+        }
+        let t = Instant::now();
+        self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
+        let res = self.kw.solve_rhs();
+        shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+        res.ok()
+    }
 
     /// Static regularisation of the equality rows, relative to each row's scale:
     /// kkt_static_regularization · clamp(max_j J_ij², 1e-3, 1). An absolute 1e-8 would swamp
@@ -136,6 +196,11 @@ impl Core<'_> {
         } else {
             out.copy_from_slice(&self.kw.eq_reg);
         }
+        if self.kw.reg_scale != 1.0 {
+            for o in out.iter_mut() {
+                *o *= self.kw.reg_scale;
+            }
+        }
         self.kw.eq_reg_step = out;
     }
 
@@ -151,7 +216,7 @@ impl Core<'_> {
         // The static Hessian regularisation only keeps exact zero pivots away while
         // δ_w = 0; a real δ_w > 0 does that itself.
         let x_reg = if delta_w == 0.0 {
-            self.opts.kkt_static_hessian_regularization
+            self.opts.kkt_static_hessian_regularization * self.kw.reg_scale
         } else {
             0.0
         };

@@ -122,6 +122,9 @@ struct Counters {
     soft_resto: Option<usize>,
     /// The filter already holds the current point (a soft restoration was tried).
     filter_has_current: bool,
+    /// Refactorisations with lowered static regularisation after a failed refinement
+    /// (see `Core::solve_with_higher_quality`).
+    quality_retries: usize,
 }
 
 /// The interior-point iteration: its named parts and the barrier and filter state.
@@ -334,6 +337,7 @@ impl<'p> Core<'p> {
                 hzero: vec![0.0; nnz_h],
                 work_nw: vec![0.0; nw],
                 lm: crate::lbfgs::LimitedMemoryHessian::from_options(opts, n),
+                reg_scale: 1.0,
             },
             pert: Perturbation::default(),
             count: Counters::default(),
