@@ -272,10 +272,11 @@ fn rocket_with_soft_restoration_within_twice_ipopt() {
 
 /// catmix_colloc_100 with IPOPT's `residual_ratio_singular` (1e-5): the refinement of
 /// iterations 16–17 ends at residual ratios 1.7e-10 and 5.2e-10, just above
-/// `residual_ratio_max` (1e-10); by default such a solve counts as singular and δ_w is
-/// raised (27 iterations, 9 regularised), with 1e-5 it is taken as it is and the solve
-/// takes IPOPT's 20 iterations (corpus.jsonl) with no δ_w. Not the default: race_car_rk4_400
-/// then takes 580 iterations instead of 61 (docs/solvers.md §6).
+/// `residual_ratio_max` (1e-10); without the refinement retry (the default since
+/// 2026-11-25, next test) such a solve counted as singular and δ_w was raised (27
+/// iterations, 9 regularised); with 1e-5 it is taken as it is and the solve takes IPOPT's
+/// 20 iterations (corpus.jsonl) with no δ_w. Not the default: race_car_rk4_400 then takes
+/// 580 iterations instead of 61 (docs/solvers.md §6).
 #[test]
 fn catmix_with_ipopts_residual_ratio_singular_takes_ipopts_count() {
     use nlp::NamedOptions;
