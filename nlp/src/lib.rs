@@ -22,6 +22,8 @@ pub(crate) mod scaling;
 pub mod sensitivity;
 pub mod solution;
 pub mod sqp;
+#[cfg(test)]
+mod test_support;
 
 pub use callback::{IterationCallback, IterationView, PhaseLabel};
 pub use compiled::Compiled;

@@ -3,38 +3,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::{Kkt, KktError, KktFactorization};
+use crate::test_support::{pattern, Rng};
 use faer::sparse::SymbolicSparseColMat;
 use faer::{Mat, Side};
-
-/// Tiny deterministic generator (xorshift) so the tests need no extra dependency.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn sym(&mut self) -> f64 {
-        2.0 * self.next() - 1.0
-    }
-}
-
-fn pattern(nrows: usize, ncols: usize, entries: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
-    let mut cols: Vec<Vec<usize>> = vec![Vec::new(); ncols];
-    for &(r, c) in entries {
-        cols[c].push(r);
-    }
-    let mut cp = vec![0];
-    let mut ri = Vec::new();
-    for mut c in cols {
-        c.sort_unstable();
-        c.dedup();
-        ri.extend(c);
-        cp.push(ri.len());
-    }
-    SymbolicSparseColMat::new_checked(nrows, ncols, cp, None, ri)
-}
 
 struct Case {
     n: usize,

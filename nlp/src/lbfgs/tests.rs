@@ -3,25 +3,9 @@
 
 use super::*;
 use crate::kkt::LowRankKkt;
+use crate::test_support::{pattern, Rng};
 use faer::linalg::solvers::Solve;
 use faer::Side;
-
-/// Deterministic xorshift generator.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn sym(&mut self) -> f64 {
-        2.0 * self.next() - 1.0
-    }
-    fn vec(&mut self, n: usize) -> Vec<f64> {
-        (0..n).map(|_| self.sym()).collect()
-    }
-}
 
 fn settings(update: LimitedMemoryUpdate, max_history: usize) -> Settings {
     Settings {
@@ -249,23 +233,6 @@ fn secant_pair_uses_the_new_multipliers_on_both_sides() {
     let y = [2.0 * 0.5 + 2.0 * 0.2, 2.0 * 0.5];
     assert!((dot(&mem.s[0], &mem.y[0]) - dot(&[0.5, 0.2], &y)).abs() < 1e-14);
     assert!((mem.y[0][0] - y[0]).abs() < 1e-14 && (mem.y[0][1] - y[1]).abs() < 1e-14);
-}
-
-/// CSC pattern from (row, col) entries.
-fn pattern(nrows: usize, ncols: usize, entries: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
-    let mut cols: Vec<Vec<usize>> = vec![Vec::new(); ncols];
-    for &(r, c) in entries {
-        cols[c].push(r);
-    }
-    let mut cp = vec![0];
-    let mut ri = Vec::new();
-    for mut c in cols {
-        c.sort_unstable();
-        c.dedup();
-        ri.extend(c);
-        cp.push(ri.len());
-    }
-    SymbolicSparseColMat::new_checked(nrows, ncols, cp, None, ri)
 }
 
 /// Dense K = [B + diag(dx), Jᵀ; J, −diag(dc)].
