@@ -17,7 +17,8 @@
 
 use faer::{Mat, Side};
 
-use super::{inf_norm, Inertia, Kkt, KktError, REFINEMENT_FLOOR};
+use super::refine::{refine, Refinable, RefineLimits};
+use super::{Inertia, Kkt, KktError};
 
 /// Eigenvalues below this × the largest magnitude in their matrix count as zero (the
 /// small matrices are formed from sums of products of O(n) vectors, so their entries
@@ -326,7 +327,8 @@ impl LowRankKkt {
         Ok(ratio)
     }
 
-    /// x (= rhs on entry) ← refined solution of (K + diag(shift)) x = b.
+    /// x (= rhs on entry) ← refined solution of (K + diag(shift)) x = b, K with the
+    /// low-rank term (the shared [`refine`] loop, the SMW solve as its approximate solve).
     fn refine(
         &mut self,
         kkt: &mut Kkt,
@@ -336,49 +338,33 @@ impl LowRankKkt {
         r: &mut [f64],
         d: &mut [f64],
     ) -> Result<f64, KktError> {
-        let b_norm = inf_norm(b);
-        self.smw_solve(kkt, x)?;
-        let mut ratio = f64::INFINITY;
-        let mut steps = 0;
-        loop {
-            kkt.multiply(x, shift, r)?;
-            if let Some(term) = &self.term {
-                term.add_low_rank_product(x, r);
-            }
-            for (ri, bi) in r.iter_mut().zip(b) {
-                *ri = bi - *ri;
-            }
-            // IPOPT's residual ratio, as in `Kkt::solve_shifted`.
-            let denom = inf_norm(x).min(1e6 * b_norm) + b_norm;
-            let r_norm = inf_norm(r);
-            let new_ratio = if denom > 0.0 { r_norm / denom } else { r_norm };
-            if !new_ratio.is_finite() {
-                break;
-            }
-            if steps > 0 && new_ratio >= ratio {
-                for (xi, di) in x.iter_mut().zip(d.iter()) {
-                    *xi -= di;
-                }
-                break;
-            }
-            // Keep refining past the target while a step still gains a lot, as
-            // `Kkt::solve_shifted` does (a backward error at the target can leave the
-            // small entries of x far off on an ill-conditioned K).
-            let fast = new_ratio <= 0.5 * ratio;
-            ratio = new_ratio;
-            let converged = ratio <= kkt.residual_ratio_max
-                && (ratio <= REFINEMENT_FLOOR || (steps > 0 && !fast));
-            if (steps >= kkt.min_refinement_steps && converged) || steps >= kkt.max_refinement_steps
-            {
-                break;
-            }
-            d.copy_from_slice(r);
-            self.smw_solve(kkt, d)?;
-            for (xi, di) in x.iter_mut().zip(d.iter()) {
-                *xi += di;
-            }
-            steps += 1;
+        let limits = RefineLimits::of(kkt);
+        let mut op = WithLowRank {
+            solver: self,
+            kkt,
+            shift,
+        };
+        refine(&mut op, limits, b, x, r, d)
+    }
+}
+
+/// K + diag(shift) + the low-rank term, with the SMW solve, as [`Refinable`].
+struct WithLowRank<'a> {
+    solver: &'a mut LowRankKkt,
+    kkt: &'a mut Kkt,
+    shift: Option<&'a [f64]>,
+}
+
+impl Refinable for WithLowRank<'_> {
+    type Error = KktError;
+    fn apply(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), KktError> {
+        self.kkt.multiply(x, self.shift, r)?;
+        if let Some(term) = &self.solver.term {
+            term.add_low_rank_product(x, r);
         }
-        Ok(ratio)
+        Ok(())
+    }
+    fn approx_solve(&mut self, v: &mut [f64]) -> Result<(), KktError> {
+        self.solver.smw_solve(self.kkt, v)
     }
 }

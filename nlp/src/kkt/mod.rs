@@ -46,7 +46,6 @@ pub use error::KktError;
 pub(crate) use low_rank::{LowRankKkt, LowRankTerm};
 
 use pattern::UpperPattern;
-use refine::{inf_norm, REFINEMENT_FLOOR};
 use simplicial::Simplicial;
 
 /// Numbers of positive, negative and zero eigenvalues.

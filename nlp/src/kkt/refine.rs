@@ -108,56 +108,118 @@ impl Kkt {
         Ok(ratio)
     }
 
-    /// x = K⁻¹b refined against K + diag(shift) until the residual ratio meets the
-    /// target (see below) or stops improving; returns the ratio.
+    /// x = K⁻¹b refined against K + diag(shift) (see [`refine`]); returns the ratio.
     fn refine(&mut self, w: &mut Work, shift: Option<&[f64]>) -> f64 {
+        let limits = RefineLimits::of(self);
         let Work { b, x, r, d } = w;
-        let b_norm = inf_norm(b);
-        x.copy_from_slice(b);
-        self.raw_solve(x);
-        let mut ratio = f64::INFINITY;
-        let mut steps = 0;
-        loop {
-            self.matvec(x, shift, r);
-            for (r, b) in r.iter_mut().zip(b.iter()) {
-                *r = b - *r;
-            }
-            // IPOPT's residual ratio ‖r‖ / (min(‖x‖, 10⁶‖b‖) + ‖b‖): the cap on ‖x‖ keeps
-            // a huge solution of a (nearly) singular system from looking accurate.
-            let r_norm = inf_norm(r);
-            let denom = inf_norm(x).min(1e6 * b_norm) + b_norm;
-            let new_ratio = if denom > 0.0 { r_norm / denom } else { r_norm };
-            if !new_ratio.is_finite() {
-                break;
-            }
-            if steps > 0 && new_ratio >= ratio {
-                // Refinement stopped improving: undo the last correction.
-                for (x, d) in x.iter_mut().zip(d.iter()) {
-                    *x -= d;
-                }
-                break;
-            }
-            // The ratio is a backward error dominated by the largest entries of x: on an
-            // ill-conditioned K (huge multipliers) it can pass the target while the small
-            // entries are still far off. So keep refining past the target while a step
-            // still gains a lot (at most ½ of the previous ratio) and the ratio is above
-            // round-off; a well-conditioned system reaches round-off in one step.
-            let fast = new_ratio <= 0.5 * ratio;
-            ratio = new_ratio;
-            let converged = ratio <= self.residual_ratio_max
-                && (ratio <= REFINEMENT_FLOOR || (steps > 0 && !fast));
-            if (steps >= self.min_refinement_steps && converged)
-                || steps >= self.max_refinement_steps
-            {
-                break;
-            }
-            d.copy_from_slice(r);
-            self.raw_solve(d);
-            for (x, d) in x.iter_mut().zip(d.iter()) {
-                *x += d;
-            }
-            steps += 1;
+        match refine(&mut Plain { kkt: self, shift }, limits, b, x, r, d) {
+            Ok(ratio) => ratio,
+            Err(never) => match never {},
         }
-        ratio
     }
+}
+
+/// The operator iterative refinement works on: K (+ shift) and an approximate solve
+/// with it (the factorisation of K, or of K plus a low-rank term).
+pub(super) trait Refinable {
+    /// Why an application can fail.
+    type Error;
+    /// r = K x.
+    fn apply(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Self::Error>;
+    /// v ← an approximate K⁻¹ v.
+    fn approx_solve(&mut self, v: &mut [f64]) -> Result<(), Self::Error>;
+}
+
+/// The factorised K with an optional diagonal shift, as [`Refinable`].
+struct Plain<'a> {
+    kkt: &'a mut Kkt,
+    shift: Option<&'a [f64]>,
+}
+
+impl Refinable for Plain<'_> {
+    type Error = std::convert::Infallible;
+    fn apply(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), Self::Error> {
+        self.kkt.matvec(x, self.shift, r);
+        Ok(())
+    }
+    fn approx_solve(&mut self, v: &mut [f64]) -> Result<(), Self::Error> {
+        self.kkt.raw_solve(v);
+        Ok(())
+    }
+}
+
+/// The refinement settings of a [`Kkt`].
+#[derive(Clone, Copy)]
+pub(super) struct RefineLimits {
+    residual_ratio_max: f64,
+    min_steps: usize,
+    max_steps: usize,
+}
+
+impl RefineLimits {
+    pub(super) fn of(kkt: &Kkt) -> RefineLimits {
+        RefineLimits {
+            residual_ratio_max: kkt.residual_ratio_max,
+            min_steps: kkt.min_refinement_steps,
+            max_steps: kkt.max_refinement_steps,
+        }
+    }
+}
+
+/// x = K⁻¹b by `op`'s approximate solve, refined against `op`'s K until the residual ratio
+/// meets the target (see below) or stops improving; returns the ratio. `r` and `d` are
+/// work vectors of K's dimension.
+pub(super) fn refine<R: Refinable>(
+    op: &mut R,
+    limits: RefineLimits,
+    b: &[f64],
+    x: &mut [f64],
+    r: &mut [f64],
+    d: &mut [f64],
+) -> Result<f64, R::Error> {
+    let b_norm = inf_norm(b);
+    x.copy_from_slice(b);
+    op.approx_solve(x)?;
+    let mut ratio = f64::INFINITY;
+    let mut steps = 0;
+    loop {
+        op.apply(x, r)?;
+        for (r, b) in r.iter_mut().zip(b.iter()) {
+            *r = b - *r;
+        }
+        // IPOPT's residual ratio ‖r‖ / (min(‖x‖, 10⁶‖b‖) + ‖b‖): the cap on ‖x‖ keeps
+        // a huge solution of a (nearly) singular system from looking accurate.
+        let r_norm = inf_norm(r);
+        let denom = inf_norm(x).min(1e6 * b_norm) + b_norm;
+        let new_ratio = if denom > 0.0 { r_norm / denom } else { r_norm };
+        if !new_ratio.is_finite() {
+            break;
+        }
+        if steps > 0 && new_ratio >= ratio {
+            // Refinement stopped improving: undo the last correction.
+            for (x, d) in x.iter_mut().zip(d.iter()) {
+                *x -= d;
+            }
+            break;
+        }
+        // The ratio is a backward error dominated by the largest entries of x: on an
+        // ill-conditioned K (huge multipliers) it can pass the target while the small
+        // entries are still far off. So keep refining past the target while a step
+        // still gains a lot (at most ½ of the previous ratio) and the ratio is above
+        // round-off; a well-conditioned system reaches round-off in one step.
+        let fast = new_ratio <= 0.5 * ratio;
+        ratio = new_ratio;
+        let converged = ratio <= limits.residual_ratio_max
+            && (ratio <= REFINEMENT_FLOOR || (steps > 0 && !fast));
+        if (steps >= limits.min_steps && converged) || steps >= limits.max_steps {
+            break;
+        }
+        d.copy_from_slice(r);
+        op.approx_solve(d)?;
+        for (x, d) in x.iter_mut().zip(d.iter()) {
+            *x += d;
+        }
+        steps += 1;
+    }
+    Ok(ratio)
 }
