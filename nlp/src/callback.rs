@@ -174,9 +174,9 @@ impl<'c> Observer<'c> {
         z_cone: &[f64],
     ) -> bool {
         self.x.copy_from_slice(x);
-        sc.lambdas_to_user(lambda_scaled, &mut self.lambda);
+        sc.scaling.lambdas_to_user(lambda_scaled, &mut self.lambda);
         for c in cones {
-            self.lambda[c.row] = sc.z_to_user(z_cone[c.offset]);
+            self.lambda[c.row] = sc.scaling.z_to_user(z_cone[c.offset]);
         }
         self.call(record)
     }

@@ -12,6 +12,84 @@ use std::time::Instant;
 use crate::numeric::NumericNlp;
 use crate::solution::Stats;
 
+/// The scaling of a problem: the objective factor s_f and one factor s_g,i per row, with
+/// the conversions of values and multipliers between the scaled problem and the user's
+/// units. Both back ends unscale through it (the IPM's core holds the factors of its
+/// reduced rows, see [`Scaling::restrict`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Scaling {
+    /// Objective factor s_f.
+    pub obj: f64,
+    /// Row factors s_g,i.
+    pub rows: Vec<f64>,
+}
+
+impl Scaling {
+    /// All factors 1, for `m` rows.
+    pub fn unscaled(m: usize) -> Self {
+        Scaling {
+            obj: 1.0,
+            rows: vec![1.0; m],
+        }
+    }
+
+    /// The factors of the rows `keep` (in that order), with the same s_f.
+    pub fn restrict(&self, keep: &[usize]) -> Self {
+        Scaling {
+            obj: self.obj,
+            rows: keep.iter().map(|&i| self.rows[i]).collect(),
+        }
+    }
+
+    /// λ_i in the user's units from the multiplier `y` of scaled row i: y·s_g,i / s_f.
+    pub fn lambda_to_user(&self, i: usize, y: f64) -> f64 {
+        y * self.rows[i] / self.obj
+    }
+
+    /// Every λ in the user's units from the multipliers of the scaled rows
+    /// ([`Scaling::lambda_to_user`] row by row) into `out`.
+    pub fn lambdas_to_user(&self, scaled: &[f64], out: &mut [f64]) {
+        for (i, (l, &y)) in out.iter_mut().zip(scaled).enumerate() {
+            *l = self.lambda_to_user(i, y);
+        }
+    }
+
+    /// A quantity in units of the objective (its value, a gradient or dual-infeasibility
+    /// entry, complementarity) in the user's units: v / s_f.
+    pub fn objective_to_user(&self, v: f64) -> f64 {
+        v / self.obj
+    }
+
+    /// A quantity in units of scaled row i (its value, its violation) in the user's
+    /// units: v / s_g,i.
+    pub fn row_to_user(&self, i: usize, v: f64) -> f64 {
+        v / self.rows[i]
+    }
+
+    /// The largest |c_i| / s_g,i: the max-norm of scaled row residuals `c` in the user's
+    /// units.
+    pub fn max_row_to_user(&self, c: &[f64]) -> f64 {
+        c.iter()
+            .zip(&self.rows)
+            .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s))
+    }
+
+    /// The multiplier of scaled row i from the user's λ_i: λ_i·s_f / s_g,i.
+    pub fn lambda_from_user(&self, i: usize, lambda: f64) -> f64 {
+        lambda * self.obj / self.rows[i]
+    }
+
+    /// A bound (or cone) multiplier in the user's units: z / s_f.
+    pub fn z_to_user(&self, z: f64) -> f64 {
+        z / self.obj
+    }
+
+    /// A bound multiplier of the scaled problem from the user's: z·s_f.
+    pub fn z_from_user(&self, z: f64) -> f64 {
+        z * self.obj
+    }
+}
+
 /// Evaluation counters and time spent in user callbacks.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct EvalCounters {
@@ -27,10 +105,8 @@ pub(crate) struct EvalCounters {
 /// and units (scaling changes only function values and multipliers).
 pub(crate) struct ScaledNlp<'a> {
     user: &'a mut dyn NumericNlp,
-    /// Objective factor s_f.
-    pub obj_scale: f64,
-    /// Row factors s_g (one per row of g, 1 where not scaled).
-    pub g_scale: Vec<f64>,
+    /// The factors s_f and s_g (1 where not scaled).
+    pub scaling: Scaling,
     pub counters: EvalCounters,
     /// Scratch: the user's multipliers for the Hessian.
     lam: Vec<f64>,
@@ -42,8 +118,7 @@ impl<'a> ScaledNlp<'a> {
         let m = user.m();
         ScaledNlp {
             user,
-            obj_scale: 1.0,
-            g_scale: vec![1.0; m],
+            scaling: Scaling::unscaled(m),
             counters: EvalCounters::default(),
             lam: vec![0.0; m],
         }
@@ -63,7 +138,7 @@ impl<'a> ScaledNlp<'a> {
     /// Scaled objective s_f·f(x).
     pub fn f(&mut self, x: &[f64]) -> f64 {
         let t = Instant::now();
-        let v = self.user.eval_f(x) * self.obj_scale;
+        let v = self.user.eval_f(x) * self.scaling.obj;
         self.counters.f += 1;
         self.counters.seconds += t.elapsed().as_secs_f64();
         v
@@ -73,7 +148,7 @@ impl<'a> ScaledNlp<'a> {
     pub fn grad(&mut self, x: &[f64], out: &mut [f64]) {
         let t = Instant::now();
         self.user.eval_grad_f(x, out);
-        out.iter_mut().for_each(|v| *v *= self.obj_scale);
+        out.iter_mut().for_each(|v| *v *= self.scaling.obj);
         self.counters.grad_f += 1;
         self.counters.seconds += t.elapsed().as_secs_f64();
     }
@@ -82,7 +157,7 @@ impl<'a> ScaledNlp<'a> {
     pub fn g(&mut self, x: &[f64], out: &mut [f64]) {
         let t = Instant::now();
         self.user.eval_g(x, out);
-        for (v, s) in out.iter_mut().zip(&self.g_scale) {
+        for (v, s) in out.iter_mut().zip(&self.scaling.rows) {
             *v *= s;
         }
         self.counters.g += 1;
@@ -95,7 +170,7 @@ impl<'a> ScaledNlp<'a> {
         self.user.eval_jac_g(x, out);
         let rows = self.user.jac_g_sparsity().row_idx();
         for (v, &r) in out.iter_mut().zip(rows) {
-            *v *= self.g_scale[r];
+            *v *= self.scaling.rows[r];
         }
         self.counters.jac_g += 1;
         self.counters.seconds += t.elapsed().as_secs_f64();
@@ -104,12 +179,12 @@ impl<'a> ScaledNlp<'a> {
     /// Hessian of the scaled Lagrangian σ·f̃ + λ̃ᵀg̃ for multipliers λ̃ of the scaled rows
     /// (the user's Hessian with σ·s_f and λ̃_i·s_g,i).
     pub fn hess(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], out: &mut [f64]) {
-        for ((l, &y), s) in self.lam.iter_mut().zip(lambda).zip(&self.g_scale) {
+        for ((l, &y), s) in self.lam.iter_mut().zip(lambda).zip(&self.scaling.rows) {
             *l = y * s;
         }
         let t = Instant::now();
         self.user
-            .eval_hess_l(x, obj_factor * self.obj_scale, &self.lam, out);
+            .eval_hess_l(x, obj_factor * self.scaling.obj, &self.lam, out);
         self.counters.hess_l += 1;
         self.counters.seconds += t.elapsed().as_secs_f64();
     }
@@ -165,46 +240,6 @@ impl<'a> ScaledNlp<'a> {
         (gmax, rmax)
     }
 
-    /// λ_i in the user's units from the multiplier `y` of scaled row i: y·s_g,i / s_f.
-    pub fn lambda_to_user(&self, i: usize, y: f64) -> f64 {
-        y * self.g_scale[i] / self.obj_scale
-    }
-
-    /// Every λ in the user's units from the multipliers of the scaled rows
-    /// ([`ScaledNlp::lambda_to_user`] row by row) into `out`.
-    pub fn lambdas_to_user(&self, scaled: &[f64], out: &mut [f64]) {
-        for (i, (l, &y)) in out.iter_mut().zip(scaled).enumerate() {
-            *l = self.lambda_to_user(i, y);
-        }
-    }
-
-    /// A quantity in units of the objective (its value, a gradient or dual-infeasibility
-    /// entry, complementarity) in the user's units: v / s_f.
-    pub fn objective_to_user(&self, v: f64) -> f64 {
-        v / self.obj_scale
-    }
-
-    /// A quantity in units of scaled row i (its value, its violation) in the user's
-    /// units: v / s_g,i.
-    pub fn row_to_user(&self, i: usize, v: f64) -> f64 {
-        v / self.g_scale[i]
-    }
-
-    /// The multiplier of scaled row i from the user's λ_i: λ_i·s_f / s_g,i.
-    pub fn lambda_from_user(&self, i: usize, lambda: f64) -> f64 {
-        lambda * self.obj_scale / self.g_scale[i]
-    }
-
-    /// A bound (or cone) multiplier in the user's units: z / s_f.
-    pub fn z_to_user(&self, z: f64) -> f64 {
-        z / self.obj_scale
-    }
-
-    /// A bound multiplier of the scaled problem from the user's: z·s_f.
-    pub fn z_from_user(&self, z: f64) -> f64 {
-        z * self.obj_scale
-    }
-
     /// Writes the evaluation counts, their time and s_f into `stats`.
     pub fn write_stats(&self, stats: &mut Stats) {
         let c = &self.counters;
@@ -214,7 +249,7 @@ impl<'a> ScaledNlp<'a> {
         stats.n_eval_jac_g = c.jac_g;
         stats.n_eval_hess_l = c.hess_l;
         stats.eval_seconds = c.seconds;
-        stats.obj_scaling = self.obj_scale;
+        stats.obj_scaling = self.scaling.obj;
     }
 }
 
@@ -257,8 +292,8 @@ mod tests {
         assert_eq!((gmax, rmax.clone()), (12.0, vec![3.0, 100.0]));
         let (gmax, rmax) = sc.unscaled_gradient_norms(&x, Some(&[false, true]));
         assert_eq!((gmax, rmax), (1.0, vec![2.0, 1.0]));
-        sc.obj_scale = 0.5;
-        sc.g_scale = vec![2.0, 0.01];
+        sc.scaling.obj = 0.5;
+        sc.scaling.rows = vec![2.0, 0.01];
         // Factors are powers of two or exact decimals times small integers: the scaled
         // values below are exact, so equality is the test.
         assert_eq!(sc.f(&x), 0.5 * 15.0);
@@ -284,16 +319,19 @@ mod tests {
         let c = &sc.counters;
         assert_eq!((c.f, c.grad_f, c.g, c.jac_g, c.hess_l), (1, 3, 1, 3, 1));
         // λ_user = λ̃·s_g/s_f and back; z_user = z/s_f and back.
-        assert_eq!(sc.lambda_to_user(0, 3.0), 12.0);
-        assert_eq!(sc.lambda_from_user(0, 12.0), 3.0);
-        assert_eq!(sc.z_to_user(1.5), 3.0);
-        assert_eq!(sc.z_from_user(3.0), 1.5);
+        assert_eq!(sc.scaling.lambda_to_user(0, 3.0), 12.0);
+        assert_eq!(sc.scaling.lambda_from_user(0, 12.0), 3.0);
+        assert_eq!(sc.scaling.z_to_user(1.5), 3.0);
+        assert_eq!(sc.scaling.z_from_user(3.0), 1.5);
         let mut lam = [0.0; 2];
-        sc.lambdas_to_user(&[3.0, 7.0], &mut lam);
+        sc.scaling.lambdas_to_user(&[3.0, 7.0], &mut lam);
         assert_eq!(lam, [12.0, 7.0 * 0.01 / 0.5]);
-        assert_eq!(sc.objective_to_user(1.5), 3.0);
+        assert_eq!(sc.scaling.objective_to_user(1.5), 3.0);
         assert_eq!(
-            (sc.row_to_user(0, 3.0), sc.row_to_user(1, 0.5)),
+            (
+                sc.scaling.row_to_user(0, 3.0),
+                sc.scaling.row_to_user(1, 0.5)
+            ),
             (1.5, 50.0)
         );
         let mut stats = Stats::default();

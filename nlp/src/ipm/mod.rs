@@ -137,17 +137,17 @@ impl Ipm {
                     y: red
                         .rows
                         .iter()
-                        .map(|&i| red.sc.lambda_from_user(i, prev.lambda[i]))
+                        .map(|&i| red.sc.scaling.lambda_from_user(i, prev.lambda[i]))
                         .collect(),
                     zl: red
                         .free
                         .iter()
-                        .map(|&j| red.sc.z_from_user(prev.z_l[j]))
+                        .map(|&j| red.sc.scaling.z_from_user(prev.z_l[j]))
                         .collect(),
                     zu: red
                         .free
                         .iter()
-                        .map(|&j| red.sc.z_from_user(prev.z_u[j]))
+                        .map(|&j| red.sc.scaling.z_from_user(prev.z_u[j]))
                         .collect(),
                 },
             };
@@ -159,8 +159,7 @@ impl Ipm {
                 },
                 bound_relax_factor: opts.bound_relax_factor,
                 in_resto: false,
-                obj_scale: red.obj_scale(),
-                g_scale: red.g_scale(),
+                scaling: red.scaling(),
                 mu_strategy: opts.mu_strategy,
             };
             match Core::new(&mut red, opts, &setup) {
@@ -254,11 +253,14 @@ fn finish(
         if k < w.len() {
             point.x[j] = w[k];
         }
-        point.z_l[j] = red.sc.z_to_user(zl.get(k).copied().unwrap_or(0.0));
-        point.z_u[j] = red.sc.z_to_user(zu.get(k).copied().unwrap_or(0.0));
+        point.z_l[j] = red.sc.scaling.z_to_user(zl.get(k).copied().unwrap_or(0.0));
+        point.z_u[j] = red.sc.scaling.z_to_user(zu.get(k).copied().unwrap_or(0.0));
     }
     for (k, &i) in red.rows.iter().enumerate() {
-        point.lambda[i] = red.sc.lambda_to_user(i, y.get(k).copied().unwrap_or(0.0));
+        point.lambda[i] = red
+            .sc
+            .scaling
+            .lambda_to_user(i, y.get(k).copied().unwrap_or(0.0));
     }
     user_solution(&mut red.sc, v, point, None, status, message)
 }
@@ -270,7 +272,7 @@ fn scale_at_start(red: &mut Reduced<'_>, opts: &IpmOptions) {
     if opts.nlp_scaling_method == ScalingMethod::GradientBased && n > 0 {
         let x0 = red.x0.clone();
         let (gmax, rmax) = red.unscaled_gradient_norms(&x0);
-        red.sc.obj_scale = opts.obj_scaling_factor
+        red.sc.scaling.obj = opts.obj_scaling_factor
             * gradient_scale(
                 gmax,
                 opts.nlp_scaling_max_gradient,
@@ -290,9 +292,9 @@ fn scale_at_start(red: &mut Reduced<'_>, opts: &IpmOptions) {
                     opts.nlp_scaling_max_value,
                 );
             }
-            red.sc.g_scale[i] = s;
+            red.sc.scaling.rows[i] = s;
         }
     } else {
-        red.sc.obj_scale = opts.obj_scaling_factor;
+        red.sc.scaling.obj = opts.obj_scaling_factor;
     }
 }

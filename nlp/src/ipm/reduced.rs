@@ -7,7 +7,7 @@
 
 use faer::sparse::SymbolicSparseColMat;
 
-use crate::frontend::scaled::ScaledNlp;
+use crate::frontend::scaled::{ScaledNlp, Scaling};
 use crate::numeric::NumericNlp;
 
 /// The problem interface of the core: a [`NumericNlp`] plus a hook that the restoration
@@ -120,14 +120,9 @@ impl<'a> Reduced<'a> {
         }
     }
 
-    /// Objective factor s_f.
-    pub fn obj_scale(&self) -> f64 {
-        self.sc.obj_scale
-    }
-
-    /// Row factors of the kept rows.
-    pub fn g_scale(&self) -> Vec<f64> {
-        self.rows.iter().map(|&i| self.sc.g_scale[i]).collect()
+    /// The scaling of the reduced problem (the factors of the kept rows).
+    pub fn scaling(&self) -> Scaling {
+        self.sc.scaling.restrict(&self.rows)
     }
 
     fn set_x(&mut self, x: &[f64]) {
@@ -200,8 +195,8 @@ impl NumericNlp for Reduced<'_> {
         x_l.copy_from_slice(&self.x_l);
         x_u.copy_from_slice(&self.x_u);
         for (k, &i) in self.rows.iter().enumerate() {
-            g_l[k] = self.g_l[k] * self.sc.g_scale[i];
-            g_u[k] = self.g_u[k] * self.sc.g_scale[i];
+            g_l[k] = self.g_l[k] * self.sc.scaling.rows[i];
+            g_u[k] = self.g_u[k] * self.sc.scaling.rows[i];
         }
     }
     fn initial_point(&self, x: &mut [f64]) {
@@ -267,7 +262,7 @@ impl IpmProblem for Reduced<'_> {
         }
         lambda_user.iter_mut().for_each(|v| *v = 0.0);
         for (k, &i) in self.rows.iter().enumerate() {
-            lambda_user[i] = self.sc.lambda_to_user(i, y[k]);
+            lambda_user[i] = self.sc.scaling.lambda_to_user(i, y[k]);
         }
     }
 }

@@ -13,6 +13,7 @@
 
 use faer::sparse::SymbolicSparseColMat;
 
+use crate::frontend::scaled::Scaling;
 use crate::ipm::core::{barrier_value, Core, Outcome, Setup, Shared, Start};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
@@ -55,9 +56,8 @@ struct Resto<'a> {
     theta_max: f64,
     gbuf: Vec<f64>,
     wbuf: Vec<f64>,
-    // unscaling of the outer problem, for the iteration log
-    obj_scale: f64,
-    g_scale: Vec<f64>,
+    /// The outer problem's scaling, for the iteration log.
+    outer_scaling: Scaling,
 }
 
 impl NumericNlp for Resto<'_> {
@@ -159,11 +159,14 @@ impl IpmProblem for Resto<'_> {
         let (n, m) = (self.n, self.m);
         let x = &w[..n];
         let s = &w[n + 2 * m..];
-        let f = self.outer.eval_f(x) / self.obj_scale;
+        let f = self.outer_scaling.objective_to_user(self.outer.eval_f(x));
         self.outer.eval_g(x, &mut self.gbuf);
         let mut viol: f64 = 0.0;
         for i in 0..m {
-            viol = viol.max(self.outer_residual(i, s).abs() / self.g_scale[i]);
+            viol = viol.max(
+                self.outer_scaling
+                    .row_to_user(i, self.outer_residual(i, s).abs()),
+            );
         }
         Some((f, viol))
     }
@@ -305,8 +308,7 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         theta_max,
         gbuf: vec![0.0; m],
         wbuf: vec![0.0; n + ni],
-        obj_scale: core.obj_scale(),
-        g_scale: core.g_scale().to_vec(),
+        outer_scaling: core.scaling().clone(),
         outer: core.problem_mut(),
     };
     let mut resto = resto;
@@ -314,8 +316,7 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         mu_init: mu,
         bound_relax_factor: 0.0,
         in_resto: true,
-        obj_scale: 1.0,
-        g_scale: vec![1.0; m],
+        scaling: Scaling::unscaled(m),
         mu_strategy: MuStrategy::Monotone,
     };
     let outcome = {
@@ -360,12 +361,7 @@ fn continue_after(
             }
             if outcome.resto_converged {
                 // The restoration problem converged: a minimiser of the infeasibility.
-                let viol = core
-                    .iterate()
-                    .c
-                    .iter()
-                    .zip(core_g_scale(core))
-                    .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s));
+                let viol = core.scaling().max_row_to_user(&core.iterate().c);
                 if viol > constr_viol_tol {
                     return Err(fail(
                         core,
@@ -473,10 +469,6 @@ fn restart_message(core: &mut Core<'_>, w_o: &[f64], message: String) -> String 
         Err(e) if message.is_empty() => e.to_string(),
         Err(e) => format!("{message}; {e}"),
     }
-}
-
-fn core_g_scale<'c>(core: &'c Core<'_>) -> &'c [f64] {
-    core.g_scale()
 }
 
 fn inf_norm(v: &[f64]) -> f64 {

@@ -67,7 +67,10 @@ impl Geometry {
         let mut s: f64 = 0.0;
         for i in 0..g.len() {
             if !self.cone_row[i] {
-                s = s.max(sc.row_to_user(i, viol(g[i], self.g_l[i], self.g_u[i])));
+                s = s.max(
+                    sc.scaling
+                        .row_to_user(i, viol(g[i], self.g_l[i], self.g_u[i])),
+                );
             }
         }
         for c in &self.cones {

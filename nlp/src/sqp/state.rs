@@ -120,14 +120,14 @@ fn scale(sc: &mut ScaledNlp<'_>, geo: &mut Geometry, x: &[f64], o: &SqpOptions) 
     let (max_gradient, min_value) = (o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
     if o.gradient_scaling {
         let (gmax, rmax) = sc.unscaled_gradient_norms(x, None);
-        sc.obj_scale = gradient_scale(gmax, max_gradient, min_value);
+        sc.scaling.obj = gradient_scale(gmax, max_gradient, min_value);
         for (i, r) in rmax.into_iter().enumerate() {
             if !geo.cone_row[i] {
-                sc.g_scale[i] = gradient_scale(r, max_gradient, min_value);
+                sc.scaling.rows[i] = gradient_scale(r, max_gradient, min_value);
             }
         }
     }
-    for (i, s) in sc.g_scale.iter().enumerate() {
+    for (i, s) in sc.scaling.rows.iter().enumerate() {
         geo.g_l[i] *= s;
         geo.g_u[i] *= s;
     }
@@ -192,7 +192,7 @@ impl<'a> SqpState<'a> {
         let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
         scale(&mut sc, &mut geo, &x, o);
         let stats = Stats {
-            obj_scaling: sc.obj_scale,
+            obj_scaling: sc.scaling.obj,
             ..Stats::default()
         };
         let mut g = vec![0.0; m];
@@ -204,11 +204,11 @@ impl<'a> SqpState<'a> {
         let mut mult = Mult::zeros(n, m, n_cone);
         if let Some(p) = warm {
             for i in 0..m {
-                mult.lambda[i] = sc.lambda_from_user(i, p.lambda[i]);
+                mult.lambda[i] = sc.scaling.lambda_from_user(i, p.lambda[i]);
             }
             for j in 0..n {
-                mult.z_l[j] = sc.z_from_user(p.z_l[j]);
-                mult.z_u[j] = sc.z_from_user(p.z_u[j]);
+                mult.z_l[j] = sc.scaling.z_from_user(p.z_l[j]);
+                mult.z_u[j] = sc.scaling.z_from_user(p.z_u[j]);
             }
         }
         let curv = Curvature {
@@ -229,7 +229,7 @@ impl<'a> SqpState<'a> {
         let record = IterationRecord {
             iter: 0,
             restoration: false,
-            objective: sc.objective_to_user(f),
+            objective: sc.scaling.objective_to_user(f),
             inf_pr: 0.0,
             inf_du: 0.0,
             mu: 0.0,
@@ -296,7 +296,7 @@ impl<'a> SqpState<'a> {
             .kkt_errors(o.s_max, &self.geo, &self.shape, &mut self.lgrad);
         let (it, sc) = (&self.it, &self.sc);
         self.record.iter = iter;
-        self.record.objective = sc.objective_to_user(it.f);
+        self.record.objective = sc.scaling.objective_to_user(it.f);
         self.record.inf_pr = err.inf_pr;
         self.record.inf_du = err.inf_du;
         self.stats.records.push(self.record);
@@ -320,9 +320,9 @@ impl<'a> SqpState<'a> {
         // measured: no test, and the streak of acceptable iterates restarts.
         let residuals = KktResiduals {
             overall: err.scaled,
-            dual: sc.objective_to_user(err.inf_du),
+            dual: sc.scaling.objective_to_user(err.inf_du),
             primal: unscaled_pr,
-            compl: sc.objective_to_user(err.compl),
+            compl: sc.scaling.objective_to_user(err.compl),
         };
         if !it.have_mult {
             *termination = Termination::default();
@@ -473,14 +473,29 @@ impl<'a> SqpState<'a> {
     pub fn user_solution(&mut self, stop: Stop) -> Solution {
         let (sc, it) = (&self.sc, &self.it);
         let mut lambda = vec![0.0; self.shape.m];
-        sc.lambdas_to_user(&it.mult.lambda, &mut lambda);
+        sc.scaling.lambdas_to_user(&it.mult.lambda, &mut lambda);
         let point = UserPoint {
             x: it.x.clone(),
             lambda,
-            z_l: it.mult.z_l.iter().map(|&z| sc.z_to_user(z)).collect(),
-            z_u: it.mult.z_u.iter().map(|&z| sc.z_to_user(z)).collect(),
+            z_l: it
+                .mult
+                .z_l
+                .iter()
+                .map(|&z| sc.scaling.z_to_user(z))
+                .collect(),
+            z_u: it
+                .mult
+                .z_u
+                .iter()
+                .map(|&z| sc.scaling.z_to_user(z))
+                .collect(),
         };
-        let z_cone: Vec<f64> = it.mult.z_cone.iter().map(|&z| sc.z_to_user(z)).collect();
+        let z_cone: Vec<f64> = it
+            .mult
+            .z_cone
+            .iter()
+            .map(|&z| sc.scaling.z_to_user(z))
+            .collect();
         let cones = ConeDuals {
             cones: &self.geo.cones,
             cone_row: &self.geo.cone_row,

@@ -34,12 +34,14 @@ impl Core<'_> {
                 r -= kd;
             }
             dual = dual.max(r.abs());
-            let unscale = if j < n {
-                1.0 / self.obj_scale
+            // A slack's dual residual is in units of its row's multiplier.
+            let r_user = if j < n {
+                self.scaling.z_to_user(r.abs())
             } else {
-                self.g_scale[self.lay.row_of_slack[j - n]] / self.obj_scale
+                self.scaling
+                    .lambda_to_user(self.lay.row_of_slack[j - n], r.abs())
             };
-            dual_u = dual_u.max(r.abs() * unscale);
+            dual_u = dual_u.max(r_user);
             if self.lay.has_l[j] {
                 compl = compl.max(((self.it.w[j] - self.lay.wl[j]) * self.it.zl[j] - mu_t).abs());
             }
@@ -49,15 +51,10 @@ impl Core<'_> {
         }
         self.kw.work_nw = work;
         let primal = inf_norm(&self.it.c);
-        let primal_u = self
-            .it
-            .c
-            .iter()
-            .zip(&self.g_scale)
-            .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s));
+        let primal_u = self.scaling.max_row_to_user(&self.it.c);
         (
             [dual, primal, compl],
-            [dual_u, primal_u, compl / self.obj_scale],
+            [dual_u, primal_u, self.scaling.objective_to_user(compl)],
         )
     }
 

@@ -11,6 +11,7 @@
 use std::time::Instant;
 
 use crate::callback::Observer;
+use crate::frontend::scaled::Scaling;
 use crate::frontend::{KktResiduals, Termination};
 use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, mu_floor_adaptive, probing_mu, tau};
 use crate::ipm::error::{At, CoreError};
@@ -71,8 +72,9 @@ pub(crate) struct Setup {
     pub mu_init: f64,
     pub bound_relax_factor: f64,
     pub in_resto: bool,
-    pub obj_scale: f64,
-    pub g_scale: Vec<f64>,
+    /// The scaling of the problem's rows (for the user's units in the log and the
+    /// termination tests).
+    pub scaling: Scaling,
     pub mu_strategy: MuStrategy,
 }
 
@@ -158,8 +160,7 @@ pub(crate) struct Core<'p> {
     setup_in_resto: bool,
     /// IPOPT's `recalc_y` in effect (see `Core::recalc_multipliers`).
     recalc_y: bool,
-    obj_scale: f64,
-    g_scale: Vec<f64>,
+    scaling: Scaling,
     mu_strategy: MuStrategy,
     /// The outer iteration's failed line search (alpha_pr, ls) that starts a restoration
     /// phase; shown in the restoration's first log row as IPOPT does ("12r … 4.8e-7R 22").
@@ -355,8 +356,7 @@ impl<'p> Core<'p> {
                 && opts
                     .recalc_y
                     .unwrap_or(opts.hessian_approximation == crate::IpmHessian::LimitedMemory),
-            obj_scale: setup.obj_scale,
-            g_scale: setup.g_scale.clone(),
+            scaling: setup.scaling.clone(),
             mu_strategy: setup.mu_strategy,
             resto_start: None,
         })
@@ -380,12 +380,8 @@ impl<'p> Core<'p> {
         let (objective, inf_pr) = match self.nlp.original_measures(&self.it.w) {
             Some(v) => v,
             None => (
-                self.it.f / self.obj_scale,
-                self.it
-                    .c
-                    .iter()
-                    .zip(&self.g_scale)
-                    .fold(0.0f64, |a, (c, s)| a.max(c.abs() / s)),
+                self.scaling.objective_to_user(self.it.f),
+                self.scaling.max_row_to_user(&self.it.c),
             ),
         };
         shared.stats.records.push(IterationRecord {
@@ -557,7 +553,7 @@ impl<'p> Core<'p> {
                         let (_, eu) = self.errors(0.0, false);
                         self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
                         if self.count.tiny_count >= 2
-                            && self.mu <= mu_floor(&self.opts, self.obj_scale) * (1.0 + 1e-12)
+                            && self.mu <= mu_floor(&self.opts, self.scaling.obj) * (1.0 + 1e-12)
                         {
                             return self.outcome(Status::SearchDirectionBecomesTooSmall, "", false);
                         }
@@ -730,13 +726,8 @@ impl<'p> Core<'p> {
         self.theta_max
     }
 
-    /// Objective scale factor (for the unscaled objective).
-    pub(crate) fn obj_scale(&self) -> f64 {
-        self.obj_scale
-    }
-
-    /// Constraint scale factors (for unscaled violations).
-    pub(crate) fn g_scale(&self) -> &[f64] {
-        &self.g_scale
+    /// The scaling of the problem (objective and rows), for the user's units.
+    pub(crate) fn scaling(&self) -> &Scaling {
+        &self.scaling
     }
 }

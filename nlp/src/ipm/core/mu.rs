@@ -13,7 +13,7 @@ impl Core<'_> {
     // ------------------------------------------------------------------ barrier update
 
     pub(super) fn update_mu_monotone(&mut self, force: bool) {
-        let floor = mu_floor(&self.opts, self.obj_scale);
+        let floor = mu_floor(&self.opts, self.scaling.obj);
         let mut first = true;
         loop {
             if self.mu <= floor {
@@ -24,7 +24,7 @@ impl Core<'_> {
                 return;
             }
             first = false;
-            self.mu = monotone_next(self.mu, &self.opts, self.obj_scale);
+            self.mu = monotone_next(self.mu, &self.opts, self.scaling.obj);
             self.tau = tau(self.mu, &self.opts);
             self.filter.reset();
             if !self.opts.mu_allow_fast_monotone_decrease {
@@ -43,7 +43,7 @@ impl Core<'_> {
                 self.free_mode = false;
                 let (avg, _) = self.avg_compl(&self.it.w, &self.it.zl, &self.it.zu);
                 self.mu = (self.opts.adaptive_mu_monotone_init_factor * avg)
-                    .clamp(mu_floor(&self.opts, self.obj_scale), self.opts.mu_max);
+                    .clamp(mu_floor(&self.opts, self.scaling.obj), self.opts.mu_max);
                 self.tau = tau(self.mu, &self.opts);
                 self.filter.reset();
                 return;
@@ -92,7 +92,7 @@ impl Core<'_> {
             }
         };
         mu = mu.clamp(
-            mu_floor_adaptive(&self.opts, self.obj_scale),
+            mu_floor_adaptive(&self.opts, self.scaling.obj),
             self.opts.mu_max,
         );
         if mu != self.mu {
