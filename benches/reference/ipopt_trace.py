@@ -67,8 +67,11 @@ def run(a):
                 rec = {"iter": k}
                 rec.update({ours: it[theirs][k] for theirs, ours in names.items()})
                 fh.write(json.dumps(rec) + "\n")
-    print(json.dumps({"status": st["return_status"], "iterations": st["iter_count"],
-                      "objective": float(r["f"]), "perturb": a.perturb, "opts": a.opt}))
+    out = {"status": st["return_status"], "iterations": st["iter_count"],
+           "objective": float(r["f"]), "perturb": a.perturb, "opts": a.opt}
+    if a.print_x:
+        out["x"] = r["x"].full().ravel().tolist()
+    print(json.dumps(out))
 
 
 def main():
@@ -77,6 +80,7 @@ def main():
     ap.add_argument("--print-level", type=int, default=5)
     ap.add_argument("--perturb", type=float, default=0.0, help="relative perturbation of x0")
     ap.add_argument("--records", help="write the per-iteration stats here (JSON lines)")
+    ap.add_argument("--print-x", action="store_true", help="also print the final x (e.g. with --opt max_iter=K)")
     ap.add_argument("--opt", action="append", default=[], help="extra IPOPT option NAME=VALUE")
     a = ap.parse_args()
     sys.setrecursionlimit(1_000_000)

@@ -82,6 +82,9 @@ enum Command {
         /// An IPM option `NAME=VALUE` (IpmOptions' field names), repeatable.
         #[arg(long = "opt")]
         opts: Vec<String>,
+        /// Also print the final x in the outcome line (e.g. with `--opt max_iter=K`).
+        #[arg(long)]
+        print_x: bool,
     },
     /// Prints the markdown table and summary of a results file and writes the profiles.
     Report {
@@ -202,7 +205,8 @@ fn real_main() -> Result<(), CorpusError> {
             perturb,
             max_wall,
             opts,
-        } => trace(&name, perturb, max_wall, &opts)?,
+            print_x,
+        } => trace(&name, perturb, max_wall, &opts, print_x)?,
         Command::Report { file, svg_dir } => {
             let text = std::fs::read_to_string(&file)
                 .map_err(|e| CorpusError::Results(format!("{file}: {e}")))?;
@@ -260,7 +264,13 @@ fn real_main() -> Result<(), CorpusError> {
 }
 
 /// `corpus trace`: every iteration record of one (possibly perturbed) solve, then the outcome.
-fn trace(name: &str, perturb: f64, max_wall: f64, opts: &[String]) -> Result<(), CorpusError> {
+fn trace(
+    name: &str,
+    perturb: f64,
+    max_wall: f64,
+    opts: &[String],
+    print_x: bool,
+) -> Result<(), CorpusError> {
     use nlp::{NamedOptions, NumericNlp};
     let mut options = run::options(max_wall);
     options
@@ -282,9 +292,12 @@ fn trace(name: &str, perturb: f64, max_wall: f64, opts: &[String]) -> Result<(),
     for r in &sol.stats.records {
         println!("{}", serde_json::to_string(r).expect("serialisable"));
     }
-    let line = serde_json::json!({"instance": name, "perturb": perturb,
+    let mut line = serde_json::json!({"instance": name, "perturb": perturb,
         "status": format!("{:?}", sol.status), "iterations": sol.stats.iterations,
         "objective": sol.objective});
+    if print_x {
+        line["x"] = serde_json::json!(sol.x);
+    }
     println!("{line}");
     Ok(())
 }
