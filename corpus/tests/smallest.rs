@@ -374,8 +374,9 @@ fn instances_at_any_size() {
 /// noncvxu2 at n = 10 (not a corpus size): the same minimum as IPOPT 3.14.19 on the same
 /// exported formulation (`benches/reference/ipopt_trace.py`: 23.16808419788213, 14
 /// iterations; symnlp 13, the inertia of the exactly singular W at iterate 9 being
-/// decided by round-off, docs/performance.md "noncvxu2 / noncvxun"). At n ≥ 200 the
-/// minimum reached depends on round-off in both solvers, so only this size is a test.
+/// decided by round-off, docs/performance.md "noncvxu2 / noncvxun"). symnlp reaches this
+/// minimum from all 21 starts x0·(1 ± k·1e-15); from n = 50 on the minimum reached depends
+/// on round-off in both solvers (n = 100: 6 minima over the same 21 starts).
 /// 1e-9: both ends agree to 1e-15 here; the tolerance leaves room for round-off only.
 /// Iteration bound: 2× IPOPT's 14 (issue 10's target).
 #[test]
