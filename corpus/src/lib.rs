@@ -122,6 +122,16 @@ pub fn instance(name: &str) -> Option<Instance> {
     instances().into_iter().find(|i| i.name() == name)
 }
 
+/// The instance `family_size` at any size of a known family, listed or not (e.g.
+/// `noncvxu2_100`, to compare a problem at sizes the corpus does not run). A size of 0 is
+/// refused.
+pub fn instance_at_any_size(name: &str) -> Option<Instance> {
+    let (family, size) = name.rsplit_once('_')?;
+    let size: usize = size.parse().ok().filter(|&s| s > 0)?;
+    let family = families().into_iter().find(|f| f.name == family)?;
+    Some(Instance { family, size })
+}
+
 /// What can go wrong while building, exporting or solving an instance.
 #[derive(Debug, thiserror::Error)]
 pub enum CorpusError {
@@ -150,6 +160,9 @@ pub enum CorpusError {
     /// No instance has this name.
     #[error("no instance named '{0}' (see `corpus list`)")]
     UnknownInstance(String),
+    /// An IPM option given by name was refused.
+    #[error("options: {0}")]
+    Options(String),
     /// A results file could not be read.
     #[error("results file: {0}")]
     Results(String),

@@ -5,6 +5,7 @@
 //! corpus solve [--filter S] [--kind K] [--max-n N] [--max-wall S]   # symnlp, one JSON line each
 //! corpus export NAME [--solve] [--max-wall S]                 # the dump IPOPT reads (JSON)
 //! corpus diagnose NAME... [--max-wall S]                     # how the IPM's iterations went
+//! corpus trace NAME [--perturb EPS] [--opt K=V]... [--max-wall S]  # every iteration record
 //! corpus report FILE [--svg-dir DIR]                          # markdown + profile SVGs
 //! ```
 use clap::{Parser, Subcommand};
@@ -45,7 +46,7 @@ enum Command {
     },
     /// Writes one instance as the JSON dump the IPOPT reference script reads.
     Export {
-        /// Instance name (`family_size`).
+        /// Instance name (`family_size`; any size of a family).
         name: String,
         /// Also solve with symnlp and include the outcome.
         #[arg(long)]
@@ -56,7 +57,7 @@ enum Command {
     },
     /// Solves one instance with symnlp and prints a summary of its iteration records.
     Diagnose {
-        /// Instance names (`family_size`).
+        /// Instance names (`family_size`; any size of a family).
         names: Vec<String>,
         /// Wall-time cap per solve in seconds.
         #[arg(long, default_value_t = 600.0)]
@@ -64,6 +65,26 @@ enum Command {
         /// The IPM's print level (5: IPOPT-style iteration table on stdout, before the summary).
         #[arg(long, default_value_t = 0)]
         print_level: u8,
+    },
+    /// Solves one instance with symnlp and prints every iteration record as a JSON line
+    /// (full precision, for comparing paths with `benches/reference/ipopt_trace.py`), then
+    /// the outcome. Any size of a family is accepted (`noncvxu2_100`).
+    Trace {
+        /// Instance name (`family_size`).
+        name: String,
+        /// Relative perturbation of the starting point: x0[i] *= 1 + EPS·(+1, −1, +1, …),
+        /// as `ipopt_trace.py --perturb` does.
+        #[arg(long, default_value_t = 0.0)]
+        perturb: f64,
+        /// Wall-time cap of the solve in seconds.
+        #[arg(long, default_value_t = 600.0)]
+        max_wall: f64,
+        /// An IPM option `NAME=VALUE` (IpmOptions' field names), repeatable.
+        #[arg(long = "opt")]
+        opts: Vec<String>,
+        /// Also print the final x in the outcome line (e.g. with `--opt max_iter=K`).
+        #[arg(long)]
+        print_x: bool,
     },
     /// Prints the markdown table and summary of a results file and writes the profiles.
     Report {
@@ -144,7 +165,7 @@ fn real_main() -> Result<(), CorpusError> {
             solve,
             max_wall,
         } => {
-            let inst = corpus::instance(&name)
+            let inst = corpus::instance_at_any_size(&name)
                 .ok_or_else(|| CorpusError::UnknownInstance(name.clone()))?;
             let t = std::time::Instant::now();
             let pb = inst.build()?;
@@ -168,7 +189,7 @@ fn real_main() -> Result<(), CorpusError> {
             print_level,
         } => {
             for name in names {
-                let inst = corpus::instance(&name)
+                let inst = corpus::instance_at_any_size(&name)
                     .ok_or_else(|| CorpusError::UnknownInstance(name.clone()))?;
                 let mut compiled = inst.build()?.compile()?;
                 let mut options = run::options(max_wall);
@@ -179,6 +200,13 @@ fn real_main() -> Result<(), CorpusError> {
                 println!("{line}");
             }
         }
+        Command::Trace {
+            name,
+            perturb,
+            max_wall,
+            opts,
+            print_x,
+        } => trace(&name, perturb, max_wall, &opts, print_x)?,
         Command::Report { file, svg_dir } => {
             let text = std::fs::read_to_string(&file)
                 .map_err(|e| CorpusError::Results(format!("{file}: {e}")))?;
@@ -232,5 +260,44 @@ fn real_main() -> Result<(), CorpusError> {
             }
         }
     }
+    Ok(())
+}
+
+/// `corpus trace`: every iteration record of one (possibly perturbed) solve, then the outcome.
+fn trace(
+    name: &str,
+    perturb: f64,
+    max_wall: f64,
+    opts: &[String],
+    print_x: bool,
+) -> Result<(), CorpusError> {
+    use nlp::{NamedOptions, NumericNlp};
+    let mut options = run::options(max_wall);
+    options
+        .set_by_name(opts)
+        .map_err(|e| CorpusError::Options(e.to_string()))?;
+    let inst = corpus::instance_at_any_size(name)
+        .ok_or_else(|| CorpusError::UnknownInstance(name.to_string()))?;
+    let mut compiled = inst.build()?.compile()?;
+    if perturb != 0.0 {
+        let mut x0 = vec![0.0; compiled.n()];
+        compiled.initial_point(&mut x0);
+        for (i, v) in x0.iter_mut().enumerate() {
+            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            *v *= 1.0 + perturb * sign;
+        }
+        compiled.set_initial_point(&x0)?;
+    }
+    let sol = nlp::Ipm::new(options).solve(&mut compiled)?;
+    for r in &sol.stats.records {
+        println!("{}", serde_json::to_string(r).expect("serialisable"));
+    }
+    let mut line = serde_json::json!({"instance": name, "perturb": perturb,
+        "status": format!("{:?}", sol.status), "iterations": sol.stats.iterations,
+        "objective": sol.objective});
+    if print_x {
+        line["x"] = serde_json::json!(sol.x);
+    }
+    println!("{line}");
     Ok(())
 }
