@@ -46,7 +46,7 @@ pub use ocp::{Horizon, Method, Ocp, OcpError, Trajectory};
 pub use option_names::{NamedOptions, OptionError};
 pub use options::{
     IpmHessian, IpmOptions, LimitedMemoryInit, LimitedMemoryUpdate, MuOracle, MuStrategy,
-    ScalingMethod,
+    QualityFunctionBalancingTerm, QualityFunctionCentrality, QualityFunctionNorm, ScalingMethod,
 };
 pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};

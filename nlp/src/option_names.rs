@@ -145,6 +145,10 @@ fn parse_value(fields: &Map<String, Value>, key: &str, value: &str) -> Result<Va
         Value::String(_) => Some(Value::String(value.to_string())),
         // An optional switch (default None), set with IPOPT's words too.
         Value::Null if matches!(value, "yes" | "no") => Some(Value::Bool(value == "yes")),
+        // An optional number, or an optional enum by its kebab-case name.
+        Value::Null => serde_json::from_str(value)
+            .ok()
+            .or_else(|| Some(Value::String(value.to_string()))),
         _ => serde_json::from_str(value).ok(),
     };
     parsed.ok_or_else(|| OptionError::BadValue {

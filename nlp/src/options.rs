@@ -26,6 +26,51 @@ pub enum MuOracle {
     Probing,
     /// LOQO's centrality rule.
     Loqo,
+    /// IPOPT's default oracle: σ minimising a prediction of the KKT error after the
+    /// step (golden-section search; `quality_function_*`, `sigma_min`, `sigma_max`).
+    QualityFunction,
+}
+
+/// Norm of the quality function's parts (IPOPT `quality_function_norm_type`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum QualityFunctionNorm {
+    /// Mean absolute value.
+    #[serde(rename = "1-norm")]
+    OneNorm,
+    /// Mean square (IPOPT's default).
+    #[serde(rename = "2-norm-squared")]
+    TwoNormSquared,
+    /// Largest absolute value.
+    #[serde(rename = "max-norm")]
+    MaxNorm,
+    /// Root mean square.
+    #[serde(rename = "2-norm")]
+    TwoNorm,
+}
+
+/// Centrality penalty of the quality function (IPOPT `quality_function_centrality`),
+/// with ξ = min/mean of the predicted complementarity products.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum QualityFunctionCentrality {
+    /// No penalty (IPOPT's default).
+    None,
+    /// −compl·ln ξ.
+    Log,
+    /// compl/ξ.
+    Reciprocal,
+    /// compl/ξ³.
+    CubedReciprocal,
+}
+
+/// Balancing term of the quality function (IPOPT `quality_function_balancing_term`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum QualityFunctionBalancingTerm {
+    /// None (IPOPT's default).
+    None,
+    /// max(0, max(dual, primal) − compl)³.
+    Cubic,
 }
 
 /// NLP scaling method (IPOPT `nlp_scaling_method`).
@@ -85,10 +130,29 @@ pub struct IpmOptions {
     #[serde(flatten)]
     pub common: CommonOptions,
     // ---------- barrier parameter ----------
-    /// Barrier parameter update strategy. Default monotone.
-    pub mu_strategy: MuStrategy,
-    /// Oracle for the adaptive strategy. Default probing.
+    /// Barrier parameter update strategy. Default `None`, IPOPT's: monotone with the
+    /// exact Hessian, adaptive with `hessian_approximation = limited-memory`; a value set
+    /// here (or by name) always wins.
+    pub mu_strategy: Option<MuStrategy>,
+    /// Oracle for the adaptive strategy. Default quality-function (IPOPT's).
     pub mu_oracle: MuOracle,
+    /// Largest centring parameter σ of the quality-function oracle. Default 100.
+    pub sigma_max: f64,
+    /// Smallest centring parameter σ of the quality-function oracle. Default 1e-6.
+    pub sigma_min: f64,
+    /// Norm of the quality function's parts. Default 2-norm-squared.
+    pub quality_function_norm_type: QualityFunctionNorm,
+    /// Centrality penalty of the quality function. Default none.
+    pub quality_function_centrality: QualityFunctionCentrality,
+    /// Balancing term of the quality function. Default none.
+    pub quality_function_balancing_term: QualityFunctionBalancingTerm,
+    /// Most golden-section steps of the quality-function oracle. Default 8.
+    pub quality_function_max_section_steps: usize,
+    /// The golden section stops when its bracket is below this × its upper end. Default 1e-2.
+    pub quality_function_section_sigma_tol: f64,
+    /// The golden section stops when 1 − min q / max q of its four points is below this.
+    /// Default 0.
+    pub quality_function_section_qf_tol: f64,
     /// Initial barrier parameter. Default 0.1.
     pub mu_init: f64,
     /// Maximum barrier parameter (adaptive strategy). Default 1e5.
@@ -321,8 +385,16 @@ impl Default for IpmOptions {
     fn default() -> Self {
         Self {
             common: CommonOptions::default(),
-            mu_strategy: MuStrategy::Monotone,
-            mu_oracle: MuOracle::Probing,
+            mu_strategy: None,
+            mu_oracle: MuOracle::QualityFunction,
+            sigma_max: 100.0,
+            sigma_min: 1e-6,
+            quality_function_norm_type: QualityFunctionNorm::TwoNormSquared,
+            quality_function_centrality: QualityFunctionCentrality::None,
+            quality_function_balancing_term: QualityFunctionBalancingTerm::None,
+            quality_function_max_section_steps: 8,
+            quality_function_section_sigma_tol: 1e-2,
+            quality_function_section_qf_tol: 0.0,
             mu_init: 0.1,
             mu_max: 1e5,
             mu_min: 1e-11,
@@ -423,6 +495,17 @@ impl IpmOptions {
             .unwrap_or(self.residual_ratio_max)
     }
 
+    /// The barrier strategy in effect: `mu_strategy` if set, else IPOPT's default for
+    /// the Hessian in use (adaptive with the limited-memory approximation, as IPOPT's
+    /// AlgorithmBuilder chooses, monotone with the exact Hessian).
+    pub fn effective_mu_strategy(&self) -> MuStrategy {
+        self.mu_strategy
+            .unwrap_or(match self.hessian_approximation {
+                IpmHessian::Exact => MuStrategy::Monotone,
+                IpmHessian::LimitedMemory => MuStrategy::Adaptive,
+            })
+    }
+
     /// Checks every option; the error names the first bad field.
     pub fn validate(&self) -> Result<(), SolveError> {
         self.common.validate()?;
@@ -464,6 +547,7 @@ impl IpmOptions {
         positive!(
             mu_init,
             mu_max,
+            sigma_max,
             mu_min,
             barrier_tol_factor,
             nlp_scaling_max_value,
@@ -503,6 +587,7 @@ impl IpmOptions {
             constr_mult_reset_threshold,
             tiny_step_tol,
             tiny_step_y_tol,
+            sigma_min,
             tiny_alpha,
             soft_resto_pderror_reduction_factor,
             kappa_d,
@@ -525,6 +610,15 @@ impl IpmOptions {
             perturb_dec_fact,
             required_infeasibility_reduction
         );
+        if !(0.0..1.0).contains(&self.quality_function_section_sigma_tol) {
+            return Err(bad(
+                "quality_function_section_sigma_tol",
+                "must be in [0, 1)",
+            ));
+        }
+        if !(0.0..1.0).contains(&self.quality_function_section_qf_tol) {
+            return Err(bad("quality_function_section_qf_tol", "must be in [0, 1)"));
+        }
         Ok(())
     }
 

@@ -79,7 +79,7 @@ fn hs071_adaptive() {
     for oracle in [nlp::MuOracle::Probing, nlp::MuOracle::Loqo] {
         let mut p = hs071();
         let opts = IpmOptions {
-            mu_strategy: MuStrategy::Adaptive,
+            mu_strategy: Some(MuStrategy::Adaptive),
             mu_oracle: oracle,
             ..print_opts()
         };

@@ -299,7 +299,7 @@ fn bounds_only_problem() {
     );
     for strategy in [MuStrategy::Monotone, MuStrategy::Adaptive] {
         let sol = Ipm::new(IpmOptions {
-            mu_strategy: strategy,
+            mu_strategy: Some(strategy),
             ..opts()
         })
         .solve(&mut p)
@@ -426,7 +426,7 @@ fn solution_and_options_serialize() {
     let o: IpmOptions =
         serde_json::from_str(r#"{"tol": 1e-6, "mu_strategy": "adaptive"}"#).unwrap();
     assert_eq!(o.tol, 1e-6);
-    assert_eq!(o.mu_strategy, MuStrategy::Adaptive);
+    assert_eq!(o.mu_strategy, Some(MuStrategy::Adaptive));
     assert!(serde_json::from_str::<IpmOptions>(r#"{"tolerance": 1e-6}"#).is_err());
 }
 

@@ -24,7 +24,7 @@ fn scaled_bound_problem() -> nlp::Compiled {
 fn check(strategy: MuStrategy) {
     let mut c = scaled_bound_problem();
     let opts = IpmOptions {
-        mu_strategy: strategy,
+        mu_strategy: Some(strategy),
         ..IpmOptions::default()
     };
     let sol = Ipm::new(opts).solve(&mut c).unwrap();

@@ -13,7 +13,7 @@ fn sets_numbers_integers_booleans_and_enums() {
     .unwrap();
     assert_eq!(o.tol, 1e-10);
     assert_eq!(o.max_iter, 42);
-    assert_eq!(o.mu_strategy, MuStrategy::Adaptive);
+    assert_eq!(o.mu_strategy, Some(MuStrategy::Adaptive));
     assert!(o.start_with_resto);
     let mut s = SqpOptions::default();
     s.set_by_name(&["max_iter=7"]).unwrap();

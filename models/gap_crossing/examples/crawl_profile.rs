@@ -45,10 +45,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for (k, v) in &opts_kv {
             match k.as_str() {
                 "mu_strategy" => {
-                    opts.mu_strategy = match v.as_str() {
+                    opts.mu_strategy = Some(match v.as_str() {
                         "adaptive" => nlp::MuStrategy::Adaptive,
                         _ => nlp::MuStrategy::Monotone,
-                    }
+                    })
                 }
                 "perturbation_skip_zero_after" => opts.perturbation_skip_zero_after = v.parse()?,
                 "perturb_dec_fact" => opts.perturb_dec_fact = v.parse()?,

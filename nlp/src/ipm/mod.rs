@@ -13,6 +13,7 @@ pub(crate) mod barrier;
 mod core;
 mod error;
 pub(crate) mod filter;
+pub(crate) mod quality;
 pub(crate) mod reduced;
 mod restoration;
 
@@ -160,7 +161,7 @@ impl Ipm {
                 bound_relax_factor: opts.bound_relax_factor,
                 in_resto: false,
                 scaling: red.scaling(),
-                mu_strategy: opts.mu_strategy,
+                mu_strategy: opts.effective_mu_strategy(),
             };
             match Core::new(&mut red, opts, &setup) {
                 Err(e) => (
