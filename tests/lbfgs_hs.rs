@@ -10,8 +10,8 @@
 //! ```text
 //! cargo test --release --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary \
 //!     > benches/reference/results/hs_lbfgs_symnlp.jsonl
-//! OPT=mu_strategy=adaptive cargo test --release --test lbfgs_hs -- --ignored --nocapture \
-//!     hs_lbfgs_summary > benches/reference/results/hs_lbfgs_adaptive_symnlp.jsonl
+//! OPT=mu_strategy=monotone cargo test --release --test lbfgs_hs -- --ignored --nocapture \
+//!     hs_lbfgs_summary > benches/reference/results/hs_lbfgs_monotone_symnlp.jsonl
 //! ```
 use std::collections::HashMap;
 
@@ -44,12 +44,14 @@ fn run(name: &'static str, build: fn() -> Built) -> Run {
     harness::run(name, build, |nlp| Ipm::new(lm_options()).solve(nlp))
 }
 
-/// As `run`, with the extra option `KEY=VALUE` given in the environment variable
-/// `OPT` (e.g. `OPT=mu_strategy=adaptive`, IPOPT's default in limited-memory mode).
+/// As `run`, with the extra options `KEY=VALUE[,KEY=VALUE...]` given in the environment
+/// variable `OPT` (e.g. `OPT=mu_strategy=monotone`, symnlp's limited-memory default
+/// before s9-lbfgs).
 fn run_with_env_option(name: &'static str, build: fn() -> Built) -> Run {
     let mut o = lm_options();
     if let Ok(v) = std::env::var("OPT") {
-        o.set_by_name(&[v]).expect("OPT=KEY=VALUE");
+        let kv: Vec<&str> = v.split(',').collect();
+        o.set_by_name(&kv).expect("OPT=KEY=VALUE[,KEY=VALUE...]");
     }
     harness::run(name, build, |nlp| Ipm::new(o).solve(nlp))
 }
@@ -108,18 +110,22 @@ fn solve_all() -> (Vec<(&'static str, Option<usize>)>, usize) {
 }
 
 /// ≥ 90 % of the suite solved (the issue's target), and iterations within 1.5× of
-/// IPOPT's limited-memory mode in geometric mean over the problems both solve.
+/// IPOPT's limited-memory mode on every problem both solve (and in geometric mean).
 #[test]
 fn limited_memory_solves_hs_within_1_5x_of_ipopt() {
     let (runs, solved) = solve_all();
     let ipopt = ipopt_results();
     let mut log_ratio = 0.0;
     let mut both = 0usize;
+    let mut above = Vec::new();
     for (name, it) in &runs {
         let (ok_i, it_i) = ipopt[*name];
         if let (Some(it), true) = (it, ok_i) {
             log_ratio += (*it as f64 / it_i as f64).ln();
             both += 1;
+            if 2 * it > 3 * it_i {
+                above.push(*name);
+            }
         }
         eprintln!("{name}: symnlp {it:?}, IPOPT {it_i} (solved {ok_i})");
     }
@@ -134,6 +140,9 @@ fn limited_memory_solves_hs_within_1_5x_of_ipopt() {
         runs.len()
     );
     assert!(geo <= 1.5, "geometric mean ratio {geo}");
+    // Since the limited-memory default follows IPOPT (adaptive μ, quality-function
+    // oracle) no problem is above 1.5× (hs100 was 63 vs 18, hs034 14 vs 8).
+    assert!(above.is_empty(), "above 1.5x IPOPT's iterations: {above:?}");
 }
 
 /// One JSON line per problem (as `tests/hs.rs`'s `hs_summary`), for

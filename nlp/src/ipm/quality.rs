@@ -36,6 +36,20 @@ impl Norms {
     }
 }
 
+/// The KKT error of the parts (dual, primal, complementarity) with their entry counts
+/// in the norm `norm`, as IPOPT's AdaptiveMuUpdate::quality_function_pd_system.
+pub(crate) fn kkt_error(norm: QualityFunctionNorm, parts: [Norms; 3], counts: [usize; 3]) -> f64 {
+    let c = counts.map(|k| k.max(1) as f64);
+    (0..3)
+        .map(|i| match norm {
+            QualityFunctionNorm::OneNorm => parts[i].sum_abs / c[i],
+            QualityFunctionNorm::TwoNormSquared => parts[i].sum_sq / c[i],
+            QualityFunctionNorm::MaxNorm => parts[i].max_abs,
+            QualityFunctionNorm::TwoNorm => (parts[i].sum_sq / c[i]).sqrt(),
+        })
+        .sum()
+}
+
 /// One iterate's data for the quality function: per complementarity pair k (a finite
 /// bound of a variable or slack) its slack s_k and multiplier z_k, and the slack and
 /// multiplier components of the affine and the centring step.

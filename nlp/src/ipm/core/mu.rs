@@ -36,33 +36,35 @@ impl Core<'_> {
 
     /// Adaptive μ (called after the KKT matrix is factorised).
     pub(super) fn update_mu_adaptive(&mut self, shared: &mut Shared, e0: f64) {
+        // IPOPT's kkt-error globalisation (AdaptiveMuUpdate::CheckSufficientProgress):
+        // progress is sufficient while fewer than `adaptive_mu_kkterror_red_iters`
+        // reference values exist, else when the primal-dual error is below
+        // `adaptive_mu_kkterror_red_fact` times one of them.
         let red = self.opts.adaptive_mu_kkterror_red_fact;
-        if self.free_mode {
-            let ok = self.kkt_refs.is_empty() || self.kkt_refs.iter().any(|&r| e0 <= red * r);
-            if !ok {
-                // Switch to the monotone (fixed) mode.
-                self.free_mode = false;
-                let (avg, _) = self.avg_compl(&self.it.w, &self.it.zl, &self.it.zu);
-                self.mu = (self.opts.adaptive_mu_monotone_init_factor * avg)
-                    .clamp(mu_floor(&self.opts, self.scaling.obj), self.opts.mu_max);
-                self.tau = tau(self.mu, &self.opts);
-                self.filter.reset();
-                return;
-            }
-            self.kkt_refs.push(e0);
-            if self.kkt_refs.len() > self.opts.adaptive_mu_kkterror_red_iters {
-                self.kkt_refs.remove(0);
-            }
-        } else {
-            if !self.kkt_refs.is_empty() && self.kkt_refs.iter().all(|&r| e0 <= red * r) {
-                self.free_mode = true;
-                self.kkt_refs.clear();
-                self.kkt_refs.push(e0);
-            } else {
-                self.update_mu_monotone(false);
-                return;
-            }
+        let max_refs = self.opts.adaptive_mu_kkterror_red_iters;
+        let err = self.pd_system_error();
+        let sufficient =
+            self.kkt_refs.len() < max_refs || self.kkt_refs.iter().any(|&r| err <= red * r);
+        if self.free_mode && !sufficient {
+            // Switch to the monotone (fixed) mode.
+            self.free_mode = false;
+            let (avg, _) = self.avg_compl(&self.it.w, &self.it.zl, &self.it.zu);
+            self.mu = (self.opts.adaptive_mu_monotone_init_factor * avg)
+                .clamp(mu_floor(&self.opts, self.scaling.obj), self.opts.mu_max);
+            self.tau = tau(self.mu, &self.opts);
+            self.filter.reset();
+            return;
         }
+        if !self.free_mode && !sufficient {
+            self.update_mu_monotone(false);
+            return;
+        }
+        // Stay in (or return to) free mode; remember this point's error.
+        self.free_mode = true;
+        if self.kkt_refs.len() >= max_refs {
+            self.kkt_refs.remove(0);
+        }
+        self.kkt_refs.push(err);
         // Free mode: τ = max(τ_min, 1 − E₀) (IPOPT's AdaptiveMuUpdate), then the oracle.
         self.tau = self.opts.tau_min.max(1.0 - e0);
         let (avg, mn) = self.avg_compl(&self.it.w, &self.it.zl, &self.it.zu);
@@ -81,6 +83,42 @@ impl Core<'_> {
             self.mu = mu;
             self.filter.reset();
         }
+    }
+
+    /// IPOPT's quality_function_pd_system: the KKT error at μ = 0 in the norm of
+    /// `quality_function_norm_type` (by default mean squares of ∇L, c and the products).
+    fn pd_system_error(&mut self) -> f64 {
+        let dual = self.grad_lag_norms();
+        let primal = quality::Norms::of(self.it.c.iter().copied());
+        let (mut prods, mut n_comp) = (Vec::new(), 0usize);
+        for j in 0..self.lay.nw {
+            if self.lay.has_l[j] {
+                prods.push((self.it.w[j] - self.lay.wl[j]) * self.it.zl[j]);
+            }
+            if self.lay.has_u[j] {
+                prods.push((self.lay.wu[j] - self.it.w[j]) * self.it.zu[j]);
+            }
+            n_comp = prods.len();
+        }
+        let compl = quality::Norms::of(prods);
+        quality::kkt_error(
+            self.opts.quality_function_norm_type,
+            [dual, primal, compl],
+            [self.lay.nw, self.lay.m, n_comp],
+        )
+    }
+
+    /// Norms of ∇L without the damping term (IPOPT's curr_grad_lag_x, curr_grad_lag_s).
+    fn grad_lag_norms(&mut self) -> quality::Norms {
+        let mut work = std::mem::take(&mut self.kw.work_nw);
+        self.at_times(&self.it.jac, &self.it.y, &mut work);
+        let n = self.lay.n;
+        let dual = quality::Norms::of((0..self.lay.nw).map(|j| {
+            let g = if j < n { self.it.grad[j] } else { 0.0 };
+            g + work[j] - self.it.zl[j] + self.it.zu[j]
+        }));
+        self.kw.work_nw = work;
+        dual
     }
 
     /// Mehrotra's probing oracle: μ from the affine-scaling step's complementarity.
@@ -147,14 +185,7 @@ impl Core<'_> {
                 p.push_cen(-cen_w, self.dir.dzu[j] - aff.2[j]);
             }
         }
-        // ∇ₓL without the damping term (IPOPT's curr_grad_lag_x, curr_grad_lag_s).
-        let mut work = std::mem::take(&mut self.kw.work_nw);
-        self.at_times(&self.it.jac, &self.it.y, &mut work);
-        let dual = quality::Norms::of((0..nw).map(|j| {
-            let g = if j < self.lay.n { self.it.grad[j] } else { 0.0 };
-            g + work[j] - self.it.zl[j] + self.it.zu[j]
-        }));
-        self.kw.work_nw = work;
+        let dual = self.grad_lag_norms();
         let data = quality::QualityData {
             slack: &p.slack,
             z: &p.z,
