@@ -99,3 +99,41 @@ fn residual_ratio_singular_is_checked_against_residual_ratio_max() {
     let e = bad.validate().unwrap_err().to_string();
     assert!(e.contains("residual_ratio_singular"), "{e}");
 }
+
+/// IPOPT's default switch: with `hessian_approximation = limited-memory` the barrier
+/// strategy is adaptive unless the user sets `mu_strategy`, which always wins; the
+/// quality-function oracle's options are set with IPOPT's names and values.
+#[test]
+fn limited_memory_defaults_to_adaptive_unless_the_user_chose() {
+    use nlp::{MuOracle, QualityFunctionCentrality, QualityFunctionNorm};
+    let mut o = IpmOptions::default();
+    assert_eq!(o.mu_strategy, None);
+    assert_eq!(o.effective_mu_strategy(), MuStrategy::Monotone);
+    o.set_by_name(&["hessian_approximation=limited-memory"])
+        .unwrap();
+    assert_eq!(o.effective_mu_strategy(), MuStrategy::Adaptive);
+    o.set_by_name(&["mu_strategy=monotone"]).unwrap();
+    assert_eq!(o.effective_mu_strategy(), MuStrategy::Monotone);
+    o.set_by_name(&[
+        "mu_oracle=quality-function",
+        "quality_function_norm_type=max-norm",
+        "quality_function_centrality=cubed-reciprocal",
+        "quality_function_balancing_term=cubic",
+        "quality_function_max_section_steps=12",
+        "sigma_max=50",
+    ])
+    .unwrap();
+    assert_eq!(o.mu_oracle, MuOracle::QualityFunction);
+    assert_eq!(o.quality_function_norm_type, QualityFunctionNorm::MaxNorm);
+    assert_eq!(
+        o.quality_function_centrality,
+        QualityFunctionCentrality::CubedReciprocal
+    );
+    assert_eq!(
+        (o.quality_function_max_section_steps, o.sigma_max),
+        (12, 50.0)
+    );
+    assert!(o
+        .set_by_name(&["quality_function_section_sigma_tol=1"])
+        .is_err());
+}
