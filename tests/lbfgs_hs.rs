@@ -168,7 +168,8 @@ fn hs_lbfgs_log() {
         let r = harness::run(name, build, |nlp| {
             let mut o = lm_options();
             if let Ok(v) = std::env::var("OPT") {
-                o.set_by_name(&[v]).expect("OPT=KEY=VALUE");
+                let kv: Vec<&str> = v.split(',').collect();
+                o.set_by_name(&kv).expect("OPT=KEY=VALUE[,KEY=VALUE...]");
             }
             o.common.print_level = 5;
             Ipm::new(o).solve(nlp)
