@@ -27,7 +27,8 @@ consecutive stances. Results (2026-11-26, docs/performance.md, "Free gait: how f
 1.69e5"): W = 1 1.685518e5, W = 2 1.689763e5, W = 3 W3BEST; the plan 1.706639e5.
 Usage (needs casadi): python3 window_bound.py W [--cache FILE] [--plan solution.json]
   --cache FILE: keep the single-stance solutions in FILE (pickle) and reuse them;
-  --plan FILE: instead of the search, the relaxation on that plan's own move counts.
+  --plan FILE: instead of the search, where that plan's cost goes and the relaxation
+    on its own move counts.
 W = 1 takes ~3 min of CPU, W = 3 ~15 min more with the cache of W = 1.
 """
 import itertools
@@ -239,6 +240,36 @@ def plan_path(file):
     return path, xs
 
 
+def nearest_com(p1, p2, goal):
+    """The point at leg length sqrt(0.5) from both feet nearest the goal (a circle)."""
+    mid = [(a + b) / 2 for a, b in zip(p1, p2)]
+    u = [b - a for a, b in zip(p1, p2)]
+    length = math.hypot(*u)
+    u = [v / length for v in u]
+    rho = math.sqrt(max(0.5 - length ** 2 / 4, 0.0))
+    d = [g - m for g, m in zip(goal, mid)]
+    along = sum(a * b for a, b in zip(d, u))
+    v = [a - along * b for a, b in zip(d, u)]
+    nv = math.hypot(*v)
+    return [m + rho * a / nv for m, a in zip(mid, v)]
+
+
+def plan_costs(file):
+    """Where a plan's cost (1) goes: CoM part, forces at equal shares and above them,
+    and the CoM part if every CoM stood at the best point its two feet allow."""
+    stances = json.load(open(file))["stances"]
+    com = best = force = 0.0
+    for st in stances[1:]:
+        for j, goal, (a, b) in (("B", GB, ("BR", "BL")), ("F", GF, ("FR", "FL"))):
+            com += 1000 * math.dist(st["com"][j], goal) ** 2
+            best += 1000 * math.dist(nearest_com(st["feet"][a], st["feet"][b], goal), goal) ** 2
+        force += 0.001 * sum(sum(f * f for f in st["forces"][n]) for n in FEET)
+    n = len(stances) - 1
+    print(f"stances 2..{n + 1}: CoM part {com:.1f} (at the best points of the plan's feet "
+          f"{best:.1f}), forces {force:.1f} = {n} x (Mg)^2/4 w_F {n * FMIN:.1f} "
+          f"+ {force - n * FMIN:.1f}")
+
+
 def check_plan(w, file):
     """The relaxation along a plan's own count path, each window solved from its stances'
     single-stance solutions (as in the search) and also from the plan's own variables:
@@ -279,6 +310,7 @@ def main():
     w = int(args[0]) if args else 1
     opts = dict(zip(args[1::2], args[2::2]))
     if "--plan" in opts:
+        plan_costs(opts["--plan"])
         check_plan(w, opts["--plan"])
         return
     cache = opts.get("--cache")  # single-stance solutions, shared between runs of any W
