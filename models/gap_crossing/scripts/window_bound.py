@@ -24,12 +24,13 @@ Relaxation (each step can only lower the optimum):
   path runs through solved windows only; a window IPOPT cannot solve keeps its bound).
 W = 1 lets every stance choose its four feet afresh; W = 2, 3 share them between 2, 3
 consecutive stances. Results (2026-11-26, docs/performance.md, "Free gait: how far is
-1.69e5"): W = 1 1.685518e5, W = 2 1.689763e5, W = 3 W3BEST; the plan 1.706639e5.
+1.69e5"): W = 1 1.685518e5, W = 2 1.689763e5, W = 3 1.692479e5; the plan 1.706639e5.
 Usage (needs casadi): python3 window_bound.py W [--cache FILE] [--plan solution.json]
   --cache FILE: keep the single-stance solutions in FILE (pickle) and reuse them;
   --plan FILE: instead of the search, where that plan's cost goes and the relaxation
     on its own move counts.
-W = 1 takes ~3 min of CPU, W = 3 ~15 min more with the cache of W = 1.
+W = 1 takes ~3 min of CPU; W = 3 took 63 min wall (35 rounds, 725 stances and windows) on a shared
+machine with the cache of W = 1.
 """
 import itertools
 import json
