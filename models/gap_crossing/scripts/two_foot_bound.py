@@ -21,19 +21,9 @@ import math
 
 import casadi as ca
 
-KEEP_OUT = (2.22, 2.38)
+from lower_bound import KEEP_OUT, reach
 MAX_MOVES = 16
 N_STEP = 60
-
-
-def reach(x0, m):
-    """Largest x a foot starting at x0 can stand at after m moves of <= 0.3 m."""
-    x = x0
-    for _ in range(m):
-        x += 0.3
-        if KEEP_OUT[0] < x < KEEP_OUT[1]:
-            x = KEEP_OUT[0]
-    return x
 
 
 def biped_table(s_r, s_l, goal):

@@ -41,9 +41,9 @@ import sys
 
 import casadi as ca
 
+from lower_bound import KEEP_OUT, reach
 from two_foot_bound import biped_table
 
-KEEP_OUT = (2.22, 2.38)
 MAXM = 15
 N_STEP = 60
 MG = 100 * 9.81
@@ -52,16 +52,6 @@ START = {"BR": (0.0, 0.0), "BL": (0.0, 1.0), "FR": (2.0, 0.0), "FL": (2.0, 1.0)}
 FEET = ["BR", "BL", "FR", "FL"]
 GB, GF = [3.0, 0.5, 0.5], [5.0, 0.5, 0.5]
 IPOPT = {"ipopt.print_level": 0, "print_time": 0, "ipopt.sb": "yes", "ipopt.max_iter": 500}
-
-
-def reach(x0, m):
-    """Largest x a foot starting at x0 can stand at after m moves of <= 0.3 m."""
-    x = x0
-    for _ in range(m):
-        x += 0.3
-        if KEEP_OUT[0] < x < KEEP_OUT[1]:
-            x = KEEP_OUT[0]
-    return x
 
 
 def succ(s, j):
