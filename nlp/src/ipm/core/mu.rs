@@ -90,7 +90,7 @@ impl Core<'_> {
     fn pd_system_error(&mut self) -> f64 {
         let dual = self.grad_lag_norms();
         let primal = quality::Norms::of(self.it.c.iter().copied());
-        let (mut prods, mut n_comp) = (Vec::new(), 0usize);
+        let mut prods = Vec::new();
         for j in 0..self.lay.nw {
             if self.lay.has_l[j] {
                 prods.push((self.it.w[j] - self.lay.wl[j]) * self.it.zl[j]);
@@ -98,8 +98,8 @@ impl Core<'_> {
             if self.lay.has_u[j] {
                 prods.push((self.lay.wu[j] - self.it.w[j]) * self.it.zu[j]);
             }
-            n_comp = prods.len();
         }
+        let n_comp = prods.len();
         let compl = quality::Norms::of(prods);
         quality::kkt_error(
             self.opts.quality_function_norm_type,
