@@ -633,6 +633,9 @@ impl IpmOptions {
         if self.mu_max < self.mu_init {
             return Err(bad("mu_max", "must not be below mu_init"));
         }
+        if self.sigma_min > self.sigma_max {
+            return Err(bad("sigma_min", "must not exceed sigma_max"));
+        }
         if self.adaptive_mu_kkterror_red_iters == 0 {
             return Err(bad("adaptive_mu_kkterror_red_iters", "must be >= 1"));
         }

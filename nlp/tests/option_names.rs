@@ -137,3 +137,17 @@ fn limited_memory_defaults_to_adaptive_unless_the_user_chose() {
         .set_by_name(&["quality_function_section_sigma_tol=1"])
         .is_err());
 }
+
+/// The quality-function oracle's σ range is checked: σ_min above σ_max is refused by
+/// name (the golden-section search would have an empty bracket).
+#[test]
+fn sigma_min_above_sigma_max_is_refused() {
+    let bad = IpmOptions {
+        sigma_min: 10.0,
+        sigma_max: 1.0,
+        ..IpmOptions::default()
+    };
+    let e = bad.validate().unwrap_err().to_string();
+    assert!(e.contains("sigma_min"), "{e}");
+    assert!(IpmOptions::default().validate().is_ok());
+}
