@@ -48,12 +48,18 @@ fn run(name: &'static str, build: fn() -> Built) -> Run {
 /// variable `OPT` (e.g. `OPT=mu_strategy=monotone`, symnlp's limited-memory default
 /// before s9-lbfgs).
 fn run_with_env_option(name: &'static str, build: fn() -> Built) -> Run {
+    let o = lm_options_with_env();
+    harness::run(name, build, |nlp| Ipm::new(o).solve(nlp))
+}
+
+/// `lm_options` with the options of the environment variable `OPT`.
+fn lm_options_with_env() -> IpmOptions {
     let mut o = lm_options();
     if let Ok(v) = std::env::var("OPT") {
         let kv: Vec<&str> = v.split(',').collect();
         o.set_by_name(&kv).expect("OPT=KEY=VALUE[,KEY=VALUE...]");
     }
-    harness::run(name, build, |nlp| Ipm::new(o).solve(nlp))
+    o
 }
 
 /// IPOPT's limited-memory results: name → (solved, iterations).
@@ -166,11 +172,7 @@ fn hs_lbfgs_log() {
     for name in harness::names_from_env() {
         let (name, build) = harness::find(SUITE, &name);
         let r = harness::run(name, build, |nlp| {
-            let mut o = lm_options();
-            if let Ok(v) = std::env::var("OPT") {
-                let kv: Vec<&str> = v.split(',').collect();
-                o.set_by_name(&kv).expect("OPT=KEY=VALUE[,KEY=VALUE...]");
-            }
+            let mut o = lm_options_with_env();
             o.common.print_level = 5;
             Ipm::new(o).solve(nlp)
         });

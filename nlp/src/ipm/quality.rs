@@ -14,13 +14,14 @@ use crate::options::{
     IpmOptions, QualityFunctionBalancingTerm, QualityFunctionCentrality, QualityFunctionNorm,
 };
 
-/// The norms of the current dual and primal infeasibility that the quality function
-/// needs: Σ|r|, Σr², max|r| over all entries.
+/// The norms of a vector that the quality function needs: Σ|r|, Σr², max|r| and the
+/// number of entries (for the means).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Norms {
     pub(crate) sum_abs: f64,
     pub(crate) sum_sq: f64,
     pub(crate) max_abs: f64,
+    pub(crate) len: usize,
 }
 
 impl Norms {
@@ -31,41 +32,85 @@ impl Norms {
             n.sum_abs += x.abs();
             n.sum_sq += x * x;
             n.max_abs = n.max_abs.max(x.abs());
+            n.len += 1;
         }
         n
     }
+
+    /// The entry count as a divisor (at least 1).
+    fn count(&self) -> f64 {
+        self.len.max(1) as f64
+    }
 }
 
-/// The KKT error of the parts (dual, primal, complementarity) with their entry counts
-/// in the norm `norm`, as IPOPT's AdaptiveMuUpdate::quality_function_pd_system.
-pub(crate) fn kkt_error(norm: QualityFunctionNorm, parts: [Norms; 3], counts: [usize; 3]) -> f64 {
-    let c = counts.map(|k| k.max(1) as f64);
-    (0..3)
-        .map(|i| match norm {
-            QualityFunctionNorm::OneNorm => parts[i].sum_abs / c[i],
-            QualityFunctionNorm::TwoNormSquared => parts[i].sum_sq / c[i],
-            QualityFunctionNorm::MaxNorm => parts[i].max_abs,
-            QualityFunctionNorm::TwoNorm => (parts[i].sum_sq / c[i]).sqrt(),
+/// The KKT error of the parts (dual, primal, complementarity) in the norm `norm`, as
+/// IPOPT's AdaptiveMuUpdate::quality_function_pd_system.
+pub(crate) fn kkt_error(norm: QualityFunctionNorm, parts: [Norms; 3]) -> f64 {
+    parts
+        .iter()
+        .map(|p| match norm {
+            QualityFunctionNorm::OneNorm => p.sum_abs / p.count(),
+            QualityFunctionNorm::TwoNormSquared => p.sum_sq / p.count(),
+            QualityFunctionNorm::MaxNorm => p.max_abs,
+            QualityFunctionNorm::TwoNorm => (p.sum_sq / p.count()).sqrt(),
         })
         .sum()
 }
 
-/// One iterate's data for the quality function: per complementarity pair k (a finite
-/// bound of a variable or slack) its slack s_k and multiplier z_k, and the slack and
-/// multiplier components of the affine and the centring step.
+/// The complementarity pairs of one iterate, flattened: per pair k (a finite bound of a
+/// variable or slack) its slack s_k and multiplier z_k, and the slack and multiplier
+/// components of the affine step and of the centring step. Kept by the core as scratch
+/// (cleared and refilled each free-mode iteration, no allocation once grown).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Pairs {
+    pub(crate) slack: Vec<f64>,
+    pub(crate) z: Vec<f64>,
+    pub(crate) ds_aff: Vec<f64>,
+    pub(crate) dz_aff: Vec<f64>,
+    pub(crate) ds_cen: Vec<f64>,
+    pub(crate) dz_cen: Vec<f64>,
+}
+
+impl Pairs {
+    /// Empties every vector (keeping its capacity).
+    pub(crate) fn clear(&mut self) {
+        for v in [
+            &mut self.slack,
+            &mut self.z,
+            &mut self.ds_aff,
+            &mut self.dz_aff,
+            &mut self.ds_cen,
+            &mut self.dz_cen,
+        ] {
+            v.clear();
+        }
+    }
+
+    /// Adds a pair with its affine step.
+    pub(crate) fn push_affine(&mut self, slack: f64, z: f64, ds_aff: f64, dz_aff: f64) {
+        self.slack.push(slack);
+        self.z.push(z);
+        self.ds_aff.push(ds_aff);
+        self.dz_aff.push(dz_aff);
+    }
+
+    /// Adds the centring step of the next pair from its step at μ = avg (the step is
+    /// affine in μ: centring = that step − the affine step).
+    pub(crate) fn push_centring_from(&mut self, ds: f64, dz: f64) {
+        let k = self.ds_cen.len();
+        self.ds_cen.push(ds - self.ds_aff[k]);
+        self.dz_cen.push(dz - self.dz_aff[k]);
+    }
+}
+
+/// One iterate's data for the quality function: its complementarity pairs with the
+/// affine and centring steps, and the norms of its infeasibilities.
 pub(crate) struct QualityData<'a> {
-    pub(crate) slack: &'a [f64],
-    pub(crate) z: &'a [f64],
-    pub(crate) ds_aff: &'a [f64],
-    pub(crate) dz_aff: &'a [f64],
-    pub(crate) ds_cen: &'a [f64],
-    pub(crate) dz_cen: &'a [f64],
-    /// Dual infeasibility ∇L (all variables and slacks, `n_dual` entries).
+    pub(crate) pairs: &'a Pairs,
+    /// Dual infeasibility ∇L (all variables and slacks).
     pub(crate) dual: Norms,
-    /// Primal infeasibility (`n_pri` entries).
+    /// Primal infeasibility.
     pub(crate) primal: Norms,
-    pub(crate) n_dual: usize,
-    pub(crate) n_pri: usize,
     /// Fraction-to-the-boundary parameter.
     pub(crate) tau: f64,
 }
@@ -113,21 +158,22 @@ fn frac_to_bound(tau: f64, v: &[f64], dv_aff: &[f64], dv_cen: &[f64], sigma: f64
 impl QualityData<'_> {
     /// The quality function at σ (IPOPT's CalculateQualityFunction).
     pub(crate) fn eval(&self, sigma: f64, s: &QualitySettings) -> f64 {
-        let ap = frac_to_bound(self.tau, self.slack, self.ds_aff, self.ds_cen, sigma);
-        let ad = frac_to_bound(self.tau, self.z, self.dz_aff, self.dz_cen, sigma);
+        let p = self.pairs;
+        let ap = frac_to_bound(self.tau, &p.slack, &p.ds_aff, &p.ds_cen, sigma);
+        let ad = frac_to_bound(self.tau, &p.z, &p.dz_aff, &p.dz_cen, sigma);
         let (mut c_sum, mut c_sq, mut c_max, mut c_min) = (0.0, 0.0, 0.0f64, f64::INFINITY);
-        for k in 0..self.slack.len() {
-            let sk = self.slack[k] + ap * (self.ds_aff[k] + sigma * self.ds_cen[k]);
-            let zk = self.z[k] + ad * (self.dz_aff[k] + sigma * self.dz_cen[k]);
+        for k in 0..p.slack.len() {
+            let sk = p.slack[k] + ap * (p.ds_aff[k] + sigma * p.ds_cen[k]);
+            let zk = p.z[k] + ad * (p.dz_aff[k] + sigma * p.dz_cen[k]);
             let c = sk * zk;
             c_sum += c.abs();
             c_sq += c * c;
             c_max = c_max.max(c.abs());
             c_min = c_min.min(c);
         }
-        let n_comp = self.slack.len().max(1) as f64;
-        let n_dual = self.n_dual.max(1) as f64;
-        let n_pri = self.n_pri.max(1) as f64;
+        let n_comp = p.slack.len().max(1) as f64;
+        let n_dual = self.dual.count();
+        let n_pri = self.primal.count();
         let (fd, fp) = (1.0 - ad, 1.0 - ap);
         let (dual, primal, compl) = match s.norm {
             QualityFunctionNorm::OneNorm => (

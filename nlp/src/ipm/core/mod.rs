@@ -155,6 +155,8 @@ pub(crate) struct Core<'p> {
     theta_max: f64,
     free_mode: bool,
     kkt_refs: Vec<f64>,
+    /// Scratch of the quality-function μ oracle (reused every free-mode iteration).
+    quality_pairs: crate::ipm::quality::Pairs,
     /// The convergence test's state (acceptable streak, previous objective).
     termination: Termination,
     setup_in_resto: bool,
@@ -349,6 +351,7 @@ impl<'p> Core<'p> {
             theta_max: 0.0,
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
             kkt_refs: Vec::new(),
+            quality_pairs: Default::default(),
             termination: Termination::default(),
             setup_in_resto: setup.in_resto,
             recalc_y: !setup.in_resto

@@ -90,22 +90,13 @@ impl Core<'_> {
     fn pd_system_error(&mut self) -> f64 {
         let dual = self.grad_lag_norms();
         let primal = quality::Norms::of(self.it.c.iter().copied());
-        let mut prods = Vec::new();
-        for j in 0..self.lay.nw {
-            if self.lay.has_l[j] {
-                prods.push((self.it.w[j] - self.lay.wl[j]) * self.it.zl[j]);
-            }
-            if self.lay.has_u[j] {
-                prods.push((self.lay.wu[j] - self.it.w[j]) * self.it.zu[j]);
-            }
-        }
-        let n_comp = prods.len();
-        let compl = quality::Norms::of(prods);
-        quality::kkt_error(
-            self.opts.quality_function_norm_type,
-            [dual, primal, compl],
-            [self.lay.nw, self.lay.m, n_comp],
-        )
+        let (it, lay) = (&self.it, &self.lay);
+        let compl = quality::Norms::of((0..lay.nw).flat_map(|j| {
+            let lower = lay.has_l[j].then(|| (it.w[j] - lay.wl[j]) * it.zl[j]);
+            let upper = lay.has_u[j].then(|| (lay.wu[j] - it.w[j]) * it.zu[j]);
+            lower.into_iter().chain(upper)
+        }));
+        quality::kkt_error(self.opts.quality_function_norm_type, [dual, primal, compl])
     }
 
     /// Norms of ∇L without the damping term (IPOPT's curr_grad_lag_x, curr_grad_lag_s).
@@ -154,80 +145,52 @@ impl Core<'_> {
         if avg <= 0.0 || !self.solve_direction(shared, 0.0, false) {
             return None;
         }
-        let nw = self.lay.nw;
-        let aff = (
-            self.dir.dw.clone(),
-            self.dir.dzl.clone(),
-            self.dir.dzu.clone(),
-        );
-        if !self.solve_direction(shared, avg, false) {
-            return None;
-        }
-        let mut p = Pairs::default();
-        for j in 0..nw {
-            let cen_w = self.dir.dw[j] - aff.0[j];
+        // The pairs with their affine step, then (after the solve for μ = avg) their
+        // centring step, in the same order.
+        let mut p = std::mem::take(&mut self.quality_pairs);
+        p.clear();
+        for j in 0..self.lay.nw {
+            let dw = self.dir.dw[j];
             if self.lay.has_l[j] {
-                p.push(
+                p.push_affine(
                     self.it.w[j] - self.lay.wl[j],
                     self.it.zl[j],
-                    aff.0[j],
-                    aff.1[j],
+                    dw,
+                    self.dir.dzl[j],
                 );
-                p.push_cen(cen_w, self.dir.dzl[j] - aff.1[j]);
             }
             if self.lay.has_u[j] {
-                p.push(
+                p.push_affine(
                     self.lay.wu[j] - self.it.w[j],
                     self.it.zu[j],
-                    -aff.0[j],
-                    aff.2[j],
+                    -dw,
+                    self.dir.dzu[j],
                 );
-                p.push_cen(-cen_w, self.dir.dzu[j] - aff.2[j]);
             }
         }
-        let dual = self.grad_lag_norms();
+        if self.solve_direction(shared, avg, false) {
+            for j in 0..self.lay.nw {
+                let dw = self.dir.dw[j];
+                if self.lay.has_l[j] {
+                    p.push_centring_from(dw, self.dir.dzl[j]);
+                }
+                if self.lay.has_u[j] {
+                    p.push_centring_from(-dw, self.dir.dzu[j]);
+                }
+            }
+        }
+        let complete = p.ds_cen.len() == p.ds_aff.len();
         let data = quality::QualityData {
-            slack: &p.slack,
-            z: &p.z,
-            ds_aff: &p.ds_aff,
-            dz_aff: &p.dz_aff,
-            ds_cen: &p.ds_cen,
-            dz_cen: &p.dz_cen,
-            dual,
+            pairs: &p,
+            dual: self.grad_lag_norms(),
             primal: quality::Norms::of(self.it.c.iter().copied()),
-            n_dual: nw,
-            n_pri: self.lay.m,
             tau: self.tau,
         };
         let settings = quality::QualitySettings::from_options(&self.opts);
         let mu_min = mu_floor_adaptive(&self.opts, self.scaling.obj);
-        let sigma = data.choose_sigma(avg, mu_min, self.opts.mu_max, &settings);
-        let mu = sigma * avg;
+        let sigma = complete.then(|| data.choose_sigma(avg, mu_min, self.opts.mu_max, &settings));
+        self.quality_pairs = p;
+        let mu = sigma? * avg;
         mu.is_finite().then_some(mu)
-    }
-}
-
-/// The complementarity pairs of the quality-function oracle, flattened.
-#[derive(Default)]
-struct Pairs {
-    slack: Vec<f64>,
-    z: Vec<f64>,
-    ds_aff: Vec<f64>,
-    dz_aff: Vec<f64>,
-    ds_cen: Vec<f64>,
-    dz_cen: Vec<f64>,
-}
-
-impl Pairs {
-    fn push(&mut self, slack: f64, z: f64, ds_aff: f64, dz_aff: f64) {
-        self.slack.push(slack);
-        self.z.push(z);
-        self.ds_aff.push(ds_aff);
-        self.dz_aff.push(dz_aff);
-    }
-
-    fn push_cen(&mut self, ds: f64, dz: f64) {
-        self.ds_cen.push(ds);
-        self.dz_cen.push(dz);
     }
 }

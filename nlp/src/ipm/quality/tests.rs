@@ -10,12 +10,7 @@ use crate::test_support::Rng;
 /// and the centring step s·dz + z·ds = avg, each split between ds and dz by a random
 /// share (some shares outside [0, 1], so that some steps run into the boundary).
 struct Instance {
-    slack: Vec<f64>,
-    z: Vec<f64>,
-    ds_aff: Vec<f64>,
-    dz_aff: Vec<f64>,
-    ds_cen: Vec<f64>,
-    dz_cen: Vec<f64>,
+    pairs: Pairs,
     dual: Vec<f64>,
     primal: Vec<f64>,
     avg: f64,
@@ -29,29 +24,23 @@ impl Instance {
         let slack: Vec<f64> = (0..n).map(|_| 0.05 + 2.0 * r.next()).collect();
         let z: Vec<f64> = (0..n).map(|_| 0.05 + 2.0 * r.next()).collect();
         let avg = slack.iter().zip(&z).map(|(s, z)| s * z).sum::<f64>() / n as f64;
-        let (mut ds_aff, mut dz_aff, mut ds_cen, mut dz_cen) = (vec![], vec![], vec![], vec![]);
+        let mut pairs = Pairs::default();
         for k in 0..n {
             let t = if hard {
                 2.0 + 4.0 * r.next()
             } else {
                 2.0 * r.next() - 0.5
             };
-            ds_aff.push(-slack[k] * t);
-            dz_aff.push(-z[k] * (1.0 - t));
+            pairs.push_affine(slack[k], z[k], -slack[k] * t, -z[k] * (1.0 - t));
             let p = r.next();
-            ds_cen.push(avg * p / z[k]);
-            dz_cen.push(avg * (1.0 - p) / slack[k]);
+            pairs.ds_cen.push(avg * p / z[k]);
+            pairs.dz_cen.push(avg * (1.0 - p) / slack[k]);
         }
         let scale = if hard { 10.0 } else { r.next() };
         let dual = r.vec(n + 2).iter().map(|v| v * scale).collect();
         let primal = r.vec(2).iter().map(|v| v * scale).collect();
         Instance {
-            slack,
-            z,
-            ds_aff,
-            dz_aff,
-            ds_cen,
-            dz_cen,
+            pairs,
             dual,
             primal,
             avg,
@@ -60,16 +49,9 @@ impl Instance {
 
     fn data(&self, tau: f64) -> QualityData<'_> {
         QualityData {
-            slack: &self.slack,
-            z: &self.z,
-            ds_aff: &self.ds_aff,
-            dz_aff: &self.dz_aff,
-            ds_cen: &self.ds_cen,
-            dz_cen: &self.dz_cen,
+            pairs: &self.pairs,
             dual: Norms::of(self.dual.iter().copied()),
             primal: Norms::of(self.primal.iter().copied()),
-            n_dual: self.dual.len(),
-            n_pri: self.primal.len(),
             tau,
         }
     }
@@ -78,13 +60,10 @@ impl Instance {
     /// sizes keeping (1 − τ) of every slack and multiplier, then the mean squares of the
     /// dual and primal infeasibility scaled by (1 − α)² and of the products.
     fn brute_q(&self, sigma: f64, tau: f64) -> f64 {
-        let n = self.slack.len();
-        let ds: Vec<f64> = (0..n)
-            .map(|k| self.ds_aff[k] + sigma * self.ds_cen[k])
-            .collect();
-        let dz: Vec<f64> = (0..n)
-            .map(|k| self.dz_aff[k] + sigma * self.dz_cen[k])
-            .collect();
+        let p = &self.pairs;
+        let n = p.slack.len();
+        let ds: Vec<f64> = (0..n).map(|k| p.ds_aff[k] + sigma * p.ds_cen[k]).collect();
+        let dz: Vec<f64> = (0..n).map(|k| p.dz_aff[k] + sigma * p.dz_cen[k]).collect();
         let largest = |v: &[f64], d: &[f64]| {
             // Shrink α to each entry's boundary in turn.
             let mut a = 1.0f64;
@@ -95,11 +74,11 @@ impl Instance {
             }
             a
         };
-        let ap = largest(&self.slack, &ds);
-        let az = largest(&self.z, &dz);
+        let ap = largest(&p.slack, &ds);
+        let az = largest(&p.z, &dz);
         let msq = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64;
         let prod: Vec<f64> = (0..n)
-            .map(|k| (self.slack[k] + ap * ds[k]) * (self.z[k] + az * dz[k]))
+            .map(|k| (p.slack[k] + ap * ds[k]) * (p.z[k] + az * dz[k]))
             .collect();
         (1.0 - az).powi(2) * msq(&self.dual) + (1.0 - ap).powi(2) * msq(&self.primal) + msq(&prod)
     }
