@@ -31,6 +31,7 @@ Usage (needs casadi): python3 window_bound.py W [--cache FILE] [--plan solution.
     on its own move counts.
 W = 1 takes ~3 min of CPU; W = 3 took 63 min wall (35 rounds, 725 stances and windows) on a shared
 machine with the cache of W = 1.
+global_bound.py turns these estimates into a certified bound (a global solver).
 """
 import itertools
 import json
