@@ -249,7 +249,7 @@ def main():
         for key, (bound, status, secs) in pool.imap_unordered(
                 settle, [k for k in keys if k not in solved]):
             solved[key] = bound
-            if status not in ("optimal", "gaplimit", "infeasible"):
+            if status not in ("optimal", "gaplimit"):
                 print(f"  {key}: {status} after {secs:.0f} s, dual bound {bound:.3f} kept",
                       flush=True)
             if cache:  # after every problem: an interrupted run loses nothing
