@@ -48,7 +48,7 @@ import time
 from pyscipopt import Model, quicksum
 
 from lower_bound import reach
-from window_bound import FEET, FMIN, GB, GF, MAXM, MG, START, shortest, stances_of
+from window_bound import FEET, FMIN, GB, GF, MAXM, MG, START, plan_path, shortest, stances_of
 
 HORIZON = 59  # transitions of the default scenario: at most 59 moves of any foot
 LAMBDA_MIN = 9.9 / MG  # F_thr / (M g), less the tilt of the normals and residuals
@@ -193,13 +193,7 @@ def check_plan(file, w, solved):
     stances = json.load(open(file))["stances"]
     cost = [1000 * (math.dist(st["com"]["B"], GB) ** 2 + math.dist(st["com"]["F"], GF) ** 2)
             + 0.001 * sum(v * v for n in FEET for v in st["forces"][n]) for st in stances]
-    counts, path, moved = [0, 0, 0, 0], [], []
-    for a, b in zip(stances, stances[1:]):
-        j = next((i for i, n in enumerate(FEET) if math.dist(a["feet"][n], b["feet"][n]) > 1e-6),
-                 0)  # a transition that moves no foot counts as a move of BR
-        counts[j] = min(counts[j] + 1, MAXM)
-        path.append(tuple(counts))
-        moved.append(j)
+    path, moved, _ = plan_path(file)
     infeasible, least = 0, math.inf
     for k in range(len(path) - w + 1):
         window, moves = stances[1 + k:1 + k + w], tuple(moved[k + 1:k + w])

@@ -21,7 +21,7 @@ import math
 
 import casadi as ca
 
-from lower_bound import KEEP_OUT, reach
+from lower_bound import reach
 MAX_MOVES = 16
 N_STEP = 60
 

@@ -42,7 +42,7 @@ import sys
 
 import casadi as ca
 
-from lower_bound import KEEP_OUT, reach
+from lower_bound import reach
 from two_foot_bound import biped_table
 
 MAXM = 15
@@ -218,18 +218,22 @@ def shortest(w, value):
 
 
 def plan_path(file):
-    """The move counts of a solution file's stances 2..60 and each stance's variables
-    (feet x, y; CoMs; forces) in the order of solve()'s single-stance x."""
+    """A solution file's stances 2..60 as a lattice path: the move counts of each stance,
+    the foot moved at each transition (one that moves no foot counts as a move of BR,
+    so that the path goes one count up per transition, as in the search; the counts stop
+    at MAXM) and each stance's variables (feet x, y; CoMs; forces) in the order of
+    solve()'s single-stance x."""
     stances = json.load(open(file))["stances"]
-    counts, path, xs = [0, 0, 0, 0], [], []
+    counts, path, moved, xs = [0, 0, 0, 0], [], [], []
     for prev, st in zip(stances, stances[1:]):
-        for i, n in enumerate(FEET):
-            if math.dist(prev["feet"][n], st["feet"][n]) > 1e-6:
-                counts[i] = min(counts[i] + 1, MAXM)
+        j = next((i for i, n in enumerate(FEET)
+                  if math.dist(prev["feet"][n], st["feet"][n]) > 1e-6), 0)
+        counts[j] = min(counts[j] + 1, MAXM)
         path.append(tuple(counts))
+        moved.append(j)
         xs.append(sum((st["feet"][n][:2] for n in FEET), []) + st["com"]["B"] + st["com"]["F"]
                   + sum((st["forces"][n] for n in FEET), []))
-    return path, xs
+    return path, moved, xs
 
 
 def nearest_com(p1, p2, goal):
@@ -267,7 +271,7 @@ def check_plan(w, file):
     single-stance solutions (as in the search) and also from the plan's own variables:
     prints the plan's cost, the relaxation's, and in how many windows the plan's point
     found a lower minimum than the search's starts (a check of the local solves)."""
-    path, xs = plan_path(file)
+    path, moved, xs = plan_path(file)
     nodes = {}
     for t in set(path):
         nodes[(t, ())] = solve(t, (), nodes)
@@ -276,8 +280,7 @@ def check_plan(w, file):
     for i in range(n):  # boundary stances, covered by fewer than w windows
         total += (1 - min(i + 1, w, n - i) / w) * nodes[(path[i], ())][0]
     for k in range(n - w + 1):
-        seq = path[k:k + w]
-        moves = tuple(next((i for i in range(4) if b[i] != a[i]), 0) for a, b in zip(seq, seq[1:]))
+        seq, moves = path[k:k + w], tuple(moved[k + 1:k + w])
         x0 = list(xs[k][:8])
         for i, j in enumerate(moves):
             x0 += xs[k + i + 1][2 * j:2 * j + 2]
