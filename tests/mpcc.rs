@@ -108,3 +108,100 @@ fn mpcc_log() {
         println!("{:?}\n{:?}", s.phases, s.report);
     }
 }
+
+/// One budget over all phases (issue 23 item 6): ralph1's SQP main phase does not converge
+/// (it runs to its own 3000 iterations; docs/performance.md, "SQP and MPCC"), so a
+/// run budget of 500 ends inside it: no final phase starts, the status says the limit
+/// was hit, and the summary says the run's budget was spent.
+#[test]
+fn one_budget_bounds_every_phase() {
+    let case = problems::ralph1();
+    let mut o = MpccOptions {
+        max_iter: 500,
+        ..MpccOptions::default()
+    };
+    let s = solve_mpcc(&(case.build)(), MpccBackend::Sqp, &o).unwrap();
+    assert_eq!(s.phases.len(), 1, "{}", s.summary());
+    assert_eq!(s.iterations, 500);
+    assert_eq!(s.solution.status, nlp::Status::MaximumIterationsExceeded);
+    assert!(s.budget_exhausted && s.rescue.is_none());
+    assert!(
+        s.summary().contains("budget of 500 iterations"),
+        "{}",
+        s.summary()
+    );
+
+    // The IPM's penalty phases share the budget the same way: qpec2 takes 132 iterations
+    // over its phases with the default budget (golden record); 40 stops it in the
+    // penalty loop, with every phase's iterations counted.
+    let case = problems::qpec2();
+    o.max_iter = 40;
+    let s = solve_mpcc(&(case.build)(), MpccBackend::Ipm, &o).unwrap();
+    assert!(s.budget_exhausted, "{}", s.summary());
+    assert!(s.iterations <= 40, "{}", s.summary());
+    assert_eq!(
+        s.iterations,
+        s.phases.iter().map(|p| p.iterations).sum::<usize>()
+    );
+    assert!(s.phases.iter().all(|p| p.kind == "penalty"));
+}
+
+/// A rescue is reported, not hidden behind the final status: ralph1's SQP phase stops at
+/// `MaximumIterationsExceeded` and the exact final phase solves the branch problem from
+/// its point (to MacMPEC's f* = 0, asserted by `ralph1` above).
+#[test]
+fn a_rescue_by_the_final_phase_is_reported() {
+    let case = problems::ralph1();
+    let s = solve_mpcc(&(case.build)(), MpccBackend::Sqp, &MpccOptions::default()).unwrap();
+    let rescue = s.rescue.expect("the final phase rescued the sqp phase");
+    assert_eq!(rescue.failed_phase, 0);
+    assert_eq!(rescue.failed_status, nlp::Status::MaximumIterationsExceeded);
+    assert_eq!(s.phases[rescue.rescued_by].kind, "final");
+    assert!(s.solution.status.is_success() && !s.budget_exhausted);
+    assert!(
+        s.summary()
+            .ends_with("the final phase rescued a failed sqp phase (MaximumIterationsExceeded)"),
+        "{}",
+        s.summary()
+    );
+    // A run whose main phase converges has no rescue (bard1: sqp 3, final 1).
+    let case = problems::bard1();
+    let s = solve_mpcc(&(case.build)(), MpccBackend::Sqp, &MpccOptions::default()).unwrap();
+    assert!(
+        s.rescue.is_none() && s.solution.status.is_success(),
+        "{}",
+        s.summary()
+    );
+}
+
+/// Bad driver options are refused by name before any solve; names are set like a back
+/// end's, with a prefix for the back ends'.
+#[test]
+fn driver_options_are_checked_and_set_by_name() {
+    let pb = (problems::bard1().build)();
+    let o = MpccOptions {
+        penalty_increase: 1.0,
+        ..MpccOptions::default()
+    };
+    let err = solve_mpcc(&pb, MpccBackend::Ipm, &o)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("penalty_increase"), "{err}");
+
+    let mut o = MpccOptions::default();
+    o.set_options_by_name(&["max_iter=7", "ipm.max_iter=5", "sqp.tol=1e-9"])
+        .unwrap();
+    assert_eq!((o.max_iter, o.ipm.max_iter, o.sqp.tol), (7, 5, 1e-9));
+    let before = o.clone();
+    let err = o
+        .set_options_by_name(&["penalty_init=5", "ipm.mu_innit=1"])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("mu_init"), "{err}");
+    assert_eq!(o, before, "a refused assignment list changes nothing");
+    let err = o
+        .set_options_by_name(&["max_iter=0"])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("max_iter"), "{err}");
+}

@@ -22,9 +22,22 @@
 //! equality constraints (exactly for variables). If that solve fails, the previous phase's
 //! solution is returned.
 //!
+//! **One budget.** [`MpccOptions::max_iter`] and [`MpccOptions::max_wall_time`] bound the
+//! whole run: each phase's solver gets the smaller of its own limit and what is left, and
+//! no phase starts once the budget is spent ([`MpccSolution::budget_exhausted`]).
+//!
+//! **Compiled once per structure.** The penalty phases share one compiled problem whose
+//! π is a parameter (`mpcc.penalty`), so only the final phase (other rows) compiles again.
+//!
 //! The result reports the complementarity residual and the biactive pairs
-//! ([`ComplementarityReport`]) and every phase. [`solve_mpcc_with_callback`] forwards an
-//! iteration callback to every phase's solve, labelling each iteration with its phase.
+//! ([`ComplementarityReport`]), every phase, and whether the final phase rescued a failed
+//! earlier phase ([`MpccSolution::rescue`], [`MpccSolution::summary`]).
+//! [`solve_mpcc_with_callback`] forwards an iteration callback to every phase's solve,
+//! labelling each iteration with its phase.
+//!
+//! Options can be set by name ([`MpccOptions::set_options_by_name`]): the driver's own
+//! (`penalty_init=100`) and either back end's with a prefix (`ipm.tol=1e-10`,
+//! `sqp.max_iter=50`).
 
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -33,14 +46,15 @@ use symx::Expr;
 use thiserror::Error;
 
 use crate::callback::{IterationCallback, IterationView, PhaseLabel};
+use crate::compiled::Compiled;
 use crate::constraint::Relation;
 use crate::error::SolveError;
-use crate::frontend::Solver;
-use crate::ipm::Ipm;
+use crate::frontend::{Solver, SolverOptions};
+use crate::option_names::{NamedOptions, OptionError};
 use crate::options::IpmOptions;
 use crate::problem::{BuildError, ComplementarityReport, Problem};
 use crate::solution::{Solution, Status};
-use crate::sqp::{Sqp, SqpOptions};
+use crate::sqp::SqpOptions;
 
 /// Which back end solves the MPCC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -72,15 +86,146 @@ pub struct MpccOptions {
     pub exact_final_phase: bool,
     /// A pair is biactive when both a and b are within this of zero. Default 1e-6.
     pub biactive_tol: f64,
+    /// Iterations over all phases together. Default 6000: twice a back end's own default
+    /// `max_iter`, so that a main phase that exhausts its own 3000 still leaves the exact
+    /// final phase its chance to rescue the point.
+    pub max_iter: usize,
+    /// Wall-clock seconds over all phases together. Default 1e20 (none).
+    pub max_wall_time: f64,
+}
+
+/// The driver's own options as set by name (the fields of [`MpccOptions`] but the two
+/// back ends' options).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct DriverOptions {
+    penalty_init: f64,
+    penalty_increase: f64,
+    penalty_max: f64,
+    switch_tol: f64,
+    exact_final_phase: bool,
+    biactive_tol: f64,
+    max_iter: usize,
+    max_wall_time: f64,
+}
+
+impl NamedOptions for DriverOptions {
+    fn check(&self) -> Result<(), SolveError> {
+        let bad = |field: &'static str, reason: &str| {
+            Err(SolveError::InvalidOption {
+                field,
+                reason: reason.to_string(),
+            })
+        };
+        let positive = [
+            ("penalty_init", self.penalty_init),
+            ("penalty_max", self.penalty_max),
+            ("switch_tol", self.switch_tol),
+            ("biactive_tol", self.biactive_tol),
+            ("max_wall_time", self.max_wall_time),
+        ];
+        for (field, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(field, &format!("must be finite and > 0, got {v}"));
+            }
+        }
+        if !(self.penalty_increase.is_finite() && self.penalty_increase > 1.0) {
+            return bad(
+                "penalty_increase",
+                &format!("must be finite and > 1, got {}", self.penalty_increase),
+            );
+        }
+        if self.penalty_max < self.penalty_init {
+            return bad(
+                "penalty_max",
+                &format!(
+                    "must be >= penalty_init = {}, got {}",
+                    self.penalty_init, self.penalty_max
+                ),
+            );
+        }
+        if self.max_iter == 0 {
+            return bad("max_iter", "must be at least 1");
+        }
+        Ok(())
+    }
 }
 
 impl MpccOptions {
+    /// The options of `backend`, behind the interface both back ends' options share.
+    pub fn backend_options(&self, backend: MpccBackend) -> Box<dyn SolverOptions> {
+        match backend {
+            MpccBackend::Sqp => Box::new(self.sqp.clone()),
+            MpccBackend::Ipm => Box::new(self.ipm.clone()),
+        }
+    }
+
     /// The solver of `backend` with its options.
     pub fn solver(&self, backend: MpccBackend) -> Box<dyn Solver> {
-        match backend {
-            MpccBackend::Sqp => Box::new(Sqp::new(self.sqp.clone())),
-            MpccBackend::Ipm => Box::new(Ipm::new(self.ipm.clone())),
+        self.backend_options(backend).solver()
+    }
+
+    /// Checks the driver's options and both back ends'; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        self.driver().check()?;
+        self.ipm.check()?;
+        self.sqp.check()
+    }
+
+    /// Applies `KEY=VALUE` assignments in order: the driver's own options by their field
+    /// names (`penalty_init=100`, `max_iter=500`), a back end's with its prefix
+    /// (`ipm.tol=1e-10`, `sqp.max_iter=50`). On any error nothing changes and the error
+    /// names the option.
+    /// ```
+    /// use nlp::MpccOptions;
+    /// let mut o = MpccOptions::default();
+    /// o.set_options_by_name(&["penalty_init=100", "ipm.tol=1e-10", "sqp.max_iter=50"]).unwrap();
+    /// assert_eq!((o.penalty_init, o.ipm.tol, o.sqp.max_iter), (100.0, 1e-10, 50));
+    /// let err = o.set_options_by_name(&["penalty_inti=5"]).unwrap_err();
+    /// assert!(err.to_string().contains("did you mean 'penalty_init'"), "{err}");
+    /// ```
+    pub fn set_options_by_name(&mut self, assignments: &[&str]) -> Result<(), OptionError> {
+        let (mut own, mut ipm, mut sqp) = (Vec::new(), Vec::new(), Vec::new());
+        for &a in assignments {
+            if let Some(rest) = a.trim_start().strip_prefix("ipm.") {
+                ipm.push(rest);
+            } else if let Some(rest) = a.trim_start().strip_prefix("sqp.") {
+                sqp.push(rest);
+            } else {
+                own.push(a);
+            }
         }
+        let mut new = self.clone();
+        let mut driver = new.driver();
+        driver.set_by_name(&own)?;
+        new.ipm.set_by_name(&ipm)?;
+        new.sqp.set_by_name(&sqp)?;
+        new.set_driver(driver);
+        *self = new;
+        Ok(())
+    }
+
+    fn driver(&self) -> DriverOptions {
+        DriverOptions {
+            penalty_init: self.penalty_init,
+            penalty_increase: self.penalty_increase,
+            penalty_max: self.penalty_max,
+            switch_tol: self.switch_tol,
+            exact_final_phase: self.exact_final_phase,
+            biactive_tol: self.biactive_tol,
+            max_iter: self.max_iter,
+            max_wall_time: self.max_wall_time,
+        }
+    }
+
+    fn set_driver(&mut self, d: DriverOptions) {
+        self.penalty_init = d.penalty_init;
+        self.penalty_increase = d.penalty_increase;
+        self.penalty_max = d.penalty_max;
+        self.switch_tol = d.switch_tol;
+        self.exact_final_phase = d.exact_final_phase;
+        self.biactive_tol = d.biactive_tol;
+        self.max_iter = d.max_iter;
+        self.max_wall_time = d.max_wall_time;
     }
 }
 
@@ -95,6 +240,8 @@ impl Default for MpccOptions {
             switch_tol: 1e-6,
             exact_final_phase: true,
             biactive_tol: 1e-6,
+            max_iter: 6000,
+            max_wall_time: 1e20,
         }
     }
 }
@@ -114,6 +261,18 @@ pub struct MpccPhase {
     pub residual: f64,
 }
 
+/// A failed phase whose point a later phase turned into a solution: the final phase
+/// solved the branch problem from a main phase that stopped without converging.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Rescue {
+    /// Index in [`MpccSolution::phases`] of the last failed phase before the rescue.
+    pub failed_phase: usize,
+    /// Its status.
+    pub failed_status: Status,
+    /// Index of the phase that succeeded from its point.
+    pub rescued_by: usize,
+}
+
 /// Result of [`solve_mpcc`].
 #[derive(Debug, Clone)]
 pub struct MpccSolution {
@@ -129,6 +288,44 @@ pub struct MpccSolution {
     pub iterations: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// Set when the main phase failed and the final phase succeeded from its point: the
+    /// solution is a KKT point of the branch problem, reached only through the rescue.
+    pub rescue: Option<Rescue>,
+    /// The run ended because [`MpccOptions::max_iter`] or [`MpccOptions::max_wall_time`]
+    /// was spent (a phase hit its share, or a phase could not start).
+    pub budget_exhausted: bool,
+}
+
+impl MpccSolution {
+    /// One line per phase and a last line saying how the run ended, e.g.
+    /// `sqp: MaximumIterationsExceeded, 3000 iterations` … `final phase rescued a failed
+    /// sqp phase (MaximumIterationsExceeded)`.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        for p in &self.phases {
+            let pi = if p.kind == "penalty" {
+                format!(" (pi = {:e})", p.penalty)
+            } else {
+                String::new()
+            };
+            out += &format!(
+                "{}{pi}: {:?}, {} iterations, residual {:.1e}\n",
+                p.kind, p.status, p.iterations, p.residual
+            );
+        }
+        out += &match (self.rescue, self.budget_exhausted) {
+            (Some(r), _) => format!(
+                "{:?}: the final phase rescued a failed {} phase ({:?})",
+                self.solution.status, self.phases[r.failed_phase].kind, r.failed_status
+            ),
+            (None, true) => format!(
+                "{:?}: the budget of {} iterations over all phases was spent",
+                self.solution.status, self.iterations
+            ),
+            (None, false) => format!("{:?}", self.solution.status),
+        };
+        out
+    }
 }
 
 /// Errors of [`solve_mpcc`].
@@ -140,14 +337,59 @@ pub enum MpccError {
     Solve(#[from] SolveError),
 }
 
+/// The name of the penalty parameter π in the penalty phases' problem.
+const PENALTY_PARAMETER: &str = "mpcc.penalty";
+
+/// What is left of the run's budget, and the phase solvers it limits.
+struct Budget<'a> {
+    options: &'a MpccOptions,
+    backend: MpccBackend,
+    start: Instant,
+    used: usize,
+}
+
+impl Budget<'_> {
+    /// The back end's solver limited to what is left, or `None` when nothing is left.
+    fn solver(&self) -> Option<Box<dyn Solver>> {
+        let iters = self.options.max_iter.saturating_sub(self.used);
+        let secs = self.options.max_wall_time - self.start.elapsed().as_secs_f64();
+        (iters > 0 && secs > 0.0).then(|| self.limited(iters, secs))
+    }
+
+    /// The solver of the first phase, which always runs (with the least positive time
+    /// when compiling already spent the budget, so that it reports the limit itself).
+    fn first_solver(&self) -> Box<dyn Solver> {
+        let secs = self.options.max_wall_time - self.start.elapsed().as_secs_f64();
+        self.limited(self.options.max_iter, secs.max(f64::MIN_POSITIVE))
+    }
+
+    fn limited(&self, iters: usize, secs: f64) -> Box<dyn Solver> {
+        let mut o = self.options.backend_options(self.backend);
+        let c = o.common_mut();
+        c.max_iter = c.max_iter.min(iters);
+        c.max_wall_time = c.max_wall_time.min(secs);
+        o.solver()
+    }
+
+    /// Whether `sol` stopped on a limit the run's budget (not the back end's own) set.
+    fn spent_by(&self, sol: &Solution) -> bool {
+        match sol.status {
+            Status::MaximumIterationsExceeded => self.used >= self.options.max_iter,
+            Status::MaximumWallTimeExceeded => {
+                self.start.elapsed().as_secs_f64() >= self.options.max_wall_time
+            }
+            _ => false,
+        }
+    }
+}
+
 fn run(
     solver: &dyn Solver,
-    pb: &Problem,
+    c: &mut Compiled,
     x0: Option<&[f64]>,
     callback: Option<&mut IterationCallback<'_>>,
     phase: PhaseLabel,
 ) -> Result<Solution, MpccError> {
-    let mut c = pb.compile()?;
     if let Some(x0) = x0 {
         c.set_initial_point(x0)?;
     }
@@ -161,7 +403,7 @@ fn run(
         }
     });
     let cb = labelled.as_mut().map(|f| f as &mut IterationCallback<'_>);
-    Ok(solver.solve_dyn(&mut c, None, cb)?)
+    Ok(solver.solve_dyn(c, None, cb)?)
 }
 
 fn ok(s: Status) -> bool {
@@ -196,12 +438,19 @@ fn solve(
     options: &MpccOptions,
     mut callback: Option<&mut IterationCallback<'_>>,
 ) -> Result<MpccSolution, MpccError> {
-    let t = Instant::now();
+    // The back end's own options are checked by its solver, the other's not at all.
+    options.driver().check()?;
     let o = options;
-    let solver = o.solver(backend);
+    let mut budget = Budget {
+        options,
+        backend,
+        start: Instant::now(),
+        used: 0,
+    };
     let f = problem.objective();
     let pairs = problem.complementarity_pairs().to_vec();
-    let mut phases = Vec::new();
+    let mut phases: Vec<MpccPhase> = Vec::new();
+    let mut spent = false;
     let record = |phases: &mut Vec<MpccPhase>,
                   kind: &'static str,
                   penalty: f64,
@@ -218,40 +467,66 @@ fn solve(
         });
         Ok(rep)
     };
-    // ---- first phase ----
     let label = |phases: &Vec<MpccPhase>, kind: &'static str, penalty: f64| PhaseLabel {
         index: phases.len(),
         kind,
         penalty,
     };
     let stopped = |sol: &Solution| sol.status == Status::UserRequestedStop;
+    // ---- main phase(s) ----
     let mut best = match backend {
         MpccBackend::Sqp => {
+            let mut c = problem.compile()?;
+            let solver = budget.first_solver();
             let phase = label(&phases, "sqp", 0.0);
             let sol = run(
                 solver.as_ref(),
-                problem,
+                &mut c,
                 None,
                 callback.as_deref_mut(),
                 phase,
             )?;
             record(&mut phases, "sqp", 0.0, &sol)?;
+            budget.used += sol.stats.iterations;
+            spent |= budget.spent_by(&sol);
             sol
         }
         MpccBackend::Ipm => {
+            // f + π·Σ aᵢbᵢ with π a parameter: one compilation for every π.
+            let mut pb = problem.mpcc_copy(f, false);
+            let pi_param = pb.parameter(PENALTY_PARAMETER, 1)?[0];
+            let mut obj = f;
+            for (_, a, b) in &pairs {
+                obj += pi_param * (*a * *b);
+            }
+            pb.minimize(obj);
             let mut pi = o.penalty_init;
+            pb.set_value(PENALTY_PARAMETER, &[pi])?;
+            let mut c = pb.compile()?;
             let mut x: Option<Vec<f64>> = None;
+            let mut last: Option<Solution> = None;
             loop {
-                let mut obj = f;
-                for (_, a, b) in &pairs {
-                    obj += pi * (*a * *b);
-                }
-                let pb = problem.mpcc_copy(obj, false);
+                let solver = match &last {
+                    None => budget.first_solver(),
+                    Some(_) => match budget.solver() {
+                        Some(solver) => solver,
+                        None => {
+                            spent = true;
+                            break last.take().expect("matched Some");
+                        }
+                    },
+                };
+                c.set_value(PENALTY_PARAMETER, &[pi])?;
                 let phase = label(&phases, "penalty", pi);
                 let cb = callback.as_deref_mut();
-                let sol = run(solver.as_ref(), &pb, x.as_deref(), cb, phase)?;
+                let sol = run(solver.as_ref(), &mut c, x.as_deref(), cb, phase)?;
                 let rep = record(&mut phases, "penalty", pi, &sol)?;
+                budget.used += sol.stats.iterations;
                 x = Some(sol.x.clone());
+                if budget.spent_by(&sol) {
+                    spent = true;
+                    break sol;
+                }
                 if stopped(&sol)
                     || (ok(sol.status) && rep.residual <= o.switch_tol)
                     || pi * o.penalty_increase > o.penalty_max
@@ -259,43 +534,64 @@ fn solve(
                     break sol;
                 }
                 pi *= o.penalty_increase;
+                last = Some(sol);
             }
         }
     };
     // The objective of the original problem at the returned point.
     let f_at = |x: &[f64]| -> Result<f64, MpccError> { Ok(problem.evaluate(&[f], x)?[0]) };
     best.objective = f_at(&best.x)?;
+    let main_phase = phases.len() - 1;
+    let mut rescue = None;
     // ---- exact final phase ----
     if o.exact_final_phase && !pairs.is_empty() && !stopped(&best) {
-        let vals = problem.evaluate(
-            &pairs
-                .iter()
-                .flat_map(|(_, a, b)| [*a, *b])
-                .collect::<Vec<Expr>>(),
-            &best.x,
-        )?;
-        let mut pb = problem.mpcc_copy(f, false);
-        for (k, (name, a, b)) in pairs.iter().enumerate() {
-            let side = if vals[2 * k] <= vals[2 * k + 1] {
-                *a
-            } else {
-                *b
-            };
-            pb.subject_to_named(&format!("{name}.branch"), side.eq(0.0))?;
-        }
-        let phase = label(&phases, "final", 0.0);
-        let sol = run(solver.as_ref(), &pb, Some(&best.x), callback, phase)?;
-        record(&mut phases, "final", 0.0, &sol)?;
-        if ok(sol.status) || stopped(&sol) {
-            best = sol;
+        match budget.solver() {
+            None => spent = true,
+            Some(solver) => {
+                let vals = problem.evaluate(
+                    &pairs
+                        .iter()
+                        .flat_map(|(_, a, b)| [*a, *b])
+                        .collect::<Vec<Expr>>(),
+                    &best.x,
+                )?;
+                let mut pb = problem.mpcc_copy(f, false);
+                for (k, (name, a, b)) in pairs.iter().enumerate() {
+                    let side = if vals[2 * k] <= vals[2 * k + 1] {
+                        *a
+                    } else {
+                        *b
+                    };
+                    pb.subject_to_named(&format!("{name}.branch"), side.eq(0.0))?;
+                }
+                let mut c = pb.compile()?;
+                let phase = label(&phases, "final", 0.0);
+                let sol = run(solver.as_ref(), &mut c, Some(&best.x), callback, phase)?;
+                record(&mut phases, "final", 0.0, &sol)?;
+                budget.used += sol.stats.iterations;
+                if ok(sol.status) && !ok(phases[main_phase].status) {
+                    rescue = Some(Rescue {
+                        failed_phase: main_phase,
+                        failed_status: phases[main_phase].status,
+                        rescued_by: phases.len() - 1,
+                    });
+                }
+                if ok(sol.status) || stopped(&sol) {
+                    best = sol;
+                } else {
+                    spent |= budget.spent_by(&sol);
+                }
+            }
         }
     }
     let report = problem.complementarity_report(&best.x, o.biactive_tol)?;
     Ok(MpccSolution {
-        iterations: phases.iter().map(|p| p.iterations).sum(),
+        iterations: budget.used,
         solution: best,
         report,
         phases,
-        seconds: t.elapsed().as_secs_f64(),
+        seconds: budget.start.elapsed().as_secs_f64(),
+        rescue,
+        budget_exhausted: spent,
     })
 }
