@@ -134,6 +134,8 @@ pub struct Mpc {
     compiled: Compiled,
     shift: Shift,
     x0_parameter: String,
+    /// Number of states.
+    nx: usize,
     /// Positions of `U[:, 0]` in `x`.
     first_control: Vec<usize>,
     sampling_period: f64,
@@ -162,6 +164,7 @@ impl Mpc {
             compiled: tr.compile()?,
             shift: tr.shift_plan()?,
             x0_parameter,
+            nx: tr.states().nrows(),
             control: vec![0.0; first_control.len()],
             first_control,
             sampling_period: t_f / tr.intervals() as f64,
@@ -175,6 +178,15 @@ impl Mpc {
     /// its status (the report tells the status).
     pub fn step(&mut self, x0: &[f64]) -> Result<StepReport, MpcError> {
         let start = Instant::now();
+        let nx = self.nx;
+        if x0.len() != nx {
+            return Err(OcpError::Size {
+                what: format!("measured state (parameter '{}')", self.x0_parameter),
+                expected: nx,
+                got: x0.len(),
+            }
+            .into());
+        }
         self.compiled.set_value(self.x0_parameter.as_str(), x0)?;
         let warm = self.previous.is_some();
         let sol = match self.previous.as_mut() {

@@ -150,14 +150,16 @@ impl Transcription {
                     match (to, from) {
                         (Some(to), Some(from)) => row_moves.push((to, from)),
                         (None, None) => {}
-                        _ => return Err(OcpError::Invalid {
-                            what: format!("constraint '{}' row {r}", g.name),
-                            why: format!(
+                        _ => {
+                            return Err(OcpError::Invalid {
+                                what: format!("constraint '{}' row {r}", g.name),
+                                why: format!(
                                 "a simple bound at stage {} but a row at stage {}: cannot shift",
                                 if to.is_none() { k } else { k + 1 },
                                 if to.is_none() { k + 1 } else { k },
                             ),
-                        }),
+                            })
+                        }
                     }
                 }
             }
