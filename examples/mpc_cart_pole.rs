@@ -10,12 +10,14 @@
 //! `benches/reference/mpc_casadi.py` runs the identical loop with CasADi (IPOPT,
 //! sqpmethod + qrqp, RTI); `tests/mpc.rs` compares the closed-loop cost.
 //!
-//! Run: `cargo run --release --example mpc_cart_pole [-- sqp]`
+//! Run: `cargo run --release --example mpc_cart_pole [-- sqp] [--json]`
 use std::f64::consts::PI;
-use symnlp::nlp::mpc::{ClosedLoop, Mpc};
-use symnlp::nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Simulator, Transcription};
-use symnlp::nlp::{Ipm, Solver, Sqp};
-use symnlp::symx::{Expr, Function, Matrix};
+use symnlp::nlp::ocp::{Horizon, Ocp};
+use symnlp::symx::{Expr, Matrix};
+
+#[path = "mpc_common/mod.rs"]
+mod mpc_common;
+pub use mpc_common::MpcExample;
 
 #[path = "cart_pole.rs"]
 #[allow(dead_code)]
@@ -50,62 +52,19 @@ pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
     Ok(ocp)
 }
 
-/// The transcription and the nominal plant.
-pub fn setup() -> Result<(Transcription, Simulator), Box<dyn std::error::Error>> {
-    let ocp = problem()?;
-    let tr = ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), N)?;
-    Ok((tr, Simulator::new(&ocp, ButcherTableau::rk4(), 1)?))
-}
-
-/// The closed loop with `solver`.
-pub fn closed_loop(solver: Box<dyn Solver>) -> Result<ClosedLoop, Box<dyn std::error::Error>> {
-    let (tr, mut plant) = setup()?;
-    let mut mpc = Mpc::new(&tr, solver)?;
-    Ok(mpc.run(&X_INIT, STEPS, |x, u, next| plant.step_into(x, u, DT, next))?)
-}
-
-/// The closed loop's cost `dt Σ_s l(x_s, u_s)`.
-pub fn closed_loop_cost(run: &ClosedLoop) -> Result<f64, Box<dyn std::error::Error>> {
-    let (x, u) = (Matrix::sym_vec("x", 4), Matrix::sym_vec("u", 1));
-    let l = Function::new(&[&x, &u], &[&[stage_cost(&x, &u)]])?;
-    let mut total = 0.0;
-    for (x, u) in run.states.iter().zip(&run.controls) {
-        total += l.call(&[x, u])?[0][0];
+/// The example: 100 steps from hanging at rest.
+pub fn example() -> MpcExample {
+    MpcExample {
+        name: "cart_pole",
+        intervals: N,
+        dt: DT,
+        steps: STEPS,
+        x_init: X_INIT.to_vec(),
+        stage_cost,
+        ocp: problem,
     }
-    Ok(DT * total)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let solver: Box<dyn Solver> = match std::env::args().nth(1).as_deref() {
-        Some("sqp") => Box::new(Sqp::default()),
-        _ => Box::new(Ipm::default()),
-    };
-    let name = solver.name();
-    let run = closed_loop(solver)?;
-    let (median, max) = run.latency();
-    let (mean_it, max_it) = run.iterations();
-    println!("step,status,iterations,ms,q1,q2,dq1,dq2,u");
-    for (s, r) in run.steps.iter().enumerate() {
-        let x = &run.states[s];
-        println!(
-            "{s},{},{},{:.3},{:.6},{:.6},{:.6},{:.6},{:.6}",
-            r.status,
-            r.iterations,
-            1e3 * r.seconds,
-            x[0],
-            x[1],
-            x[2],
-            x[3],
-            run.controls[s][0]
-        );
-    }
-    eprintln!(
-        "{name}: all succeeded {}, closed-loop cost {:.10}, latency median {:.3} ms max {:.3} ms, iterations mean {mean_it:.2} max {max_it}; final state {:?}",
-        run.all_succeeded(),
-        closed_loop_cost(&run)?,
-        1e3 * median,
-        1e3 * max,
-        run.states[STEPS]
-    );
-    Ok(())
+    example().main()
 }

@@ -1,12 +1,18 @@
 //! MPC: the shift of a solution (indices checked against the compiled constraint blocks,
 //! multipliers moved with their rows), the initial state as a parameter, the plant, and
 //! the closed loops against CasADi 3.8.2 + IPOPT 3.14 on the identical transcription
-//! (`python3 benches/reference/mpc_casadi.py cart_pole ipopt`, run 2026-11-27 on this
+//! (`python3 benches/reference/mpc_casadi.py cart_pole,car,quadrotor ipopt`, run 2026-11-27 on this
 //! machine; output recorded in `benches/reference/results/mpc_casadi.jsonl`).
 #![allow(dead_code)] // the examples' `main`s are not called here
 
 #[path = "../examples/mpc_cart_pole.rs"]
 mod mpc_cart_pole;
+
+#[path = "../examples/mpc_car.rs"]
+mod mpc_car;
+
+#[path = "../examples/mpc_quadrotor.rs"]
+mod mpc_quadrotor;
 
 use symnlp::nlp::mpc::{Mpc, MpcError};
 use symnlp::nlp::ocp::{
@@ -255,7 +261,8 @@ const IPOPT_CART_POLE_LOOP_COST: f64 = 40.42107528932347;
 /// applied a different control moves the cost by far more.
 #[test]
 fn cart_pole_closed_loop_matches_ipopt() {
-    let run = mpc_cart_pole::closed_loop(Box::new(Ipm::default())).unwrap();
+    let example = mpc_cart_pole::example();
+    let run = example.closed_loop(Box::new(Ipm::default())).unwrap();
     assert_eq!(run.steps.len(), mpc_cart_pole::STEPS);
     assert!(
         run.all_succeeded(),
@@ -263,7 +270,7 @@ fn cart_pole_closed_loop_matches_ipopt() {
         run.steps.iter().map(|s| s.status).collect::<Vec<_>>()
     );
     assert!(run.steps[1..].iter().all(|s| s.warm) && !run.steps[0].warm);
-    let cost = mpc_cart_pole::closed_loop_cost(&run).unwrap();
+    let cost = example.cost(&run).unwrap();
     let rel = ((cost - IPOPT_CART_POLE_LOOP_COST) / IPOPT_CART_POLE_LOOP_COST).abs();
     assert!(
         rel < 1e-6,
@@ -275,4 +282,37 @@ fn cart_pole_closed_loop_matches_ipopt() {
         x[0].abs() < 1e-2 && (x[1] - std::f64::consts::PI).abs() < 1e-2,
         "{x:?}"
     );
+}
+
+/// CasADi + IPOPT's closed loops of the car and the quadrotor (same script and file).
+const IPOPT_CAR_LOOP_COST: f64 = 40.9501029836042;
+const IPOPT_QUADROTOR_LOOP_COST: f64 = 17.549770607539823;
+
+/// Every step succeeds and the loop cost equals IPOPT's (tolerance as for the cart-pole;
+/// measured 1e-15 and 2e-16). A macro: each example includes its own copy of
+/// `mpc_common`, so their `MpcExample`s are distinct types.
+macro_rules! assert_loop_matches_ipopt {
+    ($example:expr, $ipopt:expr) => {{
+        let example = $example;
+        let run = example.closed_loop(Box::new(Ipm::default())).unwrap();
+        assert!(run.all_succeeded(), "{}", example.name);
+        let cost = example.cost(&run).unwrap();
+        let rel = ((cost - $ipopt) / $ipopt).abs();
+        assert!(
+            rel < 1e-6,
+            "{}: closed-loop cost {cost} vs IPOPT {}",
+            example.name,
+            $ipopt
+        );
+    }};
+}
+
+#[test]
+fn car_closed_loop_matches_ipopt() {
+    assert_loop_matches_ipopt!(mpc_car::example(), IPOPT_CAR_LOOP_COST);
+}
+
+#[test]
+fn quadrotor_closed_loop_matches_ipopt() {
+    assert_loop_matches_ipopt!(mpc_quadrotor::example(), IPOPT_QUADROTOR_LOOP_COST);
 }

@@ -53,7 +53,51 @@ def cart_pole():
     }
 
 
-PROBLEMS = {"cart_pole": cart_pole}
+def car():
+    L, target = 1.0, [5.0, 2.0]
+
+    def f(x, u):
+        return [x[3] * ca.cos(x[2]), x[3] * ca.sin(x[2]), x[3] * ca.tan(u[1]) / L, u[0]]
+
+    def stage(x, u):
+        return ((x[0] - target[0]) ** 2 + (x[1] - target[1]) ** 2 + x[2] ** 2 + 0.1 * x[3] ** 2
+                + 0.1 * (u[0] ** 2 + u[1] ** 2))
+
+    inf = math.inf
+    return {
+        "nx": 4, "nu": 2, "N": 30, "dt": 0.1, "steps": 80,
+        "f": f, "l": stage, "phi": lambda x: 10.0 * stage(x, [0.0, 0.0]),
+        "x_lb": [-inf, -inf, -inf, -1.0], "x_ub": [inf, inf, inf, 3.0],
+        "u_lb": [-2.0, -0.6], "u_ub": [2.0, 0.6],
+        "x_init": [0.0] * 4, "guess_end": None, "u_guess": [0.0, 0.0],
+    }
+
+
+def quadrotor():
+    from ocp_examples import QR, quadrotor as qr
+    hover = QR["m"] * QR["g"] / 4
+
+    def stage(x, u):
+        t = [1.0, 1.0, 1.0]
+        l = 0
+        for i in range(3):
+            l = l + 10.0 * (x[i] - t[i]) ** 2 + x[3 + i] ** 2 + x[6 + i] ** 2 + 0.1 * x[9 + i] ** 2
+        for j in range(4):
+            l = l + 0.1 * (u[j] - hover) ** 2
+        return l
+
+    inf, tilt = math.inf, math.pi / 4
+    return {
+        "nx": 12, "nu": 4, "N": 20, "dt": 0.1, "steps": 50,
+        "f": qr()["f"], "l": stage, "phi": lambda x: 10.0 * stage(x, [hover] * 4),
+        "x_lb": [-inf] * 6 + [-tilt, -tilt, -inf] + [-inf] * 3,
+        "x_ub": [inf] * 6 + [tilt, tilt, inf] + [inf] * 3,
+        "u_lb": [0.0] * 4, "u_ub": [2.5] * 4,
+        "x_init": [0.0] * 12, "guess_end": None, "u_guess": [hover] * 4,
+    }
+
+
+PROBLEMS = {"cart_pole": cart_pole, "car": car, "quadrotor": quadrotor}
 
 
 def build(P):
@@ -82,11 +126,13 @@ def build(P):
         s = min(max(k * T / N / T, 0.0), 1.0)
         for i in range(nx):
             w.append(X[i, k]); lbw.append(P["x_lb"][i]); ubw.append(P["x_ub"][i])
-            a, e = P["x_init"][i], P["guess_end"][i]
+            # symnlp's guess: linear from the start to guess_end, else 0.
+            a, e = (P["x_init"][i], P["guess_end"][i]) if P["guess_end"] else (0.0, 0.0)
             w0.append(a + s * (e - a))
     for k in range(N):
         for j in range(nu):
-            w.append(U[j, k]); lbw.append(P["u_lb"][j]); ubw.append(P["u_ub"][j]); w0.append(0.0)
+            w.append(U[j, k]); lbw.append(P["u_lb"][j]); ubw.append(P["u_ub"][j])
+            w0.append(P.get("u_guess", [0.0] * nu)[j])
     nlp = {"x": ca.vertcat(*w), "f": J, "g": ca.vertcat(*g), "p": p}
     # The plant: one RK4 step of the dynamics.
     xs, us = ca.SX.sym("x", nx), ca.SX.sym("u", nu)
