@@ -14,6 +14,11 @@
 //! start).
 use std::time::Instant;
 
+/// The guide `docs/mpc.md`, compiled and run as doc tests so that its examples stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/mpc.md")]
+pub struct MpcGuide;
+
 use thiserror::Error;
 
 use crate::compiled::Compiled;
