@@ -3,7 +3,11 @@
 //! the closed loops against CasADi 3.8.2 + IPOPT 3.14 on the identical transcription
 //! (`python3 benches/reference/mpc_casadi.py cart_pole,car,quadrotor ipopt`, run 2026-11-27 on this
 //! machine; output recorded in `benches/reference/results/mpc_casadi.jsonl`).
-#![allow(dead_code)] // the examples' `main`s are not called here
+#![allow(dead_code)]
+// the examples' `main`s are not called here
+// Each example is a program of its own that includes examples/mpc_common; included here
+// together, that file is loaded once per example.
+#![allow(clippy::duplicate_mod)]
 
 #[path = "../examples/mpc_cart_pole.rs"]
 mod mpc_cart_pole;
