@@ -15,17 +15,20 @@ const M_POLE: f64 = 0.3;
 const LENGTH: f64 = 0.5;
 const GRAVITY: f64 = 9.81;
 
+/// `ẋ` for `x = [cart position, angle (0 hanging), cart speed, angular rate]`, `u` = force.
+pub fn dynamics(x: &Matrix, u: &Matrix) -> Matrix {
+    let (s, c) = (x[1].sin(), x[1].cos());
+    let (l, m1, m2, g) = (LENGTH, M_CART, M_POLE, GRAVITY);
+    let ddq1 = (l * m2 * s * x[3].sq() + u[0] + m2 * g * c * s) / (m1 + m2 * (1.0 - c.sq()));
+    let ddq2 = -(l * m2 * c * s * x[3].sq() + u[0] * c + (m1 + m2) * g * s)
+        / (l * m1 + l * m2 * (1.0 - c.sq()));
+    Matrix::from_vec(vec![x[2], x[3], ddq1, ddq2])
+}
+
 /// The optimal control problem (no transcription yet).
 pub fn problem() -> Result<Ocp, Box<dyn std::error::Error>> {
     let mut ocp = Ocp::new(&["q1", "q2", "dq1", "dq2"], &["force"]);
-    ocp.set_dynamics(|x, u, _p| {
-        let (s, c) = (x[1].sin(), x[1].cos());
-        let (l, m1, m2, g) = (LENGTH, M_CART, M_POLE, GRAVITY);
-        let ddq1 = (l * m2 * s * x[3].sq() + u[0] + m2 * g * c * s) / (m1 + m2 * (1.0 - c.sq()));
-        let ddq2 = -(l * m2 * c * s * x[3].sq() + u[0] * c + (m1 + m2) * g * s)
-            / (l * m1 + l * m2 * (1.0 - c.sq()));
-        Matrix::from_vec(vec![x[2], x[3], ddq1, ddq2])
-    });
+    ocp.set_dynamics(|x, u, _p| dynamics(x, u));
     ocp.set_stage_cost(|_x, u, _p| u[0].sq());
     ocp.set_horizon(Horizon::Fixed(2.0))?;
     let inf = f64::INFINITY;

@@ -27,7 +27,7 @@ const GRAVITY: f64 = 9.81;
 pub const HOVER: f64 = MASS * GRAVITY / 4.0;
 
 /// `ẋ` for `x = [position, velocity, (roll, pitch, yaw), body rates]`, `u` = rotor thrusts.
-fn dynamics(x: &Matrix, u: &Matrix) -> Matrix {
+pub fn dynamics(x: &Matrix, u: &Matrix) -> Matrix {
     let (phi, th, psi) = (x[6], x[7], x[8]);
     let (wx, wy, wz) = (x[9], x[10], x[11]);
     let f: Expr = u.sum();

@@ -11,6 +11,7 @@ pub mod ipm;
 pub(crate) mod kkt;
 pub(crate) mod lbfgs;
 pub(crate) mod log;
+pub mod mpc;
 pub mod mpcc;
 pub mod numeric;
 pub mod ocp;
@@ -37,6 +38,7 @@ pub use parameter::ParameterKey;
 pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};
 
 pub use log::{format_summary, format_table};
+pub use mpc::{ClosedLoop, Mpc, MpcError, StepReport};
 pub use mpcc::{
     solve_mpcc, solve_mpcc_with_callback, MpccBackend, MpccError, MpccOptions, MpccPhase,
     MpccSolution,

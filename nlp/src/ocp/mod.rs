@@ -15,11 +15,15 @@
 //! it once per interval ([`Method::multiple_shooting_with_calls`]).
 mod butcher;
 mod collocation;
+mod shift;
+mod simulator;
 mod trajectory;
 mod transcription;
 
 pub use butcher::ButcherTableau;
 pub use collocation::{Collocation, CollocationPoints};
+pub use shift::Shift;
+pub use simulator::Simulator;
 pub use trajectory::{CollocationStates, Trajectory};
 pub use transcription::{Method, Transcription};
 
@@ -202,6 +206,8 @@ pub struct Ocp {
     pub(crate) state_bounds: (Vec<f64>, Vec<f64>),
     pub(crate) control_bounds: (Vec<f64>, Vec<f64>),
     pub(crate) initial_state: Option<Vec<f64>>,
+    /// The parameter that `x(0)` equals ([`Ocp::set_initial_state_parameter`]).
+    pub(crate) initial_state_parameter: Option<String>,
     pub(crate) final_state: Option<Vec<f64>>,
     pub(crate) state_guess: Option<GuessFn>,
     pub(crate) control_guess: Option<GuessFn>,
@@ -225,6 +231,7 @@ impl Ocp {
             state_bounds: (vec![f64::NEG_INFINITY; nx], vec![f64::INFINITY; nx]),
             control_bounds: (vec![f64::NEG_INFINITY; nu], vec![f64::INFINITY; nu]),
             initial_state: None,
+            initial_state_parameter: None,
             final_state: None,
             state_guess: None,
             control_guess: None,
@@ -401,9 +408,57 @@ impl Ocp {
         Ok(())
     }
 
-    /// Fixes `x(0)`.
+    /// Fixes `x(0)` to constant values. Exclusive with
+    /// [`Ocp::set_initial_state_parameter`] (an error names the conflict).
     pub fn set_initial_state(&mut self, x0: &[f64]) -> Result<(), OcpError> {
+        if let Some(name) = &self.initial_state_parameter {
+            return Err(OcpError::Invalid {
+                what: "initial state".into(),
+                why: format!("already the parameter '{name}' (set_initial_state_parameter)"),
+            });
+        }
         self.initial_state = Some(check_values("initial state", self.nx(), x0)?);
+        Ok(())
+    }
+
+    /// Makes the initial state a parameter: declares the parameter `name` (`nx` entries,
+    /// value `x0`, see [`Ocp::add_parameter`]) and the constraint rows `x(0) = name`
+    /// (group `initial state`, as many rows as states). Between solves the measured state
+    /// is set with `compiled.set_value(name, x)` without recompiling — the form model
+    /// predictive control needs ([`crate::mpc::Mpc`]). Exclusive with
+    /// [`Ocp::set_initial_state`].
+    ///
+    /// ```
+    /// use nlp::ocp::{ButcherTableau, Method, Ocp};
+    /// use nlp::Ipm;
+    /// use symx::Matrix;
+    /// let mut ocp = Ocp::new(&["x"], &["u"]);
+    /// ocp.set_dynamics(|x, u, _p| Matrix::from_vec(vec![-x[0] + u[0]]));
+    /// ocp.set_stage_cost(|x, u, _p| x[0].sq() + u[0].sq());
+    /// ocp.set_initial_state_parameter("x0", &[1.0]).unwrap();
+    /// let tr = ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 10).unwrap();
+    /// assert_eq!(tr.initial_state_parameter(), Some("x0"));
+    /// let mut compiled = tr.compile().unwrap();
+    /// compiled.set_value("x0", &[0.5]).unwrap(); // a new measurement, no recompilation
+    /// let sol = Ipm::default().solve(&mut compiled).unwrap();
+    /// assert!((tr.trajectory(&sol).unwrap().states[0][0] - 0.5).abs() < 1e-8);
+    /// ```
+    pub fn set_initial_state_parameter(&mut self, name: &str, x0: &[f64]) -> Result<(), OcpError> {
+        if self.initial_state.is_some() {
+            return Err(OcpError::Invalid {
+                what: "initial state".into(),
+                why: "already fixed by set_initial_state".into(),
+            });
+        }
+        if let Some(old) = &self.initial_state_parameter {
+            return Err(OcpError::Invalid {
+                what: "initial state".into(),
+                why: format!("already the parameter '{old}'"),
+            });
+        }
+        let x0 = check_values("initial state parameter", self.nx(), x0)?;
+        self.add_parameter(name, &x0)?;
+        self.initial_state_parameter = Some(name.to_string());
         Ok(())
     }
 

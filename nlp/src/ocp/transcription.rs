@@ -73,6 +73,57 @@ pub struct Transcription {
     tau: Vec<f64>,
     state_names: Vec<String>,
     control_names: Vec<String>,
+    initial_state_parameter: Option<String>,
+    /// The constraint groups written once per stage, in raw rows (before simple-bound
+    /// detection), for [`Transcription::shift_plan`].
+    staged_rows: Vec<StagedRows>,
+}
+
+/// A constraint group written once per stage: `stages` consecutive runs of `per_stage`
+/// raw rows (rows as added, before simple-bound detection) from `start`.
+#[derive(Clone, Debug)]
+pub(crate) struct StagedRows {
+    pub(crate) name: String,
+    pub(crate) start: usize,
+    pub(crate) stages: usize,
+    pub(crate) per_stage: usize,
+}
+
+/// Counts the raw rows added to the problem and records the per-stage groups.
+#[derive(Default)]
+struct RowLog {
+    count: usize,
+    staged: Vec<StagedRows>,
+}
+
+impl RowLog {
+    /// Adds `c` as the group `name`; `stages`: the number of stages it repeats over.
+    fn add(
+        &mut self,
+        pb: &mut Problem,
+        name: &str,
+        c: Constraint,
+        stages: Option<usize>,
+    ) -> Result<(), OcpError> {
+        let len = c.len();
+        pb.subject_to_named(name, c)?;
+        if let (Some(stages), true) = (stages, len > 0) {
+            if len % stages != 0 {
+                return Err(OcpError::Invalid {
+                    what: format!("constraint '{name}'"),
+                    why: format!("{len} rows do not split into {stages} equal stages"),
+                });
+            }
+            self.staged.push(StagedRows {
+                name: name.to_string(),
+                start: self.count,
+                stages,
+                per_stage: len / stages,
+            });
+        }
+        self.count += len;
+        Ok(())
+    }
 }
 
 const RESERVED: [&str; 4] = ["X", "U", "T", "Xc"];
@@ -115,6 +166,7 @@ impl Ocp {
             }
         };
         let mut p_all = Vec::new();
+        let mut x0_parameter = None;
         for (name, values) in &self.parameters {
             if RESERVED.contains(&name.as_str()) {
                 return Err(OcpError::Invalid {
@@ -124,6 +176,9 @@ impl Ocp {
             }
             let p = pb.parameter(name, values.len())?;
             pb.set_value(&p, values)?;
+            if self.initial_state_parameter.as_deref() == Some(name.as_str()) {
+                x0_parameter = Some(p.clone());
+            }
             p_all.extend_from_slice(&p);
         }
         let p = Matrix::from_vec(p_all);
@@ -145,11 +200,17 @@ impl Ocp {
             let (lo, hi) = (self.control_bounds.0[j], self.control_bounds.1[j]);
             pb.set_bounds(&u.row(j)?, lo, hi)?;
         }
+        let mut log = RowLog::default();
         if let Some(x0) = &self.initial_state {
-            pb.subject_to_named("initial state", col(&x, 0)?.eq(&Matrix::from_f64(x0)))?;
+            let c = col(&x, 0)?.eq(&Matrix::from_f64(x0));
+            log.add(&mut pb, "initial state", c, None)?;
+        }
+        if let Some(p0) = &x0_parameter {
+            log.add(&mut pb, "initial state", col(&x, 0)?.eq(p0), None)?;
         }
         if let Some(xf) = &self.final_state {
-            pb.subject_to_named("final state", col(&x, n)?.eq(&Matrix::from_f64(xf)))?;
+            let c = col(&x, n)?.eq(&Matrix::from_f64(xf));
+            log.add(&mut pb, "final state", c, None)?;
         }
         let h = t_f / n as f64;
         let stage = Stage {
@@ -165,12 +226,12 @@ impl Ocp {
                 steps,
                 step_calls,
             } => (
-                stage.shooting(&mut pb, tableau, *steps, *step_calls)?,
+                stage.shooting(&mut pb, &mut log, tableau, *steps, *step_calls)?,
                 None,
                 vec![0.0],
             ),
             Method::Collocation(c) => {
-                let (cost, xc) = stage.collocation(&mut pb, c)?;
+                let (cost, xc) = stage.collocation(&mut pb, &mut log, c)?;
                 (cost, Some(xc), c.tau.clone())
             }
         };
@@ -178,10 +239,10 @@ impl Ocp {
             let rows = (0..=n)
                 .map(|k| Ok(c(&col(&x, k)?, &col(&u, k.min(n - 1))?, &p)))
                 .collect::<Result<Vec<_>, OcpError>>()?;
-            pb.subject_to_named(name, Constraint::all(rows))?;
+            log.add(&mut pb, name, Constraint::all(rows), Some(n + 1))?;
         }
         for (name, b) in &self.boundary {
-            pb.subject_to_named(name, b(&col(&x, 0)?, &col(&x, n)?, &p, t_f))?;
+            log.add(&mut pb, name, b(&col(&x, 0)?, &col(&x, n)?, &p, t_f), None)?;
         }
         if let Some(phi) = &self.terminal_cost {
             cost += phi(&col(&x, n)?, &p, t_f);
@@ -197,6 +258,8 @@ impl Ocp {
             tau,
             state_names: self.states.clone(),
             control_names: self.controls.clone(),
+            initial_state_parameter: self.initial_state_parameter.clone(),
+            staged_rows: log.staged,
         };
         self.apply_guess(tr)
     }
@@ -267,6 +330,7 @@ impl Stage<'_> {
     fn shooting(
         &self,
         pb: &mut Problem,
+        log: &mut RowLog,
         tableau: &ButcherTableau,
         steps: usize,
         step_calls: bool,
@@ -294,7 +358,7 @@ impl Stage<'_> {
             }
             gaps.push(self.x.column(k + 1)?.eq(&x_end));
         }
-        pb.subject_to_named("continuity", Constraint::all(gaps))?;
+        log.add(pb, "continuity", Constraint::all(gaps), Some(n))?;
         Ok(cost)
     }
 
@@ -362,7 +426,12 @@ impl Stage<'_> {
 
     /// Collocation and continuity constraints; returns the Lagrange cost by quadrature
     /// and the collocation-state variables.
-    fn collocation(&self, pb: &mut Problem, c: &Collocation) -> Result<(Expr, Matrix), OcpError> {
+    fn collocation(
+        &self,
+        pb: &mut Problem,
+        log: &mut RowLog,
+        c: &Collocation,
+    ) -> Result<(Expr, Matrix), OcpError> {
         let (nx, n, d) = (self.ocp.nx(), self.u.ncols(), c.degree());
         let xc = pb.variable_matrix("Xc", nx, n * d)?;
         for i in 0..nx {
@@ -395,8 +464,8 @@ impl Stage<'_> {
             }
             gaps.push(self.x.column(k + 1)?.eq(&x_end));
         }
-        pb.subject_to_named("collocation", Constraint::all(colloc))?;
-        pb.subject_to_named("continuity", Constraint::all(gaps))?;
+        log.add(pb, "collocation", Constraint::all(colloc), Some(n))?;
+        log.add(pb, "continuity", Constraint::all(gaps), Some(n))?;
         Ok((cost, xc))
     }
 }
@@ -435,6 +504,22 @@ impl Transcription {
     /// The final time: the variable `T` or the fixed value as a constant.
     pub fn final_time(&self) -> Expr {
         self.final_time
+    }
+
+    /// The name of the parameter that `x(0)` equals, if the OCP declared one
+    /// ([`Ocp::set_initial_state_parameter`]).
+    pub fn initial_state_parameter(&self) -> Option<&str> {
+        self.initial_state_parameter.as_deref()
+    }
+
+    /// The collocation states `Xc` (`nx × N·d`, stage `k`'s `d` columns from `k·d`), for
+    /// collocation methods.
+    pub fn collocation_states(&self) -> Option<&Matrix> {
+        self.collocation_states.as_ref()
+    }
+
+    pub(crate) fn staged_rows(&self) -> &[StagedRows] {
+        &self.staged_rows
     }
 
     /// Reads a solution of the compiled problem as a trajectory.

@@ -1,0 +1,51 @@
+//! One warm interior-point re-solve of the cart-pole MPC (examples/mpc_cart_pole.rs,
+//! N = 40, 204 variables, 164 rows) after 50 closed-loop steps: the plan shifted and
+//! re-solved warm from the new state — the work of a typical step of the loop.
+//!
+//! ```text
+//! cargo bench --bench mpc
+//! ```
+#![allow(dead_code)] // the example's `main` is not called here
+
+#[path = "../examples/mpc_cart_pole.rs"]
+mod mpc_cart_pole;
+
+use std::hint::black_box;
+
+use criterion::Criterion;
+use nlp::mpc::Mpc;
+use nlp::Ipm;
+
+/// Closed-loop steps taken before the benchmarked re-solve (mid swing-up stabilisation,
+/// where a warm step takes 2–3 iterations as most of the loop's steps do).
+const STEPS_BEFORE: usize = 50;
+
+fn warm_resolve(c: &mut Criterion) {
+    let example = mpc_cart_pole::example();
+    let (tr, mut plant) = example.setup().expect("cart-pole MPC transcription");
+    let mut mpc = Mpc::new(&tr, Box::new(Ipm::default())).expect("MPC");
+    let mut x = example.x_init.clone();
+    for _ in 0..STEPS_BEFORE {
+        assert!(mpc.step(&x).expect("step").status.is_success());
+        x = plant.step(&x, mpc.control(), example.dt).expect("plant");
+    }
+    let shifted = tr.shift(mpc.solution().expect("solved")).expect("shift");
+    let compiled = mpc.compiled_mut();
+    compiled.set_value("x0", &x).expect("x0 parameter");
+    let ipm = Ipm::default();
+    let warm = ipm.solve_warm(compiled, &shifted).expect("warm solve");
+    assert!(warm.status.is_success(), "warm solve: {}", warm.status);
+    eprintln!(
+        "warm re-solve at step {STEPS_BEFORE}: {} iterations",
+        warm.stats.iterations
+    );
+    c.bench_function("mpc_cart_pole_ipm_warm_resolve", |b| {
+        b.iter(|| black_box(ipm.solve_warm(compiled, &shifted).expect("warm solve")))
+    });
+}
+
+fn main() {
+    let mut c = Criterion::default().configure_from_args();
+    warm_resolve(&mut c);
+    c.final_summary();
+}

@@ -1,0 +1,116 @@
+//! What the MPC examples share: a closed loop of an OCP whose initial state is the
+//! parameter `x0`, on the nominal plant (the transcription's RK4 step), with its cost
+//! `dt Σ_s l(x_s, u_s)` and a command line `[ipm|sqp] [--json]`.
+use symnlp::nlp::mpc::{ClosedLoop, Mpc};
+use symnlp::nlp::ocp::{ButcherTableau, Method, Ocp, Simulator, Transcription};
+use symnlp::nlp::{Ipm, Solver, Sqp};
+use symnlp::symx::{Expr, Function, Matrix};
+
+/// One MPC example: the OCP (initial state the parameter `x0`), its grid and loop.
+pub struct MpcExample {
+    /// Name printed in the summary.
+    pub name: &'static str,
+    /// Intervals of the horizon.
+    pub intervals: usize,
+    /// Sampling period = one interval (s).
+    pub dt: f64,
+    /// Closed-loop steps.
+    pub steps: usize,
+    /// The plant's initial state.
+    pub x_init: Vec<f64>,
+    /// The stage cost `l(x, u)` (also in the OCP), for the closed-loop cost.
+    pub stage_cost: fn(&Matrix, &Matrix) -> Expr,
+    /// The OCP.
+    pub ocp: fn() -> Result<Ocp, Box<dyn std::error::Error>>,
+}
+
+impl MpcExample {
+    /// The transcription (RK4 multiple shooting, one step per interval) and the plant.
+    pub fn setup(&self) -> Result<(Transcription, Simulator), Box<dyn std::error::Error>> {
+        let ocp = (self.ocp)()?;
+        let tr = ocp.transcribe(
+            &Method::multiple_shooting(ButcherTableau::rk4(), 1),
+            self.intervals,
+        )?;
+        Ok((tr, Simulator::new(&ocp, ButcherTableau::rk4(), 1)?))
+    }
+
+    /// The closed loop with `solver`.
+    pub fn closed_loop(
+        &self,
+        solver: Box<dyn Solver>,
+    ) -> Result<ClosedLoop, Box<dyn std::error::Error>> {
+        let (tr, mut plant) = self.setup()?;
+        let mut mpc = Mpc::new(&tr, solver)?;
+        let dt = self.dt;
+        Ok(mpc.run(&self.x_init, self.steps, |x, u, next| {
+            plant.step_into(x, u, dt, next)
+        })?)
+    }
+
+    /// The closed loop's cost `dt Σ_s l(x_s, u_s)`.
+    pub fn cost(&self, run: &ClosedLoop) -> Result<f64, Box<dyn std::error::Error>> {
+        let nx = self.x_init.len();
+        let nu = run.controls.first().map_or(0, |u| u.len());
+        let (x, u) = (Matrix::sym_vec("x", nx), Matrix::sym_vec("u", nu));
+        let l = Function::new(&[&x, &u], &[&[(self.stage_cost)(&x, &u)]])?;
+        let mut total = 0.0;
+        for (x, u) in run.states.iter().zip(&run.controls) {
+            total += l.call(&[x, u])?[0][0];
+        }
+        Ok(self.dt * total)
+    }
+
+    /// `[ipm|sqp] [--json]`: runs the loop; prints the steps as CSV (or one JSON summary
+    /// line with `--json`) on stdout and a summary on stderr.
+    pub fn main(&self) -> Result<(), Box<dyn std::error::Error>> {
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        let solver: Box<dyn Solver> = if args.iter().any(|a| a == "sqp") {
+            Box::new(Sqp::default())
+        } else {
+            Box::new(Ipm::default())
+        };
+        let name = solver.name();
+        let run = self.closed_loop(solver)?;
+        let (median, max) = run.latency();
+        let (mean_it, max_it) = run.iterations();
+        let cost = self.cost(&run)?;
+        if args.iter().any(|a| a == "--json") {
+            let failed: Vec<usize> = (0..run.steps.len())
+                .filter(|&s| !run.steps[s].status.is_success())
+                .collect();
+            let summary = serde_json::json!({
+                "problem": self.name, "solver": name, "closed_loop_cost": cost,
+                "all_succeeded": run.all_succeeded(), "failed_steps": failed,
+                "median_ms": 1e3 * median, "max_ms": 1e3 * max,
+                "iterations_mean": mean_it, "iterations_max": max_it,
+                "final_state": run.states.last(),
+            });
+            println!("{summary}");
+        } else {
+            println!("step,status,iterations,ms,state...,control...");
+            for (s, r) in run.steps.iter().enumerate() {
+                let v: Vec<String> = run.states[s]
+                    .iter()
+                    .chain(&run.controls[s])
+                    .map(|v| format!("{v:.6}"))
+                    .collect();
+                println!(
+                    "{s},{},{},{:.3},{}",
+                    r.status,
+                    r.iterations,
+                    1e3 * r.seconds,
+                    v.join(",")
+                );
+            }
+        }
+        eprintln!(
+            "{} {name}: all succeeded {}, closed-loop cost {cost:.10}, latency median {:.3} ms max {:.3} ms, iterations mean {mean_it:.2} max {max_it}",
+            self.name,
+            run.all_succeeded(),
+            1e3 * median,
+            1e3 * max,
+        );
+        Ok(())
+    }
+}
