@@ -95,6 +95,9 @@ fn cart_pole_loop_every_sqp_step_succeeds_and_matches_ipm() {
 }
 
 struct Loop {
+    /// Σ over the steps of (evaluation, factorisation, QP solve, total) seconds
+    /// (`Stats`; the SQP's factorisation time includes its QP loop).
+    split: [f64; 4],
     statuses: Vec<Status>,
     iterations: Vec<usize>,
     seconds: Vec<f64>,
@@ -105,6 +108,7 @@ fn closed_loop(solver: &dyn Solver, steps: usize) -> Loop {
     let mut c = Controller::new(solver);
     let mut x = [0.0; NX];
     let mut out = Loop {
+        split: [0.0; 4],
         statuses: vec![],
         iterations: vec![],
         seconds: vec![],
@@ -115,6 +119,15 @@ fn closed_loop(solver: &dyn Solver, steps: usize) -> Loop {
         out.seconds.push(secs);
         out.statuses.push(sol.status);
         out.iterations.push(sol.stats.iterations);
+        let st = &sol.stats;
+        for (a, b) in out.split.iter_mut().zip([
+            st.eval_seconds,
+            st.factor_seconds,
+            st.qp_seconds,
+            st.total_seconds,
+        ]) {
+            *a += b;
+        }
         let u = sol.x[NX];
         out.cost += cart_pole::stage_cost(&x, u);
         x = cart_pole::plant(&x, u);
@@ -141,6 +154,16 @@ fn summary(name: &str, l: &Loop) {
         l.iterations.iter().max().unwrap(),
         l.cost,
         fails
+    );
+    let [e, _, q, t] = l.split;
+    let its = l.iterations.iter().sum::<usize>().max(1) as f64;
+    println!(
+        "  per iteration: {:.3} ms = evaluations {:.3} + QP solves {:.3} + the rest {:.3} \
+         (inertia factorisations, polish, line search; all of the IPM's linear algebra)",
+        t / its * 1e3,
+        e / its * 1e3,
+        q / its * 1e3,
+        (t - e - q).max(0.0) / its * 1e3
     );
 }
 
