@@ -61,13 +61,15 @@ pub(super) struct Convexify<'a> {
 
 impl Convexify<'_> {
     /// The (δ, ρ_a) found, or `None` when no shift up to `max_hessian_shift` works;
-    /// counts the factorisations in `n_fact`.
+    /// counts the factorisations in `n_fact`. δ is the shift the inertia asks for, no
+    /// more: the step control's proximal shift is the caller's, applied on top (mixing it
+    /// into `delta_last` made one cut step damp the next iterations through the δ/3
+    /// memory, see `SqpState::convexify`).
     pub fn run(
         self,
         o: &SqpOptions,
         delta_last: f64,
         rho_last: f64,
-        extra: f64,
         n_fact: &mut usize,
     ) -> Option<(f64, f64)> {
         let Convexify {
@@ -107,7 +109,6 @@ impl Convexify<'_> {
             } else {
                 (delta_last / 3.0).max(o.min_hessian_shift)
             };
-            delta = delta.max(extra);
             let grow = if delta_last == 0.0 { 100.0 } else { 8.0 };
             while delta <= o.max_hessian_shift {
                 if test(delta) {
@@ -117,11 +118,11 @@ impl Convexify<'_> {
             }
             None
         };
-        if extra == 0.0 && rho_last == 0.0 && test(0.0, 0.0) {
+        if rho_last == 0.0 && test(0.0, 0.0) {
             return Some((0.0, 0.0));
         }
         if !any_active {
-            return shift_search(&mut |d| test(d, 0.0), extra == 0.0).map(|d| (d, 0.0));
+            return shift_search(&mut |d| test(d, 0.0), true).map(|d| (d, 0.0));
         }
         // The cheapest guess first: the last iteration's weight (or a tenth of it).
         let rho0 = if rho_last > 0.0 {
@@ -129,7 +130,7 @@ impl Convexify<'_> {
         } else {
             1.0
         };
-        if extra == 0.0 && test(0.0, rho0) {
+        if test(0.0, rho0) {
             return Some((0.0, rho0));
         }
         // δ for the reduced Hessian: the test in the limit ρ_a = rho_max is IPOPT's
@@ -137,7 +138,7 @@ impl Convexify<'_> {
         // i.e. positive definiteness on the null space of the active constraints. A
         // shift of the full-space Hessian (ρ_a = 0) would also pay for curvature across
         // the constraints, which the augmented term supplies for free.
-        let delta = shift_search(&mut |d| test(d, rho_max), extra == 0.0)?;
+        let delta = shift_search(&mut |d| test(d, rho_max), true)?;
         // Then the smallest weight ρ_a (×10 from rho0) that makes B itself positive
         // definite; rho_max passed above.
         let mut rho = if delta == 0.0 { rho0 * 10.0 } else { rho0 };

@@ -373,15 +373,21 @@ impl<'a> SqpState<'a> {
             active_r: &active_r,
             active_b: &active_b,
         };
-        let (delta, rho_a) = conv
+        let (delta_inertia, rho_a) = conv
             .run(
                 self.o,
                 curv.delta_last,
                 curv.rho_a_last,
-                curv.extra_shift,
                 &mut self.work.n_fact,
             )
             .ok_or(StepError::NoConvexification)?;
+        // The proximal shift of the step control on top of the inertia's (B stays
+        // positive definite: adding δI to a positive definite B keeps it so). Only the
+        // inertia's shift is remembered for the next search: when the applied shift was
+        // remembered, one heavily cut step (shift 0.1) damped the following iterations
+        // through the δ_last/3 start of the search (0.1, 0.033, 0.011, ...) long after the
+        // step control had released it, and the cart-pole swing-up of issue 19 crawled
+        // through 324 iterations instead of 60.
         curv.rho_a_last = rho_a;
         for (w, &a) in curv.row_weight.iter_mut().zip(&active_r) {
             *w = if a { rho_a } else { 0.0 };
@@ -392,8 +398,8 @@ impl<'a> SqpState<'a> {
         if rho_a > 0.0 && !self.qp.has_aug() {
             self.qp = new_qp(&self.shape, geo, self.o, true);
         }
-        curv.delta_last = delta;
-        Ok(delta)
+        curv.delta_last = delta_inertia;
+        Ok(delta_inertia.max(curv.extra_shift))
     }
 
     /// After a failed line search: stops when the step is negligible or the searches keep
@@ -430,17 +436,16 @@ impl<'a> SqpState<'a> {
     pub fn accept(&mut self, trial: Trial, ls: &LineSearch) -> Result<(), StepError> {
         self.ls_failures = 0;
         // Levenberg–Marquardt-like safeguard: a heavily cut step means the model is
-        // poor at this length, so the next step is shortened by a proximal shift;
-        // full steps relax it again.
+        // poor at this length, so the next step is shortened by a proximal shift
+        // (×10 while the cuts go on); a full step releases it at once. A gradual release
+        // (÷10 per full step) kept the steps short for several iterations after a
+        // single cut; with the inertia's shift no longer inheriting it (`convexify`)
+        // that gradual release made hs116 fail, the immediate one solves it.
         let c = &mut self.curv;
         if ls.alpha < 0.1 && !ls.soc_used {
             c.extra_shift = (c.extra_shift * 10.0).max(1e-1);
         } else if ls.alpha == 1.0 {
-            c.extra_shift = if c.extra_shift > 1e-6 {
-                c.extra_shift / 10.0
-            } else {
-                0.0
-            };
+            c.extra_shift = 0.0;
         }
         let (it, shape, cone_row) = (&mut self.it, &self.shape, &self.geo.cone_row);
         let x_old = std::mem::replace(&mut it.x, trial.x);
