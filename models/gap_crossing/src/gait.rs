@@ -190,6 +190,20 @@ fn project_box_disc(
     ((y[0] - c[0]).hypot(y[1] - c[1]) <= radius + 1e-12).then_some(y)
 }
 
+/// Whether the feet of one stance satisfy (6)–(9).
+pub fn feet_distances_ok(s: &Scenario, feet: &Feet) -> bool {
+    let pairs = [
+        (Foot::BR, Foot::FR, s.same_side_sq),
+        (Foot::BL, Foot::FL, s.same_side_sq),
+        (Foot::BR, Foot::BL, s.same_biped_sq),
+        (Foot::FR, Foot::FL, s.same_biped_sq),
+    ];
+    pairs.iter().all(|&(a, b, bounds)| {
+        let d2 = dist2(feet.get(a), feet.get(b));
+        d2 >= bounds.min && d2 <= bounds.max
+    })
+}
+
 /// The crawl heuristic's footholds: `n_step` foot configurations, the first the start;
 /// at each transition only the scheduled foot ([`crawl_schedule`]) moves.
 pub fn crawl_footholds(s: &Scenario) -> Vec<Feet> {
@@ -212,8 +226,16 @@ pub fn footholds_for_schedule(s: &Scenario, schedule: &[Foot]) -> Vec<Feet> {
     let mut feet = s.start.feet;
     out.push(feet);
     for &foot in schedule {
-        let p = ground.landing(feet.get(foot), goals.get(foot));
-        *feet.get_mut(foot) = p;
+        let cur = feet.get(foot);
+        let p = ground.landing(cur, goals.get(foot));
+        // A landing that would break (6)–(9) with the other feet (feet converging on a
+        // region's corner when the goal lies diagonally past it) is not taken while
+        // the feet satisfy them: the foot stays, and moves at a later turn.
+        let mut next = feet;
+        *next.get_mut(foot) = p;
+        if feet_distances_ok(s, &next) || !feet_distances_ok(s, &feet) {
+            feet = next;
+        }
         out.push(feet);
     }
     out

@@ -234,10 +234,15 @@ fn settings(a: &SolverArgs, print_level: u8) -> Result<Settings, CliError> {
     Ok(settings)
 }
 
-/// [`solve`]; when it stops with an error, the files an earlier solve wrote in DIR are
-/// removed, so that no stale result is left looking like this run's.
+/// [`solve`]; when it stops with an error before writing (an invalid scenario, a
+/// planning error), the files an earlier solve wrote in DIR are removed, so that no
+/// stale result is left looking like this run's. A failed write itself leaves DIR as it
+/// was (all or nothing, [`output::write_all`]) and says so.
 fn solve_or_clear(a: &SolveArgs) -> Result<ExitCode, CliError> {
-    solve(a).inspect_err(|_| {
+    solve(a).inspect_err(|e| {
+        if matches!(e, CliError::Output(_)) {
+            return;
+        }
         let removed = output::remove_files(&a.out, &SOLVE_FILES);
         if !removed.is_empty() {
             eprintln!(

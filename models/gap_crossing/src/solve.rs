@@ -739,7 +739,7 @@ fn search_from(
         return Ok(out);
     }
     let search_settings = candidate.warm();
-    let mut stance_solver = StanceSolver::new(s, terrain)?;
+    let mut stance_solver = StanceSolver::with_settings(s, terrain, candidate)?;
     let mut best = from;
     for round in 1..=SEARCH_ROUNDS {
         let current = Plan::from_flat(s, &best.flat)?;

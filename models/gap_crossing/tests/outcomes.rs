@@ -69,3 +69,15 @@ fn bound_relaxation_is_within_the_checker_tolerance() {
         Settings::default().ipm.bound_relax_factor
     );
 }
+
+/// Stepping stones approached at 45° (`scenarios/stones-45.toml`, 120 stances): solved
+/// and checked in the crawl gait (the free gait solves it too, 9.167e5, but takes ~45 s
+/// on a loaded 2-core machine). At 80 stances it used to end `goal not reached` and at
+/// 160 `solver_failed`, from a guess whose feet piled into the start pad's corner.
+#[test]
+fn stepping_stones_at_45_degrees() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut s = Scenario::load(&dir.join("stones-45.toml")).unwrap();
+    s.gait = gap_crossing::scenario::Gait::Crawl;
+    solved(&s);
+}
