@@ -13,6 +13,7 @@
 //! rounding even at the steep gap edges (where h is not exactly 0).
 
 use crate::plan::{Plan, Stance};
+use crate::reach;
 use crate::scenario::{dist2, Biped, Coms, Feet, Foot, Scenario, Vec3};
 use crate::terrain::{self, Region, Terrain};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -62,8 +63,10 @@ pub fn foot_goals(s: &Scenario) -> Feet {
     g
 }
 
-/// How far below the step reach the guess's longest jump stays (m): a jump of
-/// `reach − JUMP_SLACK` leaves the solver a little room on (5).
+/// How far below the step reach the guess's longest jump stays at most (m): a jump of
+/// `reach − JUMP_SLACK` leaves the solver a little room on (5). When a crossable
+/// keep-out is wider than `reach − 2·JUMP_SLACK`, the jump stays half-way between its
+/// width and the reach instead (see `Ground::of`).
 pub const JUMP_SLACK: f64 = 1e-4;
 
 /// The landing rule's view of the terrain: its allowed regions, the jump length and the
@@ -79,16 +82,18 @@ impl Ground {
     fn of(s: &Scenario) -> Ground {
         let terrain = terrain::of(s);
         let regions = terrain.regions();
-        let jump = s.step_radius_sq.sqrt() - JUMP_SLACK;
-        // The widest distance between two regions that a jump can span: landings keep
+        let reach = s.step_radius_sq.sqrt();
+        // The widest distance between two regions that a step can span
+        // (`reach::within_reach`): the jump is long enough for it, and landings keep
         // [`GAP_CLEARANCE`] from region edges, less when that jump would not fit.
         let widest = regions
             .iter()
             .enumerate()
             .flat_map(|(a, ra)| regions[a + 1..].iter().map(move |rb| ra.distance(rb)))
-            .filter(|&d| d > 0.0 && d < jump)
+            .filter(|&d| d > 0.0 && reach::within_reach(d, reach))
             .fold(0.0, f64::max);
-        let clearance = GAP_CLEARANCE.min(((jump - widest) / 4.0).max(1e-7));
+        let jump = reach - JUMP_SLACK.min((reach - widest) / 2.0);
+        let clearance = GAP_CLEARANCE.min((jump - widest) / 4.0);
         Ground {
             terrain,
             regions,
@@ -185,6 +190,20 @@ fn project_box_disc(
     ((y[0] - c[0]).hypot(y[1] - c[1]) <= radius + 1e-12).then_some(y)
 }
 
+/// Whether the feet of one stance satisfy (6)–(9).
+pub fn feet_distances_ok(s: &Scenario, feet: &Feet) -> bool {
+    let pairs = [
+        (Foot::BR, Foot::FR, s.same_side_sq),
+        (Foot::BL, Foot::FL, s.same_side_sq),
+        (Foot::BR, Foot::BL, s.same_biped_sq),
+        (Foot::FR, Foot::FL, s.same_biped_sq),
+    ];
+    pairs.iter().all(|&(a, b, bounds)| {
+        let d2 = dist2(feet.get(a), feet.get(b));
+        d2 >= bounds.min && d2 <= bounds.max
+    })
+}
+
 /// The crawl heuristic's footholds: `n_step` foot configurations, the first the start;
 /// at each transition only the scheduled foot ([`crawl_schedule`]) moves.
 pub fn crawl_footholds(s: &Scenario) -> Vec<Feet> {
@@ -207,8 +226,16 @@ pub fn footholds_for_schedule(s: &Scenario, schedule: &[Foot]) -> Vec<Feet> {
     let mut feet = s.start.feet;
     out.push(feet);
     for &foot in schedule {
-        let p = ground.landing(feet.get(foot), goals.get(foot));
-        *feet.get_mut(foot) = p;
+        let cur = feet.get(foot);
+        let p = ground.landing(cur, goals.get(foot));
+        // A landing that would break (6)–(9) with the other feet (feet converging on a
+        // region's corner when the goal lies diagonally past it) is not taken while
+        // the feet satisfy them: the foot stays, and moves at a later turn.
+        let mut next = feet;
+        *next.get_mut(foot) = p;
+        if feet_distances_ok(s, &next) || !feet_distances_ok(s, &feet) {
+            feet = next;
+        }
         out.push(feet);
     }
     out

@@ -13,6 +13,7 @@
 //!   height map) as expressions and numbers, its allowed regions, and its scenario table;
 //! - [`crossing`]: the crossing search's candidates (which move of each foot first lands
 //!   beyond a gap), [`crossing_search`]: solving them, on the plan's walking horizon;
+//! - [`frame`]: the translation to the start's frame every plan is solved in;
 //! - [`reach`]: geometric certificates that a goal is unreachable;
 //! - [`status`]: the typed outcome of planning (solved, gap not crossable, goal not
 //!   reached, solver failed, check failed) and its exit code;
@@ -33,6 +34,7 @@ pub mod convergence;
 pub mod crossing;
 pub mod crossing_search;
 pub mod export;
+pub mod frame;
 pub mod gait;
 pub mod limits;
 pub mod model;

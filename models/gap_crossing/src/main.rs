@@ -90,6 +90,10 @@ struct CheckArgs {
     /// reaches the goals in n_step stances); `required`; `skip`.
     #[arg(long, value_enum, default_value_t = GoalArg::Auto)]
     goal: GoalArg,
+    /// Check the plan against this scenario file (.toml or .json) instead of the
+    /// solution file's own `scenario` block (which may then be absent).
+    #[arg(long, value_name = "FILE")]
+    scenario: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -230,6 +234,35 @@ fn settings(a: &SolverArgs, print_level: u8) -> Result<Settings, CliError> {
     Ok(settings)
 }
 
+/// [`solve`]; when it stops with an error before writing (an invalid scenario, a
+/// planning error), the files an earlier solve wrote in DIR are removed, so that no
+/// stale result is left looking like this run's. A failed write itself leaves DIR as it
+/// was (all or nothing, [`output::write_all`]) and says so.
+fn solve_or_clear(a: &SolveArgs) -> Result<ExitCode, CliError> {
+    solve(a).inspect_err(|e| {
+        if matches!(e, CliError::Output(_)) {
+            return;
+        }
+        let removed = output::remove_files(&a.out, &SOLVE_FILES);
+        if !removed.is_empty() {
+            eprintln!(
+                "removed the earlier results in {}: {}",
+                a.out.display(),
+                removed.join(", ")
+            );
+        }
+    })
+}
+
+/// The files `solve` writes.
+const SOLVE_FILES: [&str; 5] = [
+    "solution.json",
+    "convergence.json",
+    "plan.svg",
+    "convergence.svg",
+    "plan.html",
+];
+
 fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let s = scenario(&a.scenario)?;
     let settings = settings(&a.solver, 5)?;
@@ -240,19 +273,6 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     // Convergence history of all solver runs, numbered on, with the residual of (10) at
     // every iterate (recorded by the solvers' iteration callback).
     let history = Convergence::from_phases(&outcome.phases);
-    if !outcome.status.is_solved() {
-        // Nothing partial is left as if it were a result.
-        let kind = outcome.status.kind();
-        eprintln!(
-            "error: no valid plan: status {kind} (exit code {}): {}",
-            kind.exit_code(),
-            outcome.status
-        );
-        if !report.ok() {
-            eprintln!("checker: {report}");
-        }
-        return Ok(ExitCode::from(kind.exit_code()));
-    }
     let title = format!(
         "Convergence: {} gait, {} iterations",
         s.gait, file.solver.iterations
@@ -262,6 +282,8 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let plan_svg = render::plan_svg(file);
     let conv_svg = render::convergence_svg(&history, &title);
     let plan_html = render::plan_html(file, &html_title(file));
+    // A plan that is not solved is written too, so that no older result stays in DIR:
+    // its solution.json says why (`solver.status`, `solver.reason`).
     output::write_all(
         &a.out,
         &[
@@ -272,6 +294,24 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
             ("plan.html", plan_html.as_bytes()),
         ],
     )?;
+    if !outcome.status.is_solved() {
+        let kind = outcome.status.kind();
+        eprintln!(
+            "error: no valid plan: status {kind} (exit code {}): {}",
+            kind.exit_code(),
+            outcome.status
+        );
+        // A certificate decided before solving: the file holds the guess, whose
+        // violations say nothing more.
+        if !report.ok() && !kind.is_proved_impossible() {
+            eprintln!("checker: {report}");
+        }
+        eprintln!(
+            "wrote {}/solution.json with status {kind} (not a valid plan) and its drawings",
+            a.out.display()
+        );
+        return Ok(ExitCode::from(kind.exit_code()));
+    }
 
     let moves = gap_crossing::plan::Plan::from_flat(&s, &file.plan().to_flat())
         .map(|p| foot_moves(&p))
@@ -447,7 +487,8 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
 }
 
 fn check_cmd(a: &CheckArgs) -> Result<ExitCode, CliError> {
-    let file = SolutionFile::read(&a.file)?;
+    let scenario = a.scenario.as_deref().map(Scenario::load).transpose()?;
+    let file = SolutionFile::read_with_scenario(&a.file, scenario.as_ref())?;
     file.scenario
         .validate()
         .map_err(|source| CliError::FileScenario {
@@ -546,6 +587,7 @@ fn guess_cmd(a: &GuessArgs) -> Result<ExitCode, CliError> {
         objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
+        reason: None,
     };
     let mut file = SolutionFile::new(s, info, plan);
     // A guess has no solver measure of infeasibility: record the checker's largest
@@ -574,8 +616,8 @@ fn guess_cmd(a: &GuessArgs) -> Result<ExitCode, CliError> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        None => solve(&cli.solve),
-        Some(Command::Solve(a)) => solve(a),
+        None => solve_or_clear(&cli.solve),
+        Some(Command::Solve(a)) => solve_or_clear(a),
         Some(Command::Check(a)) => check_cmd(a),
         Some(Command::Render(a)) => render_cmd(a),
         Some(Command::Sweep(a)) => sweep(a),

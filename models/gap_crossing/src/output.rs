@@ -45,6 +45,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     })
 }
 
+/// Removes the regular files `names` from `dir` where they exist; returns the names
+/// removed (a file that cannot be removed is left, and not listed).
+pub fn remove_files<'a>(dir: &Path, names: &[&'a str]) -> Vec<&'a str> {
+    names
+        .iter()
+        .copied()
+        .filter(|n| {
+            let p = dir.join(n);
+            std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file())
+                && std::fs::remove_file(&p).is_ok()
+        })
+        .collect()
+}
+
 /// Writes `files` (name, content) into `dir` (created if missing), all or nothing (see
 /// the module docs). Returns the paths written, in order.
 pub fn write_all(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, OutputError> {

@@ -91,6 +91,11 @@ pub struct SolverInfo {
     /// Wall time of the solve (s).
     #[serde(deserialize_with = "nullable_f64")]
     pub solve_seconds: f64,
+    /// Why the plan is not `solved`, in numbers (a certificate that no plan exists, how
+    /// far the plan ends from its goal, the solver's failure, the checker's findings);
+    /// absent for a solved plan.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 impl Default for SolverInfo {
@@ -103,6 +108,7 @@ impl Default for SolverInfo {
             objective_without_10: None,
             max_constraint_violation: f64::NAN,
             solve_seconds: f64::NAN,
+            reason: None,
         }
     }
 }
@@ -215,7 +221,7 @@ pub struct SolutionFile {
     #[serde(deserialize_with = "scenario_with_defaults")]
     pub scenario: Scenario,
     /// The solver's report (optional on reading, see [`SolverInfo`]).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "lenient_solver")]
     pub solver: SolverInfo,
     /// Stances 1..n_step.
     pub stances: Vec<Stance>,
@@ -224,6 +230,34 @@ pub struct SolutionFile {
 fn scenario_with_defaults<'de, D: Deserializer<'de>>(d: D) -> Result<Scenario, D::Error> {
     let v = serde_json::Value::deserialize(d)?;
     Scenario::from_value(v).map_err(serde::de::Error::custom)
+}
+
+/// The `solver` block as far as it reads: the checker does not use it, so a field of
+/// another type than [`SolverInfo`]'s (`"iterations": "many"`) or a block that is not a
+/// table is read as unknown (the field's default) instead of rejecting the plan.
+fn lenient_solver<'de, D: Deserializer<'de>>(d: D) -> Result<SolverInfo, D::Error> {
+    let v = serde_json::Value::deserialize(d)?;
+    let mut info = SolverInfo::default();
+    let Some(t) = v.as_object() else {
+        return Ok(info);
+    };
+    let text = |k: &str| t.get(k).and_then(|v| v.as_str()).map(str::to_string);
+    let number = |k: &str| t.get(k).and_then(serde_json::Value::as_f64);
+    if let Some(v) = text("name") {
+        info.name = v;
+    }
+    if let Some(v) = text("status") {
+        info.status = v;
+    }
+    if let Some(v) = t.get("iterations").and_then(serde_json::Value::as_u64) {
+        info.iterations = v as usize;
+    }
+    info.objective = number("objective").unwrap_or(f64::NAN);
+    info.objective_without_10 = number("objective_without_10");
+    info.max_constraint_violation = number("max_constraint_violation").unwrap_or(f64::NAN);
+    info.solve_seconds = number("solve_seconds").unwrap_or(f64::NAN);
+    info.reason = text("reason");
+    Ok(info)
 }
 
 impl SolutionFile {
@@ -262,11 +296,36 @@ impl SolutionFile {
 
     /// Reads a solution file.
     pub fn read(path: &Path) -> Result<SolutionFile, PlanError> {
+        SolutionFile::read_with_scenario(path, None)
+    }
+
+    /// Reads a solution file; with `scenario`, the plan is read against that scenario
+    /// instead of the file's own `scenario` block (which may then be absent), e.g. to
+    /// check a plan written by another tool against a separate scenario file.
+    pub fn read_with_scenario(
+        path: &Path,
+        scenario: Option<&Scenario>,
+    ) -> Result<SolutionFile, PlanError> {
         let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        SolutionFile::from_json(&text, path)
+        let Some(s) = scenario else {
+            return SolutionFile::from_json(&text, path);
+        };
+        let format = |message: String| PlanError::Format {
+            path: path.to_path_buf(),
+            message,
+        };
+        let mut v = crate::strict_json::parse(&text).map_err(|e| format(e.to_string()))?;
+        let Some(t) = v.as_object_mut() else {
+            return Err(format("expected a JSON object".into()));
+        };
+        t.insert(
+            "scenario".into(),
+            serde_json::to_value(s).expect("a scenario serialises"),
+        );
+        serde_json::from_value(v).map_err(|e| format(e.to_string()))
     }
 
     /// Pretty JSON text of this file.

@@ -29,8 +29,22 @@
 //! instead of 33.
 use crate::check::GOAL_TOL;
 use crate::scenario::{Foot, Scenario};
-use crate::terrain::{self, Region};
+use crate::terrain::{self, Region, Terrain};
 use std::fmt;
+
+/// Tolerance (m) on comparing a distance between allowed regions with the step reach: a
+/// keep-out narrower than `reach − WIDTH_TOL` is crossable, one wider is not. Widths
+/// are differences of coordinates, so a keep-out typed as exactly the reach (e.g. a gap
+/// 2.5–2.74 with 0.03 m margins, 0.2999999999999998 m in binary) must count as the
+/// reach itself; 1e-9 m is far above the round-off of such differences for
+/// coordinates up to 1e5 m (≈ 1e-11 m) and far below the checker's 1e-6 tolerance.
+pub const WIDTH_TOL: f64 = 1e-9;
+
+/// Whether two regions `distance` apart (m) can be stepped between with reach `reach`
+/// (the comparison of [`WIDTH_TOL`]).
+pub fn within_reach(distance: f64, reach: f64) -> bool {
+    distance < reach - WIDTH_TOL
+}
 
 /// Proof that a foot cannot reach its goal: the regions it can reach and the step
 /// needed to leave them.
@@ -61,7 +75,7 @@ impl fmt::Display for Uncrossable {
         if let Some(d) = self.shortest_exit {
             write!(
                 f,
-                "; the next region is {d:.4} m away, not less than the step reach {:.4} m",
+                "; the next region is {d:.4} m away (3-D, rises and drops included), not less than the step reach {:.4} m",
                 self.reach
             )?;
         }
@@ -90,6 +104,52 @@ impl fmt::Display for Unreachable {
             self.needed, self.moves[0], self.moves[1], self.moves[2], self.moves[3]
         )
     }
+}
+
+/// Proof that the normal-force threshold F_thr of (4) cannot be met: every foot pushes
+/// with a normal force of at least F_thr, which holds the body up with at least
+/// `4·F_thr·(cos θ − μ sin θ)` (θ the steepest ground slope a foot may stand on, the
+/// tangential force at most μ times the normal one), more than the weight (2) allows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForceThreshold {
+    /// F_thr (N).
+    pub f_thr: f64,
+    /// The friction coefficient μ.
+    pub mu: f64,
+    /// Bound on the ground slope tan θ where feet may stand.
+    pub slope: f64,
+    /// The least total vertical force the four feet exert, `4·(F_thr − TOL)·(cos θ −
+    /// μ sin θ)` (N; the checker's tolerance [`crate::check::TOL`] granted per foot).
+    pub least_vertical: f64,
+    /// The weight (m1 + m2)·g (N).
+    pub weight: f64,
+}
+
+impl fmt::Display for ForceThreshold {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "each of the 4 feet must push with a normal force of at least F_thr = {} N; with ground slopes up to {:.3e} and μ = {} they hold the body up with at least {:.4} N, more than its weight (m1 + m2)·g = {:.4} N",
+            self.f_thr, self.slope, self.mu, self.least_vertical, self.weight
+        )
+    }
+}
+
+/// The [`ForceThreshold`] certificate, or `None` when F_thr can be met as far as this
+/// test sees (or the terrain bounds no slope).
+pub fn force_threshold(s: &Scenario, terrain: &dyn Terrain) -> Option<ForceThreshold> {
+    let slope = terrain.slope_bound()?;
+    // cos θ − μ sin θ with tan θ = slope, decreasing in θ.
+    let c = (1.0 - s.friction.mu * slope) / slope.hypot(1.0);
+    let least_vertical = 4.0 * (s.friction.f_thr - crate::check::TOL) * c;
+    let weight = s.masses.total() * s.gravity;
+    (c > 0.0 && least_vertical > weight).then_some(ForceThreshold {
+        f_thr: s.friction.f_thr,
+        mu: s.friction.mu,
+        slope,
+        least_vertical,
+        weight,
+    })
 }
 
 /// `ρ`: how close to its goal CoM each foot must end (m).
@@ -132,9 +192,21 @@ pub fn stances_needed(s: &Scenario) -> Unreachable {
     }
 }
 
+/// The shortest 3-D distance between points standing on regions `a` and `b`, as far as
+/// the terrain tells: their horizontal distance and, when the terrain knows the heights
+/// over each ([`Terrain::height_range`]), the vertical gap between those ranges (a rise
+/// or drop beyond the reach is a certificate too).
+pub fn step_distance(terrain: &dyn Terrain, a: &Region, b: &Region) -> f64 {
+    let vertical = match (terrain.height_range(a), terrain.height_range(b)) {
+        (Some([a0, a1]), Some([b0, b1])) => (b0 - a1).max(a0 - b1).max(0.0),
+        _ => 0.0,
+    };
+    a.distance(b).hypot(vertical)
+}
+
 /// Indices of the regions reachable from the region(s) holding `(x, y)`, by steps
-/// between regions closer than `reach`.
-fn reachable(regions: &[Region], x: f64, y: f64, reach: f64) -> Vec<usize> {
+/// between regions closer than `reach` ([`step_distance`], [`within_reach`]).
+fn reachable(terrain: &dyn Terrain, regions: &[Region], x: f64, y: f64, reach: f64) -> Vec<usize> {
     let mut seen = vec![false; regions.len()];
     let mut stack: Vec<usize> = (0..regions.len())
         .filter(|&k| regions[k].contains(x, y, 1e-9))
@@ -144,7 +216,7 @@ fn reachable(regions: &[Region], x: f64, y: f64, reach: f64) -> Vec<usize> {
     }
     while let Some(a) = stack.pop() {
         for b in 0..regions.len() {
-            if !seen[b] && regions[a].distance(&regions[b]) < reach {
+            if !seen[b] && within_reach(step_distance(terrain, &regions[a], &regions[b]), reach) {
                 seen[b] = true;
                 stack.push(b);
             }
@@ -156,13 +228,15 @@ fn reachable(regions: &[Region], x: f64, y: f64, reach: f64) -> Vec<usize> {
 /// A certificate that some foot cannot reach its goal, or `None` when every foot can
 /// (as far as this geometric test sees).
 pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
-    let regions = terrain::of(s).regions();
+    let terrain = terrain::of(s);
+    let terrain = &*terrain;
+    let regions = terrain.regions();
     let reach = s.step_radius_sq.sqrt();
     let rho = goal_radius(s);
     for i in Foot::ALL {
         let p = s.start.feet.get(i);
         let g = s.goal.get(i.biped());
-        let ok = reachable(&regions, p[0], p[1], reach);
+        let ok = reachable(terrain, &regions, p[0], p[1], reach);
         let nearest = ok
             .iter()
             .map(|&k| regions[k].distance_to(g[0], g[1]))
@@ -180,7 +254,7 @@ pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
                     .filter(|b| !ok.contains(b))
                     .map(move |b| (a, b))
             })
-            .map(|(a, b)| regions[a].distance(&regions[b]))
+            .map(|(a, b)| step_distance(terrain, &regions[a], &regions[b]))
             .min_by(f64::total_cmp);
         return Some(Uncrossable {
             foot: i,
@@ -203,7 +277,8 @@ pub fn stopped_before_crossable(s: &Scenario, last: &crate::scenario::Feet) -> V
     if s.n_step < stances_needed(s).needed {
         return Vec::new();
     }
-    let regions = terrain::of(s).regions();
+    let terrain = terrain::of(s);
+    let regions = terrain.regions();
     let reach = s.step_radius_sq.sqrt();
     let goals = crate::gait::foot_goals(s);
     let mut out = Vec::new();
@@ -219,7 +294,10 @@ pub fn stopped_before_crossable(s: &Scenario, last: &crate::scenario::Feet) -> V
         let d = regions[target].distance_to(f[0], f[1]);
         // A foot in the keep-out itself is the checker's `gap` finding, not this one.
         let standing = regions.iter().any(|r| r.contains(f[0], f[1], 1e-6));
-        if standing && d > 1e-6 && reachable(&regions, p[0], p[1], reach).contains(&target) {
+        if standing
+            && d > 1e-6
+            && reachable(&*terrain, &regions, p[0], p[1], reach).contains(&target)
+        {
             out.push((i, d));
         }
     }
@@ -295,5 +373,56 @@ mod tests {
             uncrossable(&s).is_some(),
             "keep-out = reach counts as not crossable"
         );
+    }
+
+    /// 4·F_thr above the weight (981 N) is a certificate: F_thr = 246 N (984 N) is
+    /// refused, 245 N (980 N) is not (the ground's slope where feet stand is below
+    /// 3.6e-4 on the default gap: cos θ − μ sin θ > 0.9998).
+    #[test]
+    fn force_threshold_against_the_weight() {
+        let mut s = Scenario::default();
+        let t = terrain::of(&s);
+        s.friction.f_thr = 245.0;
+        assert_eq!(force_threshold(&s, &*t), None);
+        s.friction.f_thr = 246.0;
+        let c = force_threshold(&s, &*t).expect("certificate");
+        assert!(c.least_vertical > 981.0 && c.least_vertical < 984.0, "{c}");
+        assert!(c.to_string().contains("981.0000"), "{c}");
+    }
+
+    /// A step up of 0.35 m with 0.01 m margins: the regions are 0.02 m apart
+    /// horizontally and 0.35 − 2·1.1e-5 m apart vertically (the atan's tails at 0.01 m:
+    /// 0.35/(π·1e4)), 0.3505 m in 3-D, beyond the 0.3 m reach; a rise of 0.25 m is
+    /// within it.
+    #[test]
+    fn rise_beyond_the_reach() {
+        let mut s = Scenario::default();
+        s.apply_overrides(&[
+            "terrain={kind=\"step\", edge=2.3, rise=0.35, steepness=1e6, margin=0.01}",
+            "goal.B=[3.0, 0.5, 0.85]",
+            "goal.F=[5.0, 0.5, 0.85]",
+        ])
+        .unwrap();
+        let c = uncrossable(&s).expect("certificate");
+        let d = c.shortest_exit.unwrap();
+        let tail = 0.35 / (std::f64::consts::PI * 1e4);
+        assert!((d - 0.02f64.hypot(0.35 - 2.0 * tail)).abs() < 1e-9, "{c}");
+        s.apply_overrides(&["terrain.rise=0.25"]).unwrap();
+        assert_eq!(uncrossable(&s), None);
+    }
+
+    /// A keep-out typed as exactly the reach whose width rounds below it (2.74 − 2.5 +
+    /// 0.06 = 0.2999999999999998 in binary) is not crossable; one 1e-4 m narrower is.
+    #[test]
+    fn keep_out_typed_as_the_reach() {
+        let mut s = Scenario::default();
+        s.gap.min = 2.5;
+        s.gap.max = 2.74;
+        let width = (s.gap.max + s.gap.margin) - (s.gap.min - s.gap.margin);
+        assert!(width < 0.3, "the case of the issue: {width}");
+        let c = uncrossable(&s).expect("certificate");
+        assert!((c.shortest_exit.unwrap() - 0.3).abs() < 1e-12, "{c}");
+        s.gap.max = 2.7399;
+        assert_eq!(uncrossable(&s), None);
     }
 }

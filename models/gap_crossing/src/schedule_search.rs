@@ -37,9 +37,9 @@
 use crate::model::{build_stance, STANCE_FEET};
 use crate::plan::{Plan, Stance};
 use crate::scenario::{dist2, Coms, Feet, Foot, Scenario, Vec3};
+use crate::solve::Settings;
 use crate::terrain::Terrain;
-use nlp::ipm::Ipm;
-use nlp::{BuildError, Compiled, IpmOptions, Problem};
+use nlp::{BuildError, Compiled, Problem, Solver};
 use std::collections::HashMap;
 
 /// Iteration limit of one stance solve (they take 10–30 iterations from the old stance).
@@ -53,25 +53,36 @@ pub const MIN_RELATIVE_GAIN: f64 = 1e-5;
 pub struct StanceSolver {
     problem: Problem,
     compiled: Compiled,
-    ipm: Ipm,
+    solver: Box<dyn Solver>,
 }
 
 impl StanceSolver {
-    /// Compiles the stance problem of scenario `s` on `terrain`.
+    /// Compiles the stance problem of scenario `s` on `terrain`, solved by the default
+    /// interior-point method ([`StanceSolver::with_settings`] with the defaults).
     pub fn new(s: &Scenario, terrain: &dyn Terrain) -> Result<StanceSolver, BuildError> {
+        StanceSolver::with_settings(s, terrain, &Settings::default())
+    }
+
+    /// Compiles the stance problem of scenario `s` on `terrain`, solved by the back end
+    /// and options of `settings` (the user's `--solver` and `--opt`: tolerances, the
+    /// wall-time limit, ...), with two exceptions: at most [`STANCE_MAX_ITER`] iterations
+    /// per solve, and print level 0, because a search round solves hundreds of these
+    /// 18-variable problems, whose logs would drown those of the plan's solves.
+    pub fn with_settings(
+        s: &Scenario,
+        terrain: &dyn Terrain,
+        settings: &Settings,
+    ) -> Result<StanceSolver, BuildError> {
         let problem = build_stance(s, terrain)?;
         let compiled = problem.compile()?;
-        let ipm = Ipm::new(IpmOptions {
-            common: nlp::CommonOptions {
-                max_iter: STANCE_MAX_ITER,
-                ..Default::default()
-            },
-            ..IpmOptions::default()
-        });
+        let mut settings = settings.clone();
+        let common = settings.options_mut().common_mut();
+        common.max_iter = common.max_iter.min(STANCE_MAX_ITER);
+        common.print_level = 0;
         Ok(StanceSolver {
             problem,
             compiled,
-            ipm,
+            solver: settings.solver(),
         })
     }
 
@@ -87,7 +98,7 @@ impl StanceSolver {
             x0.extend_from_slice(&f);
         }
         self.compiled.set_initial_point(&x0).ok()?;
-        let sol = self.ipm.solve(&mut self.compiled).ok()?;
+        let sol = self.solver.solve(&mut self.compiled).ok()?;
         if !sol.status.is_success() {
             return None;
         }
@@ -110,19 +121,7 @@ pub fn stance_cost(s: &Scenario, st: &Stance) -> f64 {
     Plan { stances: vec![*st] }.cost(s)
 }
 
-/// Whether the feet of one stance satisfy (6)–(9).
-pub fn feet_distances_ok(s: &Scenario, feet: &Feet) -> bool {
-    let pairs = [
-        (Foot::BR, Foot::FR, s.same_side_sq),
-        (Foot::BL, Foot::FL, s.same_side_sq),
-        (Foot::BR, Foot::BL, s.same_biped_sq),
-        (Foot::FR, Foot::FL, s.same_biped_sq),
-    ];
-    pairs.iter().all(|&(a, b, bounds)| {
-        let d2 = dist2(feet.get(a), feet.get(b));
-        d2 >= bounds.min && d2 <= bounds.max
-    })
-}
+pub use crate::gait::feet_distances_ok;
 
 /// Foothold counts: how many scheduled moves each foot (BR, BL, FR, FL) has made.
 pub type Counts = [usize; 4];

@@ -25,6 +25,7 @@
 use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::convergence::ResidualProbe;
 use crate::crossing_search;
+use crate::frame;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
 use crate::plan::{foot_offset, Plan, PlanError, SolutionFile, SolverInfo};
@@ -231,9 +232,9 @@ pub struct Outcome {
     /// The solution file (the spec's schema); its `solver.status` is the word of
     /// `status` ([`crate::status::StatusKind::word`]). When not solved, the best plan found.
     pub file: SolutionFile,
-    /// The solver runs, in order.
+    /// The solver runs, in order (none when a certificate decided before solving).
     pub phases: Vec<Phase>,
-    /// Index in `phases` of the run whose solution is the plan.
+    /// Index in `phases` of the run whose solution is the plan (0 when `phases` is empty).
     pub chosen: usize,
 }
 
@@ -399,9 +400,66 @@ fn run(
 }
 
 /// Plans scenario `s` (its `gait` field chooses the formulation) on its terrain
-/// ([`terrain::of`]).
+/// ([`terrain::of`]), in the start's frame ([`frame`]): the outcome does not depend on
+/// where the world origin is (up to the round-off of the translation). The plan and the
+/// file are in `s`'s coordinates; `solver.objective` is the cost computed in the
+/// start's frame.
 pub fn plan(s: &Scenario, settings: &Settings) -> Result<Outcome, PlanningError> {
-    plan_on(s, &*terrain::of(s), settings)
+    let d = frame::offset(s);
+    if d == [0.0, 0.0] {
+        return plan_on(s, &*terrain::of(s), settings);
+    }
+    let local = frame::translated(s, d);
+    let mut out = plan_on(&local, &*terrain::of(&local), settings)?;
+    let back = [-d[0], -d[1]];
+    let mut plan = out.file.plan();
+    frame::translate_plan(&mut plan, back);
+    // Stance 1 is the scenario's start, exactly.
+    plan.stances[0].com = s.start.com;
+    plan.stances[0].feet = s.start.feet;
+    out.file = SolutionFile::new(s.clone(), out.file.solver.clone(), plan);
+    if let PlanStatus::GapNotCrossable(c) = &mut out.status {
+        c.reachable_x[0] += back[0];
+        c.reachable_x[1] += back[0];
+    }
+    Ok(out)
+}
+
+/// The largest bound magnitude of the model of `s` (forces in N, coordinates in m,
+/// squared lengths in m²): F_thr, the squared-distance bounds of (5)–(9) and the finite
+/// edges of the allowed regions.
+fn largest_bound(s: &Scenario, terrain: &dyn Terrain) -> f64 {
+    let mut m = s
+        .friction
+        .f_thr
+        .abs()
+        .max(s.step_radius_sq)
+        .max(s.same_side_sq.max)
+        .max(s.same_biped_sq.max);
+    for r in terrain.regions() {
+        for v in r.x.into_iter().chain(r.y) {
+            if v.is_finite() {
+                m = m.max(v.abs());
+            }
+        }
+    }
+    m
+}
+
+impl Settings {
+    /// These settings with the interior-point method's bound relaxation made consistent
+    /// with the checker, the one place where the two meet: IPOPT-style relaxation moves
+    /// each bound by `bound_relax_factor·max(1, |bound|)`, so with the default 1e-8 an
+    /// F_thr of 150 N was relaxed by 1.5e-6 N, beyond the checker's absolute
+    /// [`check::TOL`] (1e-6), and a solve ended `check_failed`. The factor is capped so
+    /// that no bound of the model moves by more than `check::TOL / 2`; on the default
+    /// scenario (largest bound 10 N) the cap is 5e-8 and the default 1e-8 stays.
+    pub fn consistent_with_checker(&self, s: &Scenario, terrain: &dyn Terrain) -> Settings {
+        let mut c = self.clone();
+        let cap = check::TOL / 2.0 / largest_bound(s, terrain).max(1.0);
+        c.ipm.bound_relax_factor = c.ipm.bound_relax_factor.min(cap);
+        c
+    }
 }
 
 /// Plans scenario `s` on any terrain.
@@ -411,6 +469,10 @@ pub fn plan_on(
     settings: &Settings,
 ) -> Result<Outcome, PlanningError> {
     crate::limits::check(s)?;
+    if let Some(out) = proved_impossible(s, settings) {
+        return Ok(out);
+    }
+    let settings = &settings.consistent_with_checker(s, terrain);
     let started = Instant::now();
     let mut phases = Vec::new();
     let crawl = gait::crawl_schedule(s.n_step);
@@ -442,10 +504,12 @@ pub fn plan_on(
         objective_without_10: without_10,
         max_constraint_violation: last.solution.constr_viol,
         solve_seconds: started.elapsed().as_secs_f64(),
+        reason: None,
     };
     let mut file = SolutionFile::new(s.clone(), solver, plan);
     let status = decide(s, last.solution.status, &file);
     file.solver.status = status.kind().word().into();
+    file.solver.reason = (!status.is_solved()).then(|| status.to_string());
     Ok(Outcome {
         status,
         file,
@@ -454,33 +518,82 @@ pub fn plan_on(
     })
 }
 
-/// The verdict on a plan of scenario `s` returned by a solver with `solver_status`, in
-/// this order: a geometric proof that the goal is unreachable ([`reach::uncrossable`]:
-/// gap not crossable; n_step below [`reach::stances_needed`]: goal not reached); the
-/// solver's failure; the independent checker's violations of (2)–(11), the keep-out and
-/// the start; a final CoM farther than [`GOAL_TOL`] (0.05 m) from its goal; else solved.
-pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanStatus {
-    if let Some(c) = reach::uncrossable(s) {
-        return PlanStatus::GapNotCrossable(c);
-    }
-    let bound = reach::stances_needed(s);
-    let distance = file.stances.last().map_or(f64::INFINITY, |last| {
+/// Largest distance of the file's final CoMs from their goals (m).
+fn goal_distance(s: &Scenario, file: &SolutionFile) -> f64 {
+    file.stances.last().map_or(f64::INFINITY, |last| {
         Biped::ALL
             .iter()
             .map(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt())
             .fold(0.0, f64::max)
-    });
-    let shortfall = |bound: Unreachable| {
-        PlanStatus::GoalNotReached(GoalShortfall {
-            n_step: s.n_step,
-            distance,
-            guess_needs: gait::crawl_stances_to_goal(s, GOAL_TOL, 4 * bound.needed + 100),
-            bound,
-        })
-    };
-    if s.n_step < bound.needed {
-        return shortfall(bound);
+    })
+}
+
+/// How far a plan ending `distance` from its goal falls short, with the bound.
+fn shortfall(s: &Scenario, distance: f64, bound: Unreachable) -> GoalShortfall {
+    GoalShortfall {
+        n_step: s.n_step,
+        distance,
+        guess_needs: gait::crawl_stances_to_goal(s, GOAL_TOL, 4 * bound.needed + 100),
+        bound,
     }
+}
+
+/// The first certificate that no plan of `s` exists, in the order of [`decide`] (a plan
+/// ending `distance` from its goal is reported with it), or `None`.
+fn certificate(s: &Scenario, distance: f64) -> Option<PlanStatus> {
+    if let Some(c) = reach::uncrossable(s) {
+        return Some(PlanStatus::GapNotCrossable(c));
+    }
+    if let Some(c) = reach::force_threshold(s, &*terrain::of(s)) {
+        return Some(PlanStatus::Infeasible(c));
+    }
+    let bound = reach::stances_needed(s);
+    (s.n_step < bound.needed).then(|| PlanStatus::GoalNotReached(shortfall(s, distance, bound)))
+}
+
+/// The outcome of a scenario that a certificate proves impossible, decided before any
+/// solve ([`decide`]'s certificates on the planner's guess): the file holds the crawl
+/// guess (not a plan: 0 iterations, no solver runs) with the status and the certificate
+/// in `solver.reason`. `None` when no certificate applies.
+fn proved_impossible(s: &Scenario, settings: &Settings) -> Option<Outcome> {
+    let plan = gait::crawl_plan(s);
+    let solver = SolverInfo {
+        name: settings.options().solver().name().into(),
+        status: String::new(),
+        iterations: 0,
+        objective: plan.cost(s),
+        objective_without_10: None,
+        max_constraint_violation: f64::NAN,
+        solve_seconds: 0.0,
+        reason: None,
+    };
+    let mut file = SolutionFile::new(s.clone(), solver, plan);
+    let distance = goal_distance(s, &file);
+    let status = certificate(s, distance)?;
+    file.solver.status = status.kind().word().into();
+    file.solver.reason = Some(status.to_string());
+    Some(Outcome {
+        status,
+        file,
+        phases: Vec::new(),
+        chosen: 0,
+    })
+}
+
+/// The verdict on a plan of scenario `s` returned by a solver with `solver_status`, in
+/// this order: a proof that no plan exists ([`reach::uncrossable`]: gap not crossable;
+/// [`reach::force_threshold`]: infeasible; n_step below [`reach::stances_needed`]: goal
+/// not reached); the
+/// solver's failure; the independent checker's violations of (2)–(11), the keep-out and
+/// the start; a final CoM farther than [`GOAL_TOL`] (0.05 m) from its goal (no plan
+/// found); else solved.
+pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanStatus {
+    let distance = goal_distance(s, file);
+    if let Some(c) = certificate(s, distance) {
+        return c;
+    }
+    let bound = reach::stances_needed(s);
+    let shortfall = |bound: Unreachable| shortfall(s, distance, bound);
     if !solver_status.is_success() {
         return PlanStatus::SolverFailed(solver_status);
     }
@@ -505,7 +618,7 @@ pub fn decide(s: &Scenario, solver_status: Status, file: &SolutionFile) -> PlanS
         return PlanStatus::CheckFailed { violations, labels };
     }
     if distance.is_nan() || distance > GOAL_TOL {
-        return shortfall(bound);
+        return PlanStatus::NoPlanFound(shortfall(bound));
     }
     PlanStatus::Solved
 }
@@ -626,7 +739,7 @@ fn search_from(
         return Ok(out);
     }
     let search_settings = candidate.warm();
-    let mut stance_solver = StanceSolver::new(s, terrain)?;
+    let mut stance_solver = StanceSolver::with_settings(s, terrain, candidate)?;
     let mut best = from;
     for round in 1..=SEARCH_ROUNDS {
         let current = Plan::from_flat(s, &best.flat)?;

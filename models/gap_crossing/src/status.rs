@@ -4,7 +4,7 @@
 //! data-free tag, the word written to files (`solution.json`'s `solver.status`,
 //! `sweep.csv`) and counted by `sweep`. Nothing in this crate compares status words as
 //! text: they are parsed into [`StatusKind`] ([`StatusKind::from_word`]) and matched.
-use crate::reach::{Uncrossable, Unreachable};
+use crate::reach::{ForceThreshold, Uncrossable, Unreachable};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -19,9 +19,15 @@ pub enum StatusKind {
     /// A keep-out zone on the way is at least as wide as the step reach: no plan can
     /// reach the goal (a geometric certificate, [`Uncrossable`]).
     GapNotCrossable,
-    /// The plan ends short of the goal: too few stances (a lower bound proves it), or the
-    /// planner did not get there although the bound allows it.
+    /// Too few stances: n_step is below a lower bound on the stances any plan needs (a
+    /// certificate, [`Unreachable`]).
     GoalNotReached,
+    /// No plan satisfies the constraints: 4·F_thr is above what the weight allows (a
+    /// certificate, [`ForceThreshold`]).
+    Infeasible,
+    /// No plan found: the planner's plan ends short of the goal though no certificate
+    /// proves the goal unreachable.
+    NoPlanFound,
     /// The NLP solver stopped without a solution (iteration limit, restoration failure, ...).
     SolverFailed,
     /// The solver reported success but the independent checker rejects the plan.
@@ -36,10 +42,12 @@ pub enum StatusKind {
 
 impl StatusKind {
     /// Every kind, in the order `sweep` reports counts.
-    pub const ALL: [StatusKind; 8] = [
+    pub const ALL: [StatusKind; 10] = [
         StatusKind::Solved,
         StatusKind::GapNotCrossable,
         StatusKind::GoalNotReached,
+        StatusKind::Infeasible,
+        StatusKind::NoPlanFound,
         StatusKind::SolverFailed,
         StatusKind::CheckFailed,
         StatusKind::InvalidScenario,
@@ -53,6 +61,8 @@ impl StatusKind {
             StatusKind::Solved => "solved",
             StatusKind::GapNotCrossable => "gap_not_crossable",
             StatusKind::GoalNotReached => "goal_not_reached",
+            StatusKind::Infeasible => "infeasible",
+            StatusKind::NoPlanFound => "no_plan_found",
             StatusKind::SolverFailed => "solver_failed",
             StatusKind::CheckFailed => "check_failed",
             StatusKind::InvalidScenario => "invalid_scenario",
@@ -72,7 +82,8 @@ impl StatusKind {
 
     /// The exit code of `gap-crossing solve` for this outcome (docs/gap-crossing.md,
     /// "Exit codes"): 0 solved, 1 solver failure or checker rejection, 2 errors
-    /// (invalid input), 3 gap not crossable, 4 goal not reached, 101 a panic.
+    /// (invalid input), 3 gap not crossable, 4 goal not reached (too few stances),
+    /// 5 infeasible (proved impossible: 3, 4, 5), 6 no plan found, 101 a panic.
     pub fn exit_code(self) -> u8 {
         match self {
             StatusKind::Solved => 0,
@@ -80,6 +91,8 @@ impl StatusKind {
             StatusKind::InvalidScenario | StatusKind::Error => 2,
             StatusKind::GapNotCrossable => 3,
             StatusKind::GoalNotReached => 4,
+            StatusKind::Infeasible => 5,
+            StatusKind::NoPlanFound => 6,
             StatusKind::Panic => 101,
         }
     }
@@ -87,6 +100,15 @@ impl StatusKind {
     /// True for [`StatusKind::Solved`].
     pub fn is_solved(self) -> bool {
         self == StatusKind::Solved
+    }
+
+    /// True when a certificate proves that no plan exists (gap not crossable, goal not
+    /// reached, infeasible), as opposed to a plan not found.
+    pub fn is_proved_impossible(self) -> bool {
+        matches!(
+            self,
+            StatusKind::GapNotCrossable | StatusKind::GoalNotReached | StatusKind::Infeasible
+        )
     }
 }
 
@@ -103,8 +125,12 @@ pub enum PlanStatus {
     Solved,
     /// No plan can reach the goal: the certificate.
     GapNotCrossable(Uncrossable),
-    /// The plan ends short of the goal.
+    /// Too few stances for any plan to reach the goal.
     GoalNotReached(GoalShortfall),
+    /// No plan satisfies the constraints: the certificate.
+    Infeasible(ForceThreshold),
+    /// The plan ends short of the goal, with no certificate that it must.
+    NoPlanFound(GoalShortfall),
     /// The solver stopped without a solution.
     SolverFailed(nlp::Status),
     /// The solver succeeded but the checker found violations: their count and labels.
@@ -137,6 +163,8 @@ impl PlanStatus {
             PlanStatus::Solved => StatusKind::Solved,
             PlanStatus::GapNotCrossable(_) => StatusKind::GapNotCrossable,
             PlanStatus::GoalNotReached(_) => StatusKind::GoalNotReached,
+            PlanStatus::Infeasible(_) => StatusKind::Infeasible,
+            PlanStatus::NoPlanFound(_) => StatusKind::NoPlanFound,
             PlanStatus::SolverFailed(_) => StatusKind::SolverFailed,
             PlanStatus::CheckFailed { .. } => StatusKind::CheckFailed,
         }
@@ -156,8 +184,20 @@ impl fmt::Display for PlanStatus {
             PlanStatus::GoalNotReached(g) => {
                 write!(
                     f,
-                    "goal not reached: the plan ends {:.3} m from a goal (tolerance 0.05 m) with n_step = {}; {}",
-                    g.distance, g.n_step, g.bound
+                    "goal not reached: n_step = {} is too few: {}",
+                    g.n_step, g.bound
+                )?;
+                match g.guess_needs {
+                    Some(n) => write!(f, "; the planner's guess reaches the goal with n_step = {n}"),
+                    None => Ok(()),
+                }
+            }
+            PlanStatus::Infeasible(c) => write!(f, "infeasible: {c}"),
+            PlanStatus::NoPlanFound(g) => {
+                write!(
+                    f,
+                    "no plan found: the plan ends {:.3} m from a goal (tolerance 0.05 m) with n_step = {}, though no certificate rules the goal out (the lower bound is {} stances)",
+                    g.distance, g.n_step, g.bound.needed
                 )?;
                 match g.guess_needs {
                     Some(n) => write!(f, "; the planner's guess reaches the goal with n_step = {n}"),

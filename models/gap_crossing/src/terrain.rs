@@ -85,6 +85,18 @@ pub trait Terrain: Send + Sync {
         None
     }
 
+    /// An upper bound on the slope `‖∇h‖` over the allowed regions, when one is known
+    /// (`reach::force_threshold` uses it; `None`: no bound).
+    fn slope_bound(&self) -> Option<f64> {
+        None
+    }
+    /// The heights `[min, max]` of the ground over region `r` (or a range holding
+    /// them), when known (`reach` uses it for rises and drops between regions; `None`:
+    /// unknown, taken as no height difference).
+    fn height_range(&self, _r: &Region) -> Option<[f64; 2]> {
+        None
+    }
+
     /// Unit surface normal `(−h_x, −h_y, 1)/‖·‖` at a point (points up, out of the ground).
     fn normal_at(&self, x: f64, y: f64) -> [f64; 3] {
         let [hx, hy] = self.slope_at(x, y);
@@ -149,6 +161,27 @@ fn smooth_step_slope(x: Expr, edge: f64, depth: f64, steepness: f64) -> Expr {
     depth / PI * steepness / (1.0 + (steepness * (x - edge)).sq())
 }
 
+/// Bound on `|d/dx (D/π)·atan(k(x − e))|` at points at least `delta` from the edge `e`.
+fn atan_slope_bound(depth: f64, steepness: f64, delta: f64) -> f64 {
+    depth.abs() / PI * steepness / (1.0 + (steepness * delta).powi(2))
+}
+
+/// The heights of a monotone 1-D profile over a strip: between its values at the
+/// strip's ends (the limits `at_minus`/`at_plus` at infinite ends).
+fn monotone_range(h: impl Fn(f64) -> f64, r: &Region, at_minus: f64, at_plus: f64) -> [f64; 2] {
+    let a = if r.x[0].is_finite() {
+        h(r.x[0])
+    } else {
+        at_minus
+    };
+    let b = if r.x[1].is_finite() {
+        h(r.x[1])
+    } else {
+        at_plus
+    };
+    [a.min(b), a.max(b)]
+}
+
 /// The specification's terrain: flat floor with a gap across the whole width,
 /// `h(x) = (D/π)[atan(k(x − gap_max)) − atan(k(x − gap_min))]`.
 #[derive(Clone, Copy, Debug)]
@@ -183,6 +216,16 @@ impl Terrain for GapTerrain {
     /// h < 0 for a gap (depth > 0); a negative depth (a ridge) rises to at most −depth.
     fn height_bound(&self) -> Option<f64> {
         Some((-self.gap.depth).max(0.0))
+    }
+    /// Each edge's term at the margin's distance.
+    fn slope_bound(&self) -> Option<f64> {
+        let g = &self.gap;
+        Some(2.0 * atan_slope_bound(g.depth, g.steepness, g.margin))
+    }
+    /// h is monotone on each side of the gap (between 0 at infinity and its value at
+    /// the keep-out's edge).
+    fn height_range(&self, r: &Region) -> Option<[f64; 2]> {
+        Some(monotone_range(|x| self.gap.height(x), r, 0.0, 0.0))
     }
     fn regions(&self) -> Vec<Region> {
         let (lo, hi) = self.gap.keep_out();
@@ -225,6 +268,15 @@ impl Terrain for GapsTerrain {
     /// Each gap's term is below 0, or below −depth for a ridge.
     fn height_bound(&self) -> Option<f64> {
         Some(self.gaps.iter().map(|g| (-g.depth).max(0.0)).sum())
+    }
+    /// The sum of each gap's bound.
+    fn slope_bound(&self) -> Option<f64> {
+        Some(
+            self.gaps
+                .iter()
+                .map(|g| 2.0 * atan_slope_bound(g.depth, g.steepness, g.margin))
+                .sum(),
+        )
     }
     fn regions(&self) -> Vec<Region> {
         let mut outs: Vec<(f64, f64)> = self.gaps.iter().map(Gap::keep_out).collect();
@@ -277,6 +329,18 @@ impl Terrain for StepTerrain {
     fn height_bound(&self) -> Option<f64> {
         Some(self.rise.max(0.0))
     }
+    fn slope_bound(&self) -> Option<f64> {
+        Some(atan_slope_bound(self.rise, self.steepness, self.margin))
+    }
+    /// h is monotone, from 0 at −∞ to `rise` at +∞.
+    fn height_range(&self, r: &Region) -> Option<[f64; 2]> {
+        Some(monotone_range(
+            |x| self.height_at(x, 0.0),
+            r,
+            0.0,
+            self.rise,
+        ))
+    }
     fn regions(&self) -> Vec<Region> {
         vec![
             Region::strip(f64::NEG_INFINITY, self.edge - self.margin),
@@ -307,6 +371,12 @@ impl Terrain for StonesTerrain {
     }
     fn height_bound(&self) -> Option<f64> {
         Some(0.0)
+    }
+    fn slope_bound(&self) -> Option<f64> {
+        Some(0.0)
+    }
+    fn height_range(&self, _r: &Region) -> Option<[f64; 2]> {
+        Some([0.0, 0.0])
     }
     fn regions(&self) -> Vec<Region> {
         self.stones.clone()

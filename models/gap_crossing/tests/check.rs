@@ -16,6 +16,7 @@ fn info() -> SolverInfo {
         objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
+        reason: None,
     }
 }
 

@@ -499,3 +499,122 @@ fn sweep_takes_solver_options() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("bogus"));
 }
+
+/// A plan written by another implementation: its scenario spells values as the
+/// specification does (`F_thr`, `mu`, `gap_min`, `m1`) and its solver block has fields
+/// of other types (`"iterations": "many"`), which the checker does not use.
+#[test]
+fn check_reads_other_tools_key_names_and_solver_blocks() {
+    let dir = tmp("aliases");
+    let mut v = valid_json();
+    v["scenario"]["F_thr"] = 10.0.into();
+    v["scenario"]["mu"] = 0.5.into();
+    v["scenario"]["gap_min"] = 2.25.into();
+    v["scenario"]["m1"] = 50.0.into();
+    v["solver"]["iterations"] = "many".into();
+    let f = write(&dir, "other.json", &v);
+    let out = run(&["check", &f]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // A value given under two names is refused, naming both.
+    v["scenario"]["friction"] = serde_json::json!({ "f_thr": 10.0 });
+    let f = write(&dir, "twice.json", &v);
+    let out = run(&["check", &f]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("F_thr") && err.contains("friction.f_thr"),
+        "{err}"
+    );
+}
+
+/// `check --scenario FILE` checks a plan (here without a scenario block) against a
+/// separate scenario file; the plan breaks that scenario's F_thr of 300 N (its forces
+/// are 245.25 N) and passes the default's.
+#[test]
+fn check_against_a_separate_scenario() {
+    let dir = tmp("separate");
+    let mut v = valid_json();
+    let scenario = v["scenario"].clone();
+    v.as_object_mut().unwrap().remove("scenario");
+    let plan = write(&dir, "plan.json", &v);
+    let ok = write(&dir, "ok.json", &scenario);
+    let out = run(&["check", &plan, "--scenario", &ok]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let mut strict = scenario;
+    strict["friction"] = serde_json::json!({ "f_thr": 300.0, "mu": 0.5 });
+    let strict = write(&dir, "strict.json", &strict);
+    let out = run(&["check", &plan, "--scenario", &strict]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stdout).contains("(4)"), "{}", text(&out.stdout));
+    // Without --scenario a plan needs its own.
+    assert_eq!(run(&["check", &plan]).status.code(), Some(2));
+}
+
+/// An empty scenario file (or one of comments only) is an error, not the default.
+#[test]
+fn empty_scenario_file_is_an_error() {
+    let dir = tmp("empty");
+    for (name, text_) in [
+        ("empty.toml", ""),
+        ("comments.toml", "# nothing\n"),
+        ("empty.json", "{}"),
+    ] {
+        let p = dir.join(name);
+        std::fs::write(&p, text_).unwrap();
+        let out = run(&[
+            "solve",
+            "--scenario",
+            p.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        assert!(
+            text(&out.stderr).contains("sets no value"),
+            "{}",
+            text(&out.stderr)
+        );
+        assert!(!dir.join("out").exists());
+    }
+}
+
+/// No stale result in `--out`: a solve proved impossible before solving writes its
+/// status and certificate over an earlier result, and a solve stopped by an error
+/// removes the earlier files.
+#[test]
+fn failed_solves_leave_no_stale_result() {
+    let dir = tmp("stale");
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    for f in [
+        "solution.json",
+        "plan.svg",
+        "plan.html",
+        "convergence.svg",
+        "convergence.json",
+    ] {
+        std::fs::write(out_dir.join(f), "old").unwrap();
+    }
+    let o = out_dir.to_str().unwrap();
+    let out = run(&["solve", "--set", "friction.f_thr=246", "--out", o]);
+    assert_eq!(
+        out.status.code(),
+        Some(StatusKind::Infeasible.exit_code().into())
+    );
+    let file = gap_crossing::plan::SolutionFile::read(&out_dir.join("solution.json")).unwrap();
+    assert_eq!(file.solver.status, "infeasible");
+    let reason = file.solver.reason.unwrap();
+    assert!(
+        reason.contains("F_thr = 246 N") && reason.contains("981.0000 N"),
+        "{reason}"
+    );
+    assert_ne!(
+        std::fs::read_to_string(out_dir.join("plan.svg")).unwrap(),
+        "old"
+    );
+    // An error (invalid scenario): the earlier files are removed.
+    let out = run(&["solve", "--set", "n_step=1", "--out", o]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("removed the earlier results"));
+    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 0);
+}

@@ -129,6 +129,7 @@ fn probe_matches_the_checker_off_complementarity() {
         objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
+        reason: None,
     };
     let file = SolutionFile::new(s.clone(), info, Plan::from_flat(&s, &guess).unwrap());
     let report = check::check(&file);

@@ -162,7 +162,11 @@ fn uncrossable_and_too_few_stances_through_the_binary() {
         err.contains("gap_not_crossable") && err.contains("0.3100"),
         "{err}"
     );
-    assert!(!wide.join("solution.json").exists());
+    // Decided before solving; the file says so, with the certificate in numbers.
+    let file = gap_crossing::plan::SolutionFile::read(&wide.join("solution.json")).unwrap();
+    assert_eq!(file.solver.status, "gap_not_crossable");
+    assert_eq!(file.solver.iterations, 0);
+    assert!(file.solver.reason.unwrap().contains("0.3100"));
     // Keep-out exactly the reach: not crossable either (the spec's "at least as wide").
     let out = run(&[
         "solve",
@@ -208,7 +212,9 @@ fn uncrossable_and_too_few_stances_through_the_binary() {
         err.contains("goal_not_reached") && err.contains("at least 37 stances"),
         "{err}"
     );
-    assert!(!short.join("solution.json").exists());
+    let file = gap_crossing::plan::SolutionFile::read(&short.join("solution.json")).unwrap();
+    assert_eq!(file.solver.status, "goal_not_reached");
+    assert!(file.solver.reason.unwrap().contains("at least 37 stances"));
 }
 
 #[test]
@@ -332,6 +338,7 @@ fn every_terrain_kind_is_drawn() {
             objective_without_10: None,
             max_constraint_violation: 0.0,
             solve_seconds: 0.0,
+            reason: None,
         };
         let svg = gap_crossing::render::plan_svg(&SolutionFile::new(s, info, plan));
         for (mark, n) in marks {

@@ -16,6 +16,7 @@ fn as_file(s: &Scenario, plan: Plan) -> SolutionFile {
             objective_without_10: None,
             max_constraint_violation: 0.0,
             solve_seconds: 0.0,
+            reason: None,
         },
         plan,
     )
@@ -124,4 +125,28 @@ fn crawl_handles_a_gap_too_wide_to_jump_and_backward_goals() {
         }
     }
     assert!((feet.last().unwrap().br[0] + 3.0).abs() < 1e-9);
+}
+
+/// Stepping stones approached at 45° (`scenarios/stones-45.toml`): the straight moves
+/// toward the goals converge on the start pad's corner; the guess still satisfies every
+/// equation the landing rule controls — (5)–(9), the keep-out — at every stance (the
+/// feet used to pile into the corner, breaking (8) and (9) at 83 stances).
+#[test]
+fn guess_keeps_feet_apart_on_a_diagonal_approach() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let s = Scenario::load(&dir.join("stones-45.toml")).unwrap();
+    let f = as_file(&s, gait::crawl_plan(&s));
+    let report = gap_crossing::check::check_with(
+        &f,
+        &gap_crossing::check::Options {
+            goal: gap_crossing::check::GoalCheck::Skip,
+            ..Default::default()
+        },
+    );
+    let bad: Vec<_> = report
+        .violations
+        .iter()
+        .filter(|v| ["(5)", "(6)", "(7)", "(8)", "(9)", "gap"].contains(&v.equation.as_str()))
+        .collect();
+    assert!(bad.is_empty(), "{report}");
 }

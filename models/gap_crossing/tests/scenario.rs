@@ -51,10 +51,14 @@ fn defaults_equal_the_spec_table() {
     s.validate().expect("the default scenario is valid");
 }
 
+/// An empty scenario file is refused (it used to plan the default silently, issue 20);
+/// a file naming one value takes the defaults for the rest.
 #[test]
-fn empty_files_give_the_defaults() {
-    assert_eq!(toml("").unwrap(), Scenario::default());
-    assert_eq!(json("{}").unwrap(), Scenario::default());
+fn empty_files_are_refused() {
+    for e in [toml("").unwrap_err(), json("{}").unwrap_err()] {
+        assert!(e.to_string().contains("sets no value"), "{e}");
+    }
+    assert_eq!(toml("n_step = 60").unwrap(), Scenario::default());
 }
 
 #[test]

@@ -20,10 +20,11 @@ fn info() -> SolverInfo {
         objective_without_10: None,
         max_constraint_violation: 0.0,
         solve_seconds: 0.0,
+        reason: None,
     }
 }
 
-/// From the solved crawl gait (n_step 16), the proposal's plan satisfies every equation
+/// From the solved crawl gait (n_step 40), the proposal's plan satisfies every equation
 /// (the independent checker, (10) exactly), only the schedule's feet move, its cost is
 /// the old cost minus the announced gain, and that gain is at least the best single
 /// adjacent swap's (each evaluated here by the stance solver: the band holds them all,
@@ -31,13 +32,14 @@ fn info() -> SolverInfo {
 #[test]
 fn proposal_is_a_valid_cheaper_plan_of_its_schedule() {
     let s = Scenario {
-        n_step: 16,
+        n_step: 40,
         gait: Gait::Crawl,
         ..Scenario::default()
     };
     let out = solve::plan(&s, &Settings::default()).unwrap();
-    // 16 stances do not reach the default goals (status goal_not_reached); the solve
-    // itself succeeds, which is what the swaps need.
+    // 40 stances are above the lower bound (37), so the planner solves; the crawl
+    // schedule needs 45 to reach the goals (status no_plan_found); the solve itself
+    // succeeds, which is what the swaps need.
     assert!(out.phases[out.chosen].status.is_success(), "{}", out.status);
     let plan = out.file.plan();
     let crawl = gait::crawl_schedule(s.n_step);
@@ -197,8 +199,10 @@ fn circle_min_dist2(a: [f64; 3], b: [f64; 3], g: [f64; 3], l2: f64) -> f64 {
 /// CoMs and forces are optimal for its footholds), to the solver's tolerance.
 #[test]
 fn stance_solver_reproduces_a_solved_stance() {
+    // 40 stances: at or above the lower bound (37), so the planner solves (below it, it
+    // stops at the certificate with the guess).
     let s = Scenario {
-        n_step: 12,
+        n_step: 40,
         gait: Gait::Crawl,
         ..Scenario::default()
     };
@@ -233,4 +237,32 @@ fn free_gait_beats_the_crawl_schedule_on_the_default_scenario() {
     // The reference without (10) is reported, and dropping a constraint lowers the cost.
     let without = free.file.solver.objective_without_10.expect("reported");
     assert!(without > 0.0 && without < f, "{without:.6e} vs {f:.6e}");
+}
+
+/// The stance solves take the user's back end and options (issue 23): the SQP back end
+/// finds the same least stance cost as the interior-point method (relative 1e-6: both
+/// stop at tolerance 1e-8 on an 18-variable convex-in-forces problem), and an option
+/// the user sets is honoured (`max_iter=1`: no solve succeeds from the previous stance).
+#[test]
+fn stance_solves_take_the_users_back_end_and_options() {
+    let s = Scenario::default();
+    let t = GapTerrain { gap: s.gap };
+    let plan = gap_crossing::gait::crawl_plan(&s);
+    let (feet, start) = (plan.stances[5].feet, plan.stances[4]);
+    let mut ipm = StanceSolver::new(&s, &t).unwrap();
+    let (_, c_ipm) = ipm.solve(&s, &feet, &start).expect("IPM solves the stance");
+    let sqp = Settings {
+        backend: gap_crossing::solve::Backend::Sqp,
+        ..Settings::default()
+    };
+    let mut sqp = StanceSolver::with_settings(&s, &t, &sqp).unwrap();
+    let (_, c_sqp) = sqp.solve(&s, &feet, &start).expect("SQP solves the stance");
+    assert!(
+        (c_ipm - c_sqp).abs() <= 1e-6 * c_ipm,
+        "{c_ipm} against {c_sqp}"
+    );
+    let mut none = Settings::default();
+    none.set_by_name(&["max_iter=1"]).unwrap();
+    let mut capped = StanceSolver::with_settings(&s, &t, &none).unwrap();
+    assert!(capped.solve(&s, &feet, &start).is_none());
 }

@@ -15,6 +15,7 @@ use std::path::PathBuf;
 pub use crate::terrain_spec::{read_height_csv, TerrainSpec};
 
 mod read;
+pub use read::ALIASES;
 
 /// A point or vector in metres (positions) or newtons (forces): `[x, y, z]`.
 pub type Vec3 = [f64; 3];

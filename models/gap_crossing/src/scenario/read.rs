@@ -112,6 +112,82 @@ fn merge_terrain(base: &mut Value, patch: Value) -> Result<(), ScenarioError> {
     Ok(())
 }
 
+/// Other names a scenario may give a value, as the specification's table and the
+/// source's equations spell them (`gap_min`, `F_thr`, `w_CoM`, `m1`, ...), with the
+/// dotted path of the value they name. Scenarios written by other implementations of
+/// the specification use them; they are read as the canonical key (and written back
+/// under it).
+pub const ALIASES: [(&str, &str); 24] = [
+    ("gap_min", "gap.min"),
+    ("gap_max", "gap.max"),
+    ("depth", "gap.depth"),
+    ("D", "gap.depth"),
+    ("steepness", "gap.steepness"),
+    ("k", "gap.steepness"),
+    ("margin", "gap.margin"),
+    ("safety_margin", "gap.margin"),
+    ("gap.D", "gap.depth"),
+    ("gap.k", "gap.steepness"),
+    ("gap.safety_margin", "gap.margin"),
+    ("mu", "friction.mu"),
+    ("f_thr", "friction.f_thr"),
+    ("F_thr", "friction.f_thr"),
+    ("friction.F_thr", "friction.f_thr"),
+    ("w_com", "weights.com"),
+    ("w_CoM", "weights.com"),
+    ("w_f", "weights.force"),
+    ("w_F", "weights.force"),
+    ("weights.w_CoM", "weights.com"),
+    ("weights.w_F", "weights.force"),
+    ("m1", "masses.B"),
+    ("m2", "masses.F"),
+    ("nstep", "n_step"),
+];
+
+/// Moves every aliased key of `v` ([`ALIASES`]) to its canonical place; a value given
+/// under two names is an error naming both.
+fn canonical_keys(mut v: Value) -> Result<Value, ScenarioError> {
+    for (alias, canonical) in ALIASES {
+        let (parent, key) = match alias.split_once('.') {
+            Some((p, k)) => (Some(p), k),
+            None => (None, alias),
+        };
+        let table = match parent {
+            Some(p) => v.get_mut(p).and_then(Value::as_object_mut),
+            None => v.as_object_mut(),
+        };
+        let Some(value) = table.and_then(|t| t.remove(key)) else {
+            continue;
+        };
+        let (cp, ck) = canonical.split_once('.').unwrap_or(("", canonical));
+        let root = v.as_object_mut().expect("a table holds the alias");
+        let target = if cp.is_empty() {
+            root
+        } else {
+            let entry = root
+                .entry(cp)
+                .or_insert_with(|| Value::Object(Default::default()));
+            match entry.as_object_mut() {
+                Some(t) => t,
+                None => {
+                    return Err(ScenarioError::WrongType {
+                        field: cp.into(),
+                        expected: "a table".into(),
+                        found: kind(entry).into(),
+                    })
+                }
+            }
+        };
+        if target.contains_key(ck) {
+            return Err(ScenarioError::Value(format!(
+                "`{alias}` and `{canonical}` name the same value; give only one"
+            )));
+        }
+        target.insert(ck.into(), value);
+    }
+    Ok(v)
+}
+
 impl Scenario {
     /// Reads the files a scenario refers to (a height map's CSV), relative to `dir`,
     /// when their contents are not already in the scenario.
@@ -127,7 +203,9 @@ impl Scenario {
     /// Builds a scenario from a (possibly partial) JSON value: given fields override the
     /// defaults, unknown fields and wrongly typed values are rejected with their dotted
     /// path. Does not call [`Scenario::validate`].
+    /// Keys may also be spelled as in [`ALIASES`].
     pub fn from_value(v: Value) -> Result<Scenario, ScenarioError> {
+        let v = canonical_keys(v)?;
         let mut base = serde_json::to_value(Scenario::default()).expect("defaults serialise");
         merge(&mut base, v, "")?;
         // The terrain table is replaced, not merged, so serde checks it: its errors are
@@ -154,6 +232,14 @@ impl Scenario {
             "json" => crate::strict_json::parse(text).map_err(|e| syntax(e.to_string()))?,
             _ => return Err(ScenarioError::Extension(origin.to_path_buf())),
         };
+        // An empty file (or one of comments only) is most likely a mistake (a file
+        // truncated, the wrong file): it would silently plan the default scenario.
+        if value.as_object().is_some_and(|t| t.is_empty()) {
+            return Err(syntax(
+                "the file sets no value (empty); to plan the default scenario, omit --scenario"
+                    .into(),
+            ));
+        }
         let mut s = Scenario::from_value(value)?;
         s.load_terrain_files(origin.parent().unwrap_or(Path::new(".")))?;
         Ok(s)
