@@ -1,0 +1,557 @@
+//! `Problem`: the Opti-like builder (nlp::Problem), its solves, and pickling by replay.
+//!
+//! Every builder call is recorded as a [`Step`]; pickling prints the steps' expressions
+//! with symx's printer and unpickling replays them, parsing the text back against the
+//! rebuilt problem's symbols (names are unique within a problem), so a problem crosses
+//! processes as its formulation, not as a graph of thread-bound handles.
+use std::ops::ControlFlow;
+
+use nlp::{Compiled, NumericNlp, Solver, SolverOptions};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict};
+use serde::{Deserialize, Serialize};
+use symx::Expr;
+
+use crate::error::{build_err, option_err, solve_err};
+use crate::expr::{operand, symbols, PyConstraint, PyExpr};
+use crate::function::numbers;
+use crate::same_thread::SameThread;
+use crate::solution::{iteration_dict, PySolution};
+
+/// One recorded builder call; `E` is an expression (`Expr` live, `String` pickled).
+#[derive(Clone, Serialize, Deserialize)]
+enum Step<E> {
+    Variable {
+        name: String,
+        rows: usize,
+        cols: usize,
+    },
+    Parameter {
+        name: String,
+        n: usize,
+    },
+    Minimize {
+        f: E,
+    },
+    Constraint {
+        name: Option<String>,
+        rows: Vec<(E, Option<f64>, Option<f64>)>,
+    },
+    Initial {
+        targets: Vec<E>,
+        values: Vec<f64>,
+    },
+    Value {
+        targets: Vec<E>,
+        values: Vec<f64>,
+    },
+    Cone {
+        name: String,
+        v: Vec<E>,
+        t: E,
+    },
+    Complementarity {
+        name: String,
+        a: E,
+        b: E,
+    },
+    DetectSimpleBounds {
+        on: bool,
+    },
+}
+
+impl<E> Step<E> {
+    /// The same step with every expression mapped by `f`.
+    fn map<F, R>(&self, mut f: impl FnMut(&E) -> Result<F, R>) -> Result<Step<F>, R> {
+        let mut many = |v: &Vec<E>| v.iter().map(&mut f).collect::<Result<Vec<F>, R>>();
+        Ok(match self {
+            Step::Variable { name, rows, cols } => Step::Variable {
+                name: name.clone(),
+                rows: *rows,
+                cols: *cols,
+            },
+            Step::Parameter { name, n } => Step::Parameter {
+                name: name.clone(),
+                n: *n,
+            },
+            Step::Minimize { f: e } => Step::Minimize { f: f(e)? },
+            Step::Constraint { name, rows } => Step::Constraint {
+                name: name.clone(),
+                rows: rows
+                    .iter()
+                    .map(|(e, l, u)| Ok((f(e)?, *l, *u)))
+                    .collect::<Result<_, R>>()?,
+            },
+            Step::Initial { targets, values } => Step::Initial {
+                targets: many(targets)?,
+                values: values.clone(),
+            },
+            Step::Value { targets, values } => Step::Value {
+                targets: many(targets)?,
+                values: values.clone(),
+            },
+            Step::Cone { name, v, t } => Step::Cone {
+                name: name.clone(),
+                v: many(v)?,
+                t: f(t)?,
+            },
+            Step::Complementarity { name, a, b } => Step::Complementarity {
+                name: name.clone(),
+                a: f(a)?,
+                b: f(b)?,
+            },
+            Step::DetectSimpleBounds { on } => Step::DetectSimpleBounds { on: *on },
+        })
+    }
+}
+
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+/// An optimisation problem built symbolically (CasADi's `Opti`): variables, parameters,
+/// objective, constraints, cones and complementarity; solved by `solve`.
+///
+/// The problem is compiled (gradient, sparse Jacobian and Hessian) at the first solve
+/// and the compiled form is reused while only initial values and parameter values change
+/// (`set_initial`, `set_value`); any structural call recompiles at the next solve.
+/// Problems are bound to the thread that built them; pickle them to use elsewhere.
+#[pyclass(name = "Problem", module = "symnlp", unsendable)]
+pub struct PyProblem {
+    pb: nlp::Problem,
+    steps: Vec<Step<Expr>>,
+    compiled: Option<Compiled>,
+}
+
+impl PyProblem {
+    fn structural(&mut self, step: Step<Expr>) {
+        self.steps.push(step);
+        self.compiled = None;
+    }
+
+    fn apply(&mut self, step: Step<Expr>) -> PyResult<()> {
+        match &step {
+            Step::Variable { name, rows, cols } => {
+                self.pb
+                    .variable_matrix(name, *rows, *cols)
+                    .map_err(build_err)?;
+            }
+            Step::Parameter { name, n } => {
+                self.pb.parameter(name, *n).map_err(build_err)?;
+            }
+            Step::Minimize { f } => self.pb.minimize(*f),
+            Step::Constraint { name, rows } => {
+                let c = nlp::Constraint::all(rows.iter().map(|&(e, l, u)| {
+                    nlp::bounded(
+                        l.unwrap_or(f64::NEG_INFINITY),
+                        e,
+                        u.unwrap_or(f64::INFINITY),
+                    )
+                }));
+                match name {
+                    Some(n) => self.pb.subject_to_named(n, c),
+                    None => self.pb.subject_to(c),
+                }
+                .map_err(build_err)?;
+            }
+            Step::Initial { targets, values } => {
+                self.pb.set_initial(targets, values).map_err(build_err)?;
+                if let Some(c) = &mut self.compiled {
+                    let idx = self.pb.variable_indices(targets).map_err(build_err)?;
+                    let mut x0 = vec![0.0; c.n()];
+                    c.initial_point(&mut x0);
+                    for (i, v) in idx.into_iter().zip(values) {
+                        x0[i] = *v;
+                    }
+                    c.set_initial_point(&x0).map_err(build_err)?;
+                }
+                self.steps.push(step);
+                return Ok(());
+            }
+            Step::Value { targets, values } => {
+                self.pb
+                    .set_value(targets.as_slice(), values)
+                    .map_err(build_err)?;
+                if let Some(c) = &mut self.compiled {
+                    c.set_value(targets.as_slice(), values).map_err(build_err)?;
+                }
+                self.steps.push(step);
+                return Ok(());
+            }
+            Step::Cone { name, v, t } => {
+                self.pb.subject_to_cone(name, v, *t).map_err(build_err)?;
+            }
+            Step::Complementarity { name, a, b } => {
+                self.pb.complementarity(name, *a, *b).map_err(build_err)?;
+            }
+            Step::DetectSimpleBounds { on } => self.pb.set_detect_simple_bounds(*on),
+        }
+        self.structural(step);
+        Ok(())
+    }
+
+    /// Values broadcast to `n` entries (a single number is repeated).
+    fn values_for(n: usize, values: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+        let v = numbers(values)?;
+        match v.len() {
+            1 => Ok(vec![v[0]; n]),
+            k if k == n => Ok(v),
+            k => Err(PyValueError::new_err(format!(
+                "{what}: {k} values for {n} entries"
+            ))),
+        }
+    }
+
+    fn ensure_compiled(&mut self, py: Python<'_>) -> PyResult<()> {
+        if self.compiled.is_none() {
+            let pb = SameThread(&self.pb);
+            let c = py.allow_threads(move || {
+                let pb = pb;
+                pb.0.compile()
+            });
+            self.compiled = Some(c.map_err(build_err)?);
+        }
+        Ok(())
+    }
+
+    fn names(&self) -> Vec<String> {
+        self.pb
+            .variables()
+            .iter()
+            .chain(self.pb.parameters())
+            .map(|e| e.name().unwrap_or_default())
+            .collect()
+    }
+
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        solver: &str,
+        options: Option<&Bound<'_, PyDict>>,
+        callback: Option<Py<PyAny>>,
+        warm: Option<&PySolution>,
+    ) -> PyResult<PySolution> {
+        let backend = make_solver(solver, options)?;
+        self.ensure_compiled(py)?;
+        let names = self.names();
+        let compiled = self.compiled.as_mut().expect("compiled above");
+        let parameters = compiled.parameter_values().to_vec();
+        let warm = warm.map(|w| &w.inner);
+        let mut raised: Option<PyErr> = None;
+        let result = py.allow_threads(|| match callback {
+            None => backend.solve_dyn(compiled, warm, None),
+            Some(cb) => {
+                let mut call = |view: &nlp::IterationView<'_>| -> ControlFlow<()> {
+                    Python::with_gil(|py| {
+                        let go = iteration_dict(py, view.record()).and_then(|d| {
+                            d.set_item(
+                                "x",
+                                numpy::IntoPyArray::into_pyarray(view.x().to_vec(), py),
+                            )?;
+                            cb.call1(py, (d,))
+                        });
+                        match go {
+                            Ok(r) if r.bind(py).is(&PyBool::new(py, false).to_owned()) => {
+                                ControlFlow::Break(())
+                            }
+                            Ok(_) => ControlFlow::Continue(()),
+                            Err(e) => {
+                                raised = Some(e);
+                                ControlFlow::Break(())
+                            }
+                        }
+                    })
+                };
+                backend.solve_dyn(compiled, warm, Some(&mut call))
+            }
+        });
+        if let Some(e) = raised {
+            return Err(e);
+        }
+        Ok(PySolution {
+            inner: result.map_err(solve_err)?,
+            names,
+            parameters,
+        })
+    }
+}
+
+/// The back end named `solver` with `options` (IPOPT names) applied.
+fn make_solver(solver: &str, options: Option<&Bound<'_, PyDict>>) -> PyResult<Box<dyn Solver>> {
+    let mut opts: Box<dyn SolverOptions> = match solver {
+        "ipm" | "ipopt" => Box::new(nlp::IpmOptions::default()),
+        "sqp" => Box::new(nlp::SqpOptions::default()),
+        other => {
+            return Err(crate::error::OptionError::new_err(format!(
+                "unknown solver '{other}': expected 'ipm' or 'sqp'"
+            )))
+        }
+    };
+    if let Some(d) = options {
+        let mut assignments = Vec::with_capacity(d.len());
+        for (k, v) in d.iter() {
+            let key: String = k.extract()?;
+            let value = if v.is_instance_of::<PyBool>() {
+                if v.extract::<bool>()? {
+                    "true".to_string()
+                } else {
+                    "false".to_string()
+                }
+            } else {
+                v.str()?.to_string()
+            };
+            assignments.push(format!("{key}={value}"));
+        }
+        let refs: Vec<&str> = assignments.iter().map(String::as_str).collect();
+        opts.set_options_by_name(&refs).map_err(option_err)?;
+    }
+    Ok(opts.solver())
+}
+
+#[pymethods]
+impl PyProblem {
+    /// An empty problem.
+    #[new]
+    fn new() -> PyProblem {
+        PyProblem {
+            pb: nlp::Problem::new(),
+            steps: Vec::new(),
+            compiled: None,
+        }
+    }
+
+    /// Declares `rows × cols` variables named `name[i]` (unbounded, initial value 0).
+    #[pyo3(signature = (name, rows = 1, cols = 1))]
+    fn variable(&mut self, name: &str, rows: usize, cols: usize) -> PyResult<PyExpr> {
+        let m = self
+            .pb
+            .variable_matrix(name, rows, cols)
+            .map_err(build_err)?;
+        self.structural(Step::Variable {
+            name: name.into(),
+            rows,
+            cols,
+        });
+        Ok(PyExpr::new(m))
+    }
+
+    /// Declares `n` parameters named `name[i]`; give them values with `set_value` before
+    /// solving; changing them later does not rebuild the problem.
+    #[pyo3(signature = (name, n = 1))]
+    fn parameter(&mut self, name: &str, n: usize) -> PyResult<PyExpr> {
+        let m = self.pb.parameter(name, n).map_err(build_err)?;
+        self.structural(Step::Parameter {
+            name: name.into(),
+            n,
+        });
+        Ok(PyExpr::new(m))
+    }
+
+    /// Sets the objective (a scalar expression) to minimise.
+    fn minimize(&mut self, f: &Bound<'_, PyAny>) -> PyResult<()> {
+        let m = operand(f)?;
+        let f = PyExpr::new(m).as_scalar("minimize")?;
+        self.apply(Step::Minimize { f })
+    }
+
+    /// Adds constraints: a `Constraint` (from `<=`, `>=`, `==` or `bounded`) or a list
+    /// of them; `name` labels the rows in logs and errors.
+    #[pyo3(signature = (constraint, name = None))]
+    fn subject_to(&mut self, constraint: &Bound<'_, PyAny>, name: Option<String>) -> PyResult<()> {
+        let parts: Vec<PyRef<'_, PyConstraint>> =
+            match constraint.extract::<PyRef<'_, PyConstraint>>() {
+                Ok(c) => vec![c],
+                Err(_) => constraint.extract().map_err(|_| {
+                    pyo3::exceptions::PyTypeError::new_err(
+                        "subject_to: expected a Constraint (e.g. x >= 0) or a list of them",
+                    )
+                })?,
+            };
+        let mut rows = Vec::new();
+        for p in &parts {
+            let c = &p.c;
+            // A shape mismatch is reported by nlp when the parts are added.
+            if c.is_empty() {
+                continue;
+            }
+            for ((e, l), u) in c
+                .expressions()
+                .into_iter()
+                .zip(c.lower_bounds())
+                .zip(c.upper_bounds())
+            {
+                rows.push((e, finite(l), finite(u)));
+            }
+        }
+        self.apply(Step::Constraint { name, rows })
+    }
+
+    /// `lower <= expr <= upper` entry by entry (numbers; `None` for no bound).
+    #[pyo3(signature = (lower, expr, upper))]
+    fn bounded(
+        &self,
+        lower: Option<f64>,
+        expr: &Bound<'_, PyAny>,
+        upper: Option<f64>,
+    ) -> PyResult<PyConstraint> {
+        let m = operand(expr)?;
+        let (l, u) = (
+            lower.unwrap_or(f64::NEG_INFINITY),
+            upper.unwrap_or(f64::INFINITY),
+        );
+        if l.is_nan() || u.is_nan() || l > u {
+            return Err(crate::error::BuildError::new_err(format!(
+                "bounded: bounds [{l}, {u}] are not an interval"
+            )));
+        }
+        Ok(PyConstraint {
+            c: nlp::bounded(l, m, u),
+        })
+    }
+
+    /// Second-order cone `‖v‖₂ ≤ t`.
+    fn subject_to_cone(
+        &mut self,
+        name: &str,
+        v: &Bound<'_, PyAny>,
+        t: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let v = operand(v)?.entries().to_vec();
+        let t = PyExpr::new(operand(t)?).as_scalar("subject_to_cone: t")?;
+        self.apply(Step::Cone {
+            name: name.into(),
+            v,
+            t,
+        })
+    }
+
+    /// Complementarity `0 ≤ a ⟂ b ≥ 0` (scalars).
+    fn complementarity(
+        &mut self,
+        name: &str,
+        a: &Bound<'_, PyAny>,
+        b: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let a = PyExpr::new(operand(a)?).as_scalar("complementarity: a")?;
+        let b = PyExpr::new(operand(b)?).as_scalar("complementarity: b")?;
+        self.apply(Step::Complementarity {
+            name: name.into(),
+            a,
+            b,
+        })
+    }
+
+    /// Initial values of variables (a number is repeated over the entries).
+    fn set_initial(&mut self, x: &PyExpr, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        let targets = symbols(&x.m, "set_initial")?;
+        let values = Self::values_for(targets.len(), values, "set_initial")?;
+        self.apply(Step::Initial { targets, values })
+    }
+
+    /// Values of parameters (a number is repeated over the entries). Does not rebuild.
+    fn set_value(&mut self, p: &PyExpr, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        let targets = symbols(&p.m, "set_value")?;
+        let values = Self::values_for(targets.len(), values, "set_value")?;
+        self.apply(Step::Value { targets, values })
+    }
+
+    /// Turns single-variable constraint rows into bounds at compile time (default on).
+    fn set_detect_simple_bounds(&mut self, on: bool) -> PyResult<()> {
+        self.apply(Step::DetectSimpleBounds { on })
+    }
+
+    /// Number of variables (entries).
+    #[getter]
+    fn n_variables(&self) -> usize {
+        self.pb.n_variables()
+    }
+
+    /// Number of constraint rows.
+    #[getter]
+    fn n_constraints(&self) -> usize {
+        self.pb.n_constraints()
+    }
+
+    /// Compiles now (otherwise the first solve does). Releases the GIL.
+    fn compile(&mut self, py: Python<'_>) -> PyResult<()> {
+        self.ensure_compiled(py)
+    }
+
+    /// Solves with `solver` (`"ipm"`, the default, or `"sqp"`) and `options` by their
+    /// IPOPT names (`{"tol": 1e-10, "max_iter": 500, "print_level": 0}`).
+    /// `callback(info)` is called at each iteration with a dict of the log's columns and
+    /// `x`; returning `False` stops the solve (status `User_Requested_Stop`), an exception
+    /// stops it and propagates. Returns a `Solution` whatever the status (check
+    /// `success`); raises `SolveError` when the solve cannot run. Releases the GIL.
+    #[pyo3(signature = (solver = "ipm", options = None, callback = None))]
+    fn solve(
+        &mut self,
+        py: Python<'_>,
+        solver: &str,
+        options: Option<&Bound<'_, PyDict>>,
+        callback: Option<Py<PyAny>>,
+    ) -> PyResult<PySolution> {
+        self.run(py, solver, options, callback, None)
+    }
+
+    /// Like `solve`, started from `previous` (primal point and multipliers), e.g. after
+    /// `set_value` on parameters in an MPC loop. IPM users typically also pass
+    /// `{"warm_start_init_point": True}`-style options by their IPOPT names.
+    #[pyo3(signature = (previous, solver = "ipm", options = None, callback = None))]
+    fn solve_warm(
+        &mut self,
+        py: Python<'_>,
+        previous: &PySolution,
+        solver: &str,
+        options: Option<&Bound<'_, PyDict>>,
+        callback: Option<Py<PyAny>>,
+    ) -> PyResult<PySolution> {
+        self.run(py, solver, options, callback, Some(previous))
+    }
+
+    /// The state pickle uses: the recorded builder calls with printed expressions.
+    fn to_json(&self) -> PyResult<String> {
+        let steps: Vec<Step<String>> = self
+            .steps
+            .iter()
+            .map(|s| s.map(|e| Ok::<_, PyErr>(e.to_string())))
+            .collect::<PyResult<_>>()?;
+        serde_json::to_string(&steps).map_err(build_err)
+    }
+
+    /// Rebuilds a problem from `to_json`'s text (in this thread's graph).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<PyProblem> {
+        let steps: Vec<Step<String>> = serde_json::from_str(text).map_err(build_err)?;
+        let mut p = PyProblem::new();
+        for s in steps {
+            let symbols: Vec<Expr> =
+                p.pb.variables()
+                    .iter()
+                    .chain(p.pb.parameters())
+                    .copied()
+                    .collect();
+            let live = s.map(|t| symx::parse(t, &symbols).map_err(build_err))?;
+            p.apply(live)?;
+        }
+        Ok(p)
+    }
+
+    fn __reduce__(slf: &Bound<'_, Self>) -> PyResult<(Py<PyAny>, (String,))> {
+        let f = slf.get_type().getattr("from_json")?;
+        Ok((f.unbind(), (slf.borrow().to_json()?,)))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Problem({} variables, {} constraints)",
+            self.pb.n_variables(),
+            self.pb.n_constraints()
+        )
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyProblem>()
+}
