@@ -122,12 +122,14 @@ pub struct PyProblem {
     pb: nlp::Problem,
     steps: Vec<Step<Expr>>,
     compiled: Option<Compiled>,
+    sensitivity: Option<nlp::ParametricSensitivity>,
 }
 
 impl PyProblem {
     fn structural(&mut self, step: Step<Expr>) {
         self.steps.push(step);
         self.compiled = None;
+        self.sensitivity = None;
     }
 
     fn apply(&mut self, step: Step<Expr>) -> PyResult<()> {
@@ -318,6 +320,7 @@ impl PyProblem {
             pb: nlp::Problem::new(),
             steps: Vec::new(),
             compiled: None,
+            sensitivity: None,
         }
     }
 
@@ -461,6 +464,29 @@ impl PyProblem {
         self.apply(Step::DetectSimpleBounds { on })
     }
 
+    /// The variable or parameter declared as `name`, as a column of its entries (for a
+    /// problem rebuilt from pickle or `from_json`, whose handles the caller does not hold).
+    fn lookup(&self, name: &str) -> PyResult<PyExpr> {
+        let prefix = format!("{name}[");
+        let found: Vec<Expr> = self
+            .pb
+            .variables()
+            .iter()
+            .chain(self.pb.parameters())
+            .copied()
+            .filter(|e| {
+                e.name()
+                    .is_some_and(|n| n == name || n.starts_with(&prefix))
+            })
+            .collect();
+        if found.is_empty() {
+            return Err(crate::error::BuildError::new_err(format!(
+                "lookup: no variable or parameter named '{name}'"
+            )));
+        }
+        Ok(PyExpr::new(symx::Matrix::from_vec(found)))
+    }
+
     /// Number of variables (entries).
     #[getter]
     fn n_variables(&self) -> usize {
@@ -510,6 +536,46 @@ impl PyProblem {
         self.run(py, solver, options, callback, Some(previous))
     }
 
+    /// Parametric sensitivities of a converged `solution` of this problem at its current
+    /// parameter values: a dict with `dx_dp` (array n × n_p, `[i, j] = ∂x*ᵢ/∂pⱼ`, parameters
+    /// in declaration order), `dlam_g_dp` (m × n_p), `active_rows`, `active_bounds`,
+    /// `weakly_active` (where the solution is not differentiable) and `residual`.
+    /// The derivatives are compiled at the first call and reused. Releases the GIL.
+    fn sensitivity<'py>(
+        &mut self,
+        py: Python<'py>,
+        solution: &PySolution,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        self.ensure_compiled(py)?;
+        let p = self
+            .compiled
+            .as_ref()
+            .expect("compiled above")
+            .parameter_values()
+            .to_vec();
+        if self.sensitivity.is_none() {
+            let pb = SameThread(&self.pb);
+            let ps = py.allow_threads(move || {
+                let pb = pb;
+                nlp::ParametricSensitivity::new(pb.0)
+            });
+            self.sensitivity = Some(ps.map_err(build_err)?);
+        }
+        let ps = self.sensitivity.as_mut().expect("built above");
+        let sol = &solution.inner;
+        let s = py
+            .allow_threads(|| ps.compute(sol, &p))
+            .map_err(solve_err)?;
+        let d = PyDict::new(py);
+        d.set_item("dx_dp", columns(py, &s.dx_dp)?)?;
+        d.set_item("dlam_g_dp", columns(py, &s.dlambda_dp)?)?;
+        d.set_item("active_rows", s.active_rows.clone())?;
+        d.set_item("active_bounds", s.active_bounds.clone())?;
+        d.set_item("weakly_active", s.weakly_active.clone())?;
+        d.set_item("residual", s.residual)?;
+        Ok(d)
+    }
+
     /// The state pickle uses: the recorded builder calls with printed expressions.
     fn to_json(&self) -> PyResult<String> {
         let steps: Vec<Step<String>> = self
@@ -550,6 +616,19 @@ impl PyProblem {
             self.pb.n_constraints()
         )
     }
+}
+
+/// Columns `cols[j]` (each of one length) as a 2-D array with those columns.
+fn columns(py: Python<'_>, cols: &[Vec<f64>]) -> PyResult<Py<PyAny>> {
+    let rows = cols.first().map_or(0, Vec::len);
+    let flat: Vec<f64> = cols.iter().flatten().copied().collect();
+    let a = numpy::IntoPyArray::into_pyarray(flat, py);
+    let m = numpy::PyArrayMethods::reshape_with_order(
+        &a,
+        [rows, cols.len()],
+        numpy::npyffi::NPY_ORDER::NPY_FORTRANORDER,
+    )?;
+    Ok(m.into_any().unbind())
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

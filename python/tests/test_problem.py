@@ -176,3 +176,24 @@ def test_problem_is_bound_to_its_thread():
     t.start()
     t.join()
     assert err  # must not silently touch another thread's graph
+
+
+def test_sensitivity_against_finite_differences():
+    def solve_at(y1):
+        pb = s.Problem()
+        ys, ends = build_chain(pb, s, n=10)
+        pb.set_value(ends, [0.0, 1.0, 1.0, y1])
+        sol = pb.solve(options={"tol": 1e-12})
+        assert sol.success
+        return pb, sol
+
+    pb, sol = solve_at(0.5)
+    sens = pb.sensitivity(sol)
+    dx = sens["dx_dp"]
+    assert dx.shape == (pb.n_variables, 4)
+    h = 1e-5
+    fd = (solve_at(0.5 + h)[1].x - solve_at(0.5 - h)[1].x) / (2 * h)
+    # Central differences of solutions converged to 1e-12: error O(h²) + O(1e-12/h)
+    # ≈ 1e-7; 1e-5 separates a wrong derivative from that noise.
+    np.testing.assert_allclose(dx[:, 3], fd, atol=1e-5)
+    assert not sens["weakly_active"]
