@@ -116,16 +116,64 @@ fn finite(v: f64) -> Option<f64> {
 /// The problem is compiled (gradient, sparse Jacobian and Hessian) at the first solve
 /// and the compiled form is reused while only initial values and parameter values change
 /// (`set_initial`, `set_value`); any structural call recompiles at the next solve.
-/// Problems are bound to the thread that built them; pickle them to use elsewhere.
-#[pyclass(name = "Problem", module = "symnlp", unsendable)]
+/// A problem belongs to the thread that built it (its expressions live in that thread's
+/// graph); using it from another thread raises `BuildError`. Pickle it to use it
+/// elsewhere: an unpickled problem is rebuilt in the first thread that uses it.
+#[pyclass(name = "Problem", module = "symnlp")]
 pub struct PyProblem {
+    /// The thread whose graph holds `pb`'s expressions.
+    owner: std::thread::ThreadId,
+    /// An unpickled problem's `to_json` text, replayed by the first thread that uses it.
+    pending: Option<String>,
     pb: nlp::Problem,
     steps: Vec<Step<Expr>>,
     compiled: Option<Compiled>,
     sensitivity: Option<nlp::ParametricSensitivity>,
 }
 
+// SAFETY: the thread-bound fields (expressions indexing the owner's graph) are only read
+// or written after `bind` checked that the calling thread is `owner` (or rebuilt them in
+// the calling thread). Other threads can only move or drop a problem, and dropping touches
+// no graph: `Expr` is an index, and no type of nlp or symx held here implements `Drop`
+// with graph access.
+unsafe impl Send for PyProblem {}
+// SAFETY: as above; the methods taking `&self` (`__repr__`, `bounded`) read no expression.
+unsafe impl Sync for PyProblem {}
+
 impl PyProblem {
+    /// Makes the problem usable on this thread: replays a pending (unpickled) problem
+    /// here, or checks that this thread built it.
+    fn bind(&mut self) -> PyResult<()> {
+        if let Some(text) = self.pending.take() {
+            *self = PyProblem::replay(&text)?;
+            return Ok(());
+        }
+        if self.owner != std::thread::current().id() {
+            return Err(crate::error::BuildError::new_err(
+                "this Problem was built on another thread and its expressions live there; \
+                 pickle it (or use to_json/from_json) to use it on this thread",
+            ));
+        }
+        Ok(())
+    }
+
+    /// A problem rebuilt from `to_json`'s text in this thread's graph.
+    fn replay(text: &str) -> PyResult<PyProblem> {
+        let steps: Vec<Step<String>> = serde_json::from_str(text).map_err(build_err)?;
+        let mut p = PyProblem::new();
+        for s in steps {
+            let symbols: Vec<Expr> =
+                p.pb.variables()
+                    .iter()
+                    .chain(p.pb.parameters())
+                    .copied()
+                    .collect();
+            let live = s.map(|t| symx::parse(t, &symbols).map_err(build_err))?;
+            p.apply(live)?;
+        }
+        Ok(p)
+    }
+
     fn structural(&mut self, step: Step<Expr>) {
         self.steps.push(step);
         self.compiled = None;
@@ -234,6 +282,7 @@ impl PyProblem {
         callback: Option<Py<PyAny>>,
         warm: Option<&PySolution>,
     ) -> PyResult<PySolution> {
+        self.bind()?;
         let backend = make_solver(solver, options)?;
         self.ensure_compiled(py)?;
         let names = self.names();
@@ -317,6 +366,8 @@ impl PyProblem {
     #[new]
     fn new() -> PyProblem {
         PyProblem {
+            owner: std::thread::current().id(),
+            pending: None,
             pb: nlp::Problem::new(),
             steps: Vec::new(),
             compiled: None,
@@ -327,6 +378,7 @@ impl PyProblem {
     /// Declares `rows × cols` variables named `name[i]` (unbounded, initial value 0).
     #[pyo3(signature = (name, rows = 1, cols = 1))]
     fn variable(&mut self, name: &str, rows: usize, cols: usize) -> PyResult<PyExpr> {
+        self.bind()?;
         let m = self
             .pb
             .variable_matrix(name, rows, cols)
@@ -343,6 +395,7 @@ impl PyProblem {
     /// solving; changing them later does not rebuild the problem.
     #[pyo3(signature = (name, n = 1))]
     fn parameter(&mut self, name: &str, n: usize) -> PyResult<PyExpr> {
+        self.bind()?;
         let m = self.pb.parameter(name, n).map_err(build_err)?;
         self.structural(Step::Parameter {
             name: name.into(),
@@ -353,6 +406,7 @@ impl PyProblem {
 
     /// Sets the objective (a scalar expression) to minimise.
     fn minimize(&mut self, f: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.bind()?;
         let m = operand(f)?;
         let f = PyExpr::new(m).as_scalar("minimize")?;
         self.apply(Step::Minimize { f })
@@ -362,6 +416,7 @@ impl PyProblem {
     /// of them; `name` labels the rows in logs and errors.
     #[pyo3(signature = (constraint, name = None))]
     fn subject_to(&mut self, constraint: &Bound<'_, PyAny>, name: Option<String>) -> PyResult<()> {
+        self.bind()?;
         let parts: Vec<PyRef<'_, PyConstraint>> =
             match constraint.extract::<PyRef<'_, PyConstraint>>() {
                 Ok(c) => vec![c],
@@ -420,6 +475,7 @@ impl PyProblem {
         v: &Bound<'_, PyAny>,
         t: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
+        self.bind()?;
         let v = operand(v)?.entries().to_vec();
         let t = PyExpr::new(operand(t)?).as_scalar("subject_to_cone: t")?;
         self.apply(Step::Cone {
@@ -436,6 +492,7 @@ impl PyProblem {
         a: &Bound<'_, PyAny>,
         b: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
+        self.bind()?;
         let a = PyExpr::new(operand(a)?).as_scalar("complementarity: a")?;
         let b = PyExpr::new(operand(b)?).as_scalar("complementarity: b")?;
         self.apply(Step::Complementarity {
@@ -447,6 +504,7 @@ impl PyProblem {
 
     /// Initial values of variables (a number is repeated over the entries).
     fn set_initial(&mut self, x: &PyExpr, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.bind()?;
         let targets = symbols(&x.m, "set_initial")?;
         let values = Self::values_for(targets.len(), values, "set_initial")?;
         self.apply(Step::Initial { targets, values })
@@ -454,6 +512,7 @@ impl PyProblem {
 
     /// Values of parameters (a number is repeated over the entries). Does not rebuild.
     fn set_value(&mut self, p: &PyExpr, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.bind()?;
         let targets = symbols(&p.m, "set_value")?;
         let values = Self::values_for(targets.len(), values, "set_value")?;
         self.apply(Step::Value { targets, values })
@@ -461,12 +520,14 @@ impl PyProblem {
 
     /// Turns single-variable constraint rows into bounds at compile time (default on).
     fn set_detect_simple_bounds(&mut self, on: bool) -> PyResult<()> {
+        self.bind()?;
         self.apply(Step::DetectSimpleBounds { on })
     }
 
     /// The variable or parameter declared as `name`, as a column of its entries (for a
     /// problem rebuilt from pickle or `from_json`, whose handles the caller does not hold).
-    fn lookup(&self, name: &str) -> PyResult<PyExpr> {
+    fn lookup(&mut self, name: &str) -> PyResult<PyExpr> {
+        self.bind()?;
         let prefix = format!("{name}[");
         let found: Vec<Expr> = self
             .pb
@@ -489,18 +550,21 @@ impl PyProblem {
 
     /// Number of variables (entries).
     #[getter]
-    fn n_variables(&self) -> usize {
-        self.pb.n_variables()
+    fn n_variables(&mut self) -> PyResult<usize> {
+        self.bind()?;
+        Ok(self.pb.n_variables())
     }
 
     /// Number of constraint rows.
     #[getter]
-    fn n_constraints(&self) -> usize {
-        self.pb.n_constraints()
+    fn n_constraints(&mut self) -> PyResult<usize> {
+        self.bind()?;
+        Ok(self.pb.n_constraints())
     }
 
     /// Compiles now (otherwise the first solve does). Releases the GIL.
     fn compile(&mut self, py: Python<'_>) -> PyResult<()> {
+        self.bind()?;
         self.ensure_compiled(py)
     }
 
@@ -546,6 +610,7 @@ impl PyProblem {
         py: Python<'py>,
         solution: &PySolution,
     ) -> PyResult<Bound<'py, PyDict>> {
+        self.bind()?;
         self.ensure_compiled(py)?;
         let p = self
             .compiled
@@ -577,7 +642,12 @@ impl PyProblem {
     }
 
     /// The state pickle uses: the recorded builder calls with printed expressions.
-    fn to_json(&self) -> PyResult<String> {
+    #[pyo3(name = "to_json")]
+    fn json_state(&mut self) -> PyResult<String> {
+        if let Some(text) = &self.pending {
+            return Ok(text.clone());
+        }
+        self.bind()?;
         let steps: Vec<Step<String>> = self
             .steps
             .iter()
@@ -589,27 +659,27 @@ impl PyProblem {
     /// Rebuilds a problem from `to_json`'s text (in this thread's graph).
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<PyProblem> {
-        let steps: Vec<Step<String>> = serde_json::from_str(text).map_err(build_err)?;
+        PyProblem::replay(text)
+    }
+
+    /// What unpickling calls: a problem rebuilt from `text` by the first thread using it.
+    #[staticmethod]
+    fn _from_pickle(text: String) -> PyProblem {
         let mut p = PyProblem::new();
-        for s in steps {
-            let symbols: Vec<Expr> =
-                p.pb.variables()
-                    .iter()
-                    .chain(p.pb.parameters())
-                    .copied()
-                    .collect();
-            let live = s.map(|t| symx::parse(t, &symbols).map_err(build_err))?;
-            p.apply(live)?;
-        }
-        Ok(p)
+        p.pending = Some(text);
+        p
     }
 
     fn __reduce__(slf: &Bound<'_, Self>) -> PyResult<(Py<PyAny>, (String,))> {
-        let f = slf.get_type().getattr("from_json")?;
-        Ok((f.unbind(), (slf.borrow().to_json()?,)))
+        let f = slf.get_type().getattr("_from_pickle")?;
+        Ok((f.unbind(), (slf.borrow_mut().json_state()?,)))
     }
 
     fn __repr__(&self) -> String {
+        if self.pending.is_some() {
+            return "Problem(unpickled, rebuilt at first use)".into();
+        }
+        // Lengths only: no expression is read, so any thread may ask.
         format!(
             "Problem({} variables, {} constraints)",
             self.pb.n_variables(),

@@ -11,10 +11,9 @@ distributed = pytest.importorskip("dask.distributed")
 HEIGHTS = list(np.linspace(0.4, 0.9, 6))  # right-end heights, all within reach (> 0.25)
 
 
-def solve_at(problem_json, height):
-    """Runs on a worker: rebuild the problem (in the executing thread), set the
-    parameter, solve. Returns the picklable Solution."""
-    pb = s.Problem.from_json(problem_json)
+def solve_at(pb, height):
+    """Runs on a worker, with the problem unpickled there: set the parameter, solve.
+    Returns the picklable Solution."""
     pb.set_value(pb.lookup("ends"), [0.0, 1.0, 1.0, height])
     return pb.solve()
 
@@ -22,7 +21,6 @@ def solve_at(problem_json, height):
 def test_dask_sweep_equals_serial_loop():
     pb = s.Problem()
     ys, ends = build_chain(pb, s)
-    text = pb.to_json()
 
     serial = []
     for h in HEIGHTS:
@@ -33,7 +31,7 @@ def test_dask_sweep_equals_serial_loop():
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster, distributed.Client(cluster) as client:
         assert len(client.scheduler_info()["workers"]) == 2
-        futures = client.map(solve_at, [text] * len(HEIGHTS), HEIGHTS, pure=False)
+        futures = client.map(solve_at, [pb] * len(HEIGHTS), HEIGHTS, pure=False)
         remote = client.gather(futures)
 
     for a, b, h in zip(serial, remote, HEIGHTS):

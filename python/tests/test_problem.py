@@ -175,7 +175,7 @@ def test_problem_is_bound_to_its_thread():
     t = threading.Thread(target=other)
     t.start()
     t.join()
-    assert err  # must not silently touch another thread's graph
+    assert err and "another thread" in str(err[0])  # a clear error, not a crash
 
 
 def test_sensitivity_against_finite_differences():
@@ -197,3 +197,18 @@ def test_sensitivity_against_finite_differences():
     # ≈ 1e-7; 1e-5 separates a wrong derivative from that noise.
     np.testing.assert_allclose(dx[:, 3], fd, atol=1e-5)
     assert not sens["weakly_active"]
+
+
+def test_unpickled_problem_is_rebuilt_in_the_thread_that_uses_it():
+    # What Dask distributed does: unpickle on one thread, run the task on another.
+    pb = s.Problem()
+    build_hs071(pb, s)
+    want = pb.solve().objective
+    data = pickle.dumps(pb)
+    box = {}
+    t = threading.Thread(target=lambda: box.update(pb=pickle.loads(data)))
+    t.start()
+    t.join()
+    other = box["pb"]  # unpickled on thread t, used here
+    assert other.solve().objective == want
+    assert other.n_variables == 4
