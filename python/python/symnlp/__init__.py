@@ -1,0 +1,72 @@
+"""symnlp: symbolic nonlinear programming with CasADi's habits, solved in Rust.
+
+Expressions (``sym``, operators, ``sin``, ``jacobian`` ...), compiled ``Function``\\ s,
+the ``Problem`` builder with ``solve(solver="ipm" | "sqp", options={...})`` and
+``Solution``; ``symnlp.gap_crossing`` plans the quadruped gap crossing. Everything is a
+thin wrapper over the Rust crates ``symx``, ``nlp`` and ``gap_crossing``; see
+docs/python.md.
+"""
+from . import _symnlp
+from ._symnlp import (
+    BuildError,
+    Constraint,
+    Expr,
+    Function,
+    OptionError,
+    Problem,
+    Solution,
+    SolveError,
+    SymnlpError,
+    acos,
+    acosh,
+    asin,
+    asinh,
+    atan,
+    atan2,
+    atanh,
+    ceil,
+    cos,
+    cosh,
+    dot,
+    eq,
+    erf,
+    exp,
+    expm1,
+    fabs,
+    floor,
+    fmax,
+    fmin,
+    fmod,
+    ge,
+    gradient,
+    gt,
+    hessian,
+    horzcat,
+    hypot,
+    if_else,
+    jacobian,
+    jacobian_sparsity,
+    le,
+    log,
+    log1p,
+    logic_and,
+    logic_or,
+    lt,
+    ne,
+    norm_2,
+    power,
+    sign,
+    sin,
+    sinh,
+    sq,
+    sqrt,
+    sum1,
+    sumsqr,
+    sym,
+    tan,
+    tanh,
+    vertcat,
+)
+from . import gap_crossing
+
+__all__ = [name for name in dir(_symnlp) if not name.startswith("_")] + ["gap_crossing"]
