@@ -8,6 +8,7 @@
 //! results are bit-identical to the tape's, NaN and infinities included.
 #[cfg(feature = "jit")]
 mod jit;
+mod rust_source;
 
 use crate::error::SymxError;
 use crate::function::Function;
@@ -26,6 +27,7 @@ pub enum Evaluator {
 
 /// The machine code of one function (and of the functions it calls), kept alive as long
 /// as a [`Function`] refers to it.
+#[cfg_attr(not(feature = "jit"), allow(dead_code))] // never built without the feature
 pub(crate) struct NativeCode {
     /// Runs the function on a work vector whose input registers are filled (the tape's
     /// `exec`: template copy included).
