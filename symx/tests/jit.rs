@@ -43,7 +43,7 @@ const SPECIAL: [f64; 14] = [
     f64::INFINITY,
     f64::NEG_INFINITY,
     f64::NAN,
-    0.7853981633974483,
+    std::f64::consts::FRAC_PI_4,
     64.0,
 ];
 
