@@ -33,6 +33,11 @@
 //! exit, for peak-memory measurement (see `memory_run`). benches/reference/ocp_compare.sh
 //! runs both sides and prints the ratios.
 //!
+//! `native_chain`, `native_gap`, `native_quadrotor` (`cargo bench --bench symx_eval --
+//! native`): the tape against native code (`Function::jit`) on ∇f, ∂g/∂x and the
+//! Hessian, with the JIT's compile times (benches/reference/native_casadi.py measures
+//! CasADi's VM and its generated C on the same functions).
+//!
 //! `map` (`cargo bench --bench symx_eval -- map`): 10 000 evaluations of the RK4 step F
 //! with `Function::map`, serial and on 2 threads.
 use criterion::{criterion_group, BenchmarkId, Criterion, SamplingMode};
@@ -517,7 +522,95 @@ fn bench_map(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, bench_gap, bench_ocp, bench_map);
+/// Tape vs native code (`Function::jit`) on ∇f, ∂g/∂x and the Hessian of one problem:
+/// prints the instruction counts, the JIT's compile time per function and the per-call
+/// medians of both evaluators measured alternately (3 rounds of [`per_call`] each, the
+/// median of the rounds), then times both in the criterion group `{group}/eval`.
+fn native_versus_tape(c: &mut Criterion, group: &str, fns: &Compiled, ins: [&[f64]; 3]) {
+    let all: [(&str, &Function, &[&[f64]]); 3] = [
+        ("grad_f", &fns.grad, &ins[..1]),
+        ("jac_g", &fns.jac, &ins[..1]),
+        ("hess_L", &fns.hess, &ins[..]),
+    ];
+    let mut g = c.benchmark_group(format!("{group}/eval"));
+    g.sample_size(20)
+        .measurement_time(Duration::from_secs(3))
+        .warm_up_time(Duration::from_secs(1));
+    for (name, f, args) in all {
+        let t = Instant::now();
+        let native = f.jit().unwrap();
+        let compile = t.elapsed().as_secs_f64();
+        let (mut tape_us, mut jit_us) = (Vec::new(), Vec::new());
+        for _ in 0..3 {
+            tape_us.push(per_call(f, args).0);
+            jit_us.push(per_call(&native, args).0);
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[1]
+        };
+        let (t_tape, t_jit) = (median(&mut tape_us), median(&mut jit_us));
+        eprintln!(
+            "{group} {name:6} instructions {:7}  jit compile {:8.1} ms  tape {t_tape:9.2} us  jit {t_jit:8.2} us  jit/tape {:.3}",
+            f.instruction_count(),
+            1e3 * compile,
+            t_jit / t_tape
+        );
+        for (evaluator, f) in [("tape", f), ("jit", &native)] {
+            let mut out = vec![0.0; f.output_sizes()[0]];
+            let mut work = vec![0.0; f.work_size()];
+            g.bench_function(BenchmarkId::new(name, evaluator), |b| {
+                b.iter(|| {
+                    f.eval(black_box(args), &mut [&mut out], &mut work).unwrap();
+                    black_box(&out);
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+/// `native_chain`, `native_gap`, `native_quadrotor` (`cargo bench --bench symx_eval --
+/// native`): tape vs JIT on the hanging chain (1000 links), the gap-crossing model and the
+/// quadrotor OCP at N = 320 (inlined RK4, the size).
+fn bench_native(c: &mut Criterion) {
+    if selected("native_chain/eval/hess_L") {
+        let (p, x0) = chain(LINKS);
+        let fns = compile(&differentiate(p));
+        let (x, sigma, lambda) = inputs(LINKS, &x0);
+        native_versus_tape(c, "native_chain", &fns, [&x, &sigma, &lambda]);
+    }
+    if selected("native_gap/eval/hess_L") {
+        let m = gap_model(&gap_scenario());
+        let fns = compile(&differentiate(gap_symbolic(&m)));
+        let compiled = m.problem.compile().unwrap();
+        let mut x0 = vec![0.0; compiled.n()];
+        compiled.initial_point(&mut x0);
+        let (x, sigma, lambda) = inputs(compiled.m(), &x0);
+        native_versus_tape(c, "native_gap", &fns, [&x, &sigma, &lambda]);
+    }
+    if selected("native_quadrotor/eval/hess_L") {
+        const STAGES: usize = 320;
+        let o = quadrotor_ocp::build(STAGES, false);
+        let fns = compile(&differentiate(Symbolic {
+            f: o.f,
+            g: o.g,
+            x: o.w,
+        }));
+        let m = (STAGES + 1) * quadrotor_ocp::NX;
+        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(STAGES));
+        native_versus_tape(c, "native_quadrotor", &fns, [&x, &sigma, &lambda]);
+    }
+}
+
+criterion_group!(
+    benches,
+    bench,
+    bench_gap,
+    bench_ocp,
+    bench_map,
+    bench_native
+);
 
 /// With `SYMX_OCP_MEMORY=inlined | calls | none` in the environment the binary builds,
 /// differentiates and compiles the `ocp_chain` problem once (or, for `none`, nothing),

@@ -3,7 +3,7 @@ use crate::numeric::{AffineCone, NumericNlp};
 use crate::parameter::{ParameterIndex, ParameterKey};
 use crate::problem::{row_name, Block, BuildError, ProblemParts};
 use std::sync::Arc;
-use symx::{Expr, Function, Matrix, Sparsity};
+use symx::{Evaluator, Expr, Function, Matrix, Sparsity};
 
 /// A compiled problem: evaluators for f, ∇f, g, the sparse Jacobian of g and the sparse
 /// lower-triangular Lagrangian Hessian, with fixed sparsity and their own work space.
@@ -39,6 +39,14 @@ pub struct Compiled {
     /// of the entries' Jacobian (`None` without affine cones).
     affine_cones: Vec<AffineCone>,
     cone_fns: Option<Arc<ConeEvaluators>>,
+}
+
+/// Options of [`Problem::compile_with`](crate::Problem::compile_with).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CompileOptions {
+    /// How the compiled functions evaluate: the tape (default) or native code compiled by
+    /// Cranelift ([`Evaluator::Jit`], bit-identical values, so identical iterates).
+    pub evaluator: Evaluator,
 }
 
 /// Evaluators of the affine cones' stacked entries `[t; v]` and of their Jacobian.
@@ -122,6 +130,43 @@ impl Compiled {
             affine_cones,
             cone_fns,
         })
+    }
+
+    /// This problem with every evaluator (f, ∇f, g, the Jacobian, the Hessian and the cone
+    /// functions) evaluated by `evaluator`; the values are bit-identical, so any solver
+    /// takes identical iterates. `Err` if native code cannot be generated (e.g. symx built
+    /// without its `jit` feature).
+    ///
+    /// ```
+    /// use nlp::{Ipm, Problem, Solver};
+    /// use symx::Evaluator;
+    /// let mut p = Problem::new();
+    /// let x = p.variable("x", 2).unwrap();
+    /// p.minimize((1.0 - x[0]).sq() + 100.0 * (x[1] - x[0].sq()).sq());
+    /// let mut c = p.compile().unwrap().with_evaluator(Evaluator::Jit).unwrap();
+    /// let sol = Ipm::default().solve(&mut c).unwrap();
+    /// assert!((sol.x[0] - 1.0).abs() < 1e-6);
+    /// ```
+    pub fn with_evaluator(mut self, evaluator: Evaluator) -> Result<Compiled, BuildError> {
+        let convert = |f: &Function| f.with_evaluator(evaluator).map(Arc::new);
+        self.f_fn = convert(&self.f_fn)?;
+        self.grad_fn = convert(&self.grad_fn)?;
+        self.g_fn = convert(&self.g_fn)?;
+        self.jac_fn = convert(&self.jac_fn)?;
+        self.hess_fn = convert(&self.hess_fn)?;
+        if let Some(c) = &self.cone_fns {
+            self.cone_fns = Some(Arc::new(ConeEvaluators {
+                entries: c.entries.with_evaluator(evaluator)?,
+                jacobian: c.jacobian.with_evaluator(evaluator)?,
+                jacobian_sparsity: c.jacobian_sparsity.clone(),
+            }));
+        }
+        Ok(self)
+    }
+
+    /// How the evaluators evaluate (see [`Compiled::with_evaluator`]).
+    pub fn evaluator(&self) -> Evaluator {
+        self.hess_fn.evaluator()
     }
 
     /// Sets parameter values (finite numbers), by handle or by name: the same call as

@@ -27,7 +27,7 @@ pub mod sqp;
 mod test_support;
 
 pub use callback::{IterationCallback, IterationView, PhaseLabel};
-pub use compiled::Compiled;
+pub use compiled::{CompileOptions, Compiled};
 pub use constraint::{bounded, Constraint, Relation};
 pub use derivative_check::{check_derivatives, DerivativeCheckOptions, DerivativeReport};
 pub use dump::{DumpError, DumpVerification, ProblemDump};

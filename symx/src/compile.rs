@@ -253,6 +253,7 @@ pub(crate) fn compile(
         call_scratch,
         dependencies: OnceLock::new(),
         jacobians: Default::default(),
+        native: None,
     })
 }
 

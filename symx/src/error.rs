@@ -44,6 +44,10 @@ pub enum SymxError {
     /// Bad data for a lookup table ([`crate::Interpolant`]).
     #[error("interpolant: {reason}")]
     Table { reason: String },
+    /// Native code could not be generated ([`crate::Function::jit`]), or symx was built
+    /// without its `jit` feature.
+    #[error("native code generation failed: {message}")]
+    Jit { message: String },
     /// A syntax error in [`crate::parse`].
     #[error("parse error at byte {position}: {message}")]
     Parse { position: usize, message: String },

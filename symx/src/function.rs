@@ -28,6 +28,7 @@ use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::graph;
+use crate::native::{self, Evaluator, NativeCode};
 use crate::op::{self, Op};
 use crate::sparsity::{pattern_from_entries, Sparsity};
 use crate::table::Table;
@@ -92,6 +93,8 @@ pub struct Function {
     /// The Jacobian functions used to differentiate calls of this function, by the set
     /// of input entries differentiated (built on first use; shared by clones).
     pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
+    /// Machine code computing what the tape computes (see [`Function::jit`]).
+    pub(crate) native: Option<Arc<NativeCode>>,
 }
 
 /// The output slices as raw pointers, for [`Function::run`]: `&mut [f64]` and
@@ -212,6 +215,61 @@ impl Function {
     /// outputs and the temporaries (reused by liveness).
     pub fn work_size(&self) -> usize {
         self.work_size
+    }
+
+    /// This function evaluated by machine code compiled from its tape (and the tapes of the
+    /// functions it calls) with Cranelift: same inputs, outputs, work vector and
+    /// allocation-free, `Send + Sync` evaluation, bit-identical results (the same IEEE
+    /// operations in the same order, and the very Rust math functions the tape calls). The
+    /// tape is kept as the reference ([`Function::tape`] gives it back). Compile time is
+    /// linear in the tape's length (the tape is compiled in chunks).
+    ///
+    /// `Err` if symx was built without its default `jit` feature, or if Cranelift fails
+    /// (e.g. an unsupported processor).
+    ///
+    /// ```
+    /// use symx::{Evaluator, Function, Matrix};
+    /// let x = Matrix::sym_vec("x", 2);
+    /// let f = Function::new(&[&x], &[&[(x[0] * x[1]).sin() + x[1].powi(3)]]).unwrap();
+    /// let native = f.jit().unwrap();
+    /// assert_eq!(native.evaluator(), Evaluator::Jit);
+    /// let (a, b) = (f.call(&[&[0.3, 1.7]]).unwrap(), native.call(&[&[0.3, 1.7]]).unwrap());
+    /// assert_eq!(a[0][0].to_bits(), b[0][0].to_bits());
+    /// ```
+    pub fn jit(&self) -> Result<Function, SymxError> {
+        if self.native.is_some() {
+            return Ok(self.clone());
+        }
+        let code = native::compile(self)?;
+        Ok(Function {
+            native: Some(Arc::new(code)),
+            ..self.clone()
+        })
+    }
+
+    /// This function evaluated by `evaluator`: [`Function::jit`] or [`Function::tape`].
+    pub fn with_evaluator(&self, evaluator: Evaluator) -> Result<Function, SymxError> {
+        match evaluator {
+            Evaluator::Tape => Ok(self.tape()),
+            Evaluator::Jit => self.jit(),
+        }
+    }
+
+    /// This function evaluated by its tape (the interpreter; native code dropped).
+    pub fn tape(&self) -> Function {
+        Function {
+            native: None,
+            ..self.clone()
+        }
+    }
+
+    /// How this function evaluates.
+    pub fn evaluator(&self) -> Evaluator {
+        if self.native.is_some() {
+            Evaluator::Jit
+        } else {
+            Evaluator::Tape
+        }
     }
 
     /// Number of tape instructions: one per operation, plus one copy per output entry that
@@ -375,6 +433,10 @@ impl Function {
     /// `w` must point to at least `work_size` numbers.
     #[inline(always)]
     pub(crate) unsafe fn exec(&self, w: *mut f64) {
+        if let Some(native) = &self.native {
+            // SAFETY: the code does what the tape does (same registers, same template).
+            return (native.entry)(w);
+        }
         std::ptr::copy_nonoverlapping(
             self.template.as_ptr(),
             w.add(self.template_start),

@@ -317,6 +317,7 @@ impl Function {
             call_scratch: n + 1,
             dependencies: OnceLock::new(),
             jacobians: Default::default(),
+            native: None,
         }
     }
 

@@ -34,6 +34,7 @@ mod interpolant;
 mod linalg;
 mod map;
 mod matrix;
+mod native;
 mod op;
 mod simplify;
 pub mod sparsity;
@@ -49,6 +50,7 @@ pub use graph::{node_count, with_fresh_arena};
 pub use interpolant::{Interpolant, Interpolant2, InterpolantN};
 pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
+pub use native::Evaluator;
 pub use op::Op;
 pub use sparsity::Sparsity;
 

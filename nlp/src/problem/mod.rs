@@ -13,7 +13,7 @@ pub use complementarity::ComplementarityReport;
 pub use cone::{Cone, CONE_SMOOTHING};
 pub use error::BuildError;
 
-use crate::compiled::Compiled;
+use crate::compiled::{CompileOptions, Compiled};
 use crate::constraint::{Constraint, Row};
 use crate::parameter::{ParameterIndex, ParameterKey};
 use crate::solution::Solution;
@@ -519,6 +519,22 @@ impl Problem {
             return Err(e);
         }
         Compiled::new(self.parts()?, f, params)
+    }
+
+    /// As [`Problem::compile`], with options: e.g. native evaluators, so that every solver
+    /// evaluates with machine code without other changes.
+    ///
+    /// ```
+    /// use nlp::{CompileOptions, Problem};
+    /// use symx::Evaluator;
+    /// let mut p = Problem::new();
+    /// let x = p.variable("x", 1).unwrap();
+    /// p.minimize((x[0] - 2.0).sq());
+    /// let options = CompileOptions { evaluator: Evaluator::Jit };
+    /// assert_eq!(p.compile_with(options).unwrap().evaluator(), Evaluator::Jit);
+    /// ```
+    pub fn compile_with(&self, options: CompileOptions) -> Result<Compiled, BuildError> {
+        self.compile()?.with_evaluator(options.evaluator)
     }
 
     /// The pieces [`Compiled::new`] needs, after simple bound detection.

@@ -1,0 +1,151 @@
+"""CasADi's SX virtual machine and CasADi's generated C (gcc -O3 -march=native, called in a
+C loop) against symx's tape and JIT, side by side in one run, on the gap-crossing model's
+grad_f, jac_g and hess_L (the functions, point and checksums of benches/symx_eval.rs's
+`symx_eval_gap` group; issue 24).
+
+For each function:
+  * CasADi VM: `internal_us` as in symx_eval_gap_casadi.py (record_time's t_wall_total,
+    median of calls, median of repetitions);
+  * CasADi C: `Function.generate` (default options), compile time of `gcc -O3
+    -march=native -c`, then a C driver calls the function 7 x K times at the same point and
+    prints the median of the per-round medians (µs per call) and a checksum;
+  * symx: runs `cargo bench --bench symx_eval -- native_gap` (the `native_gap` lines: JIT
+    compile time, tape and JIT per-call medians) right after, and prints the ratios.
+
+Run (takes several minutes, mostly gcc):
+  cargo build --release -p gap_crossing --example export
+  python3 benches/reference/native_casadi.py --export-bin target/release/examples/export
+"""
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import casadi as ca
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from eval_timing import internal_times  # noqa: E402
+from symx_eval_gap_casadi import build_all  # noqa: E402
+
+DRIVER = r"""
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+typedef long long casadi_int;
+int NAME(const double** arg, double** res, casadi_int* iw, double* w, int mem);
+int NAME_work(casadi_int* sz_arg, casadi_int* sz_res, casadi_int* sz_iw, casadi_int* sz_w);
+static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
+static int cmp(const void* a, const void* b) { double x = *(const double*)a, y = *(const double*)b; return (x > y) - (x < y); }
+int main(int argc, char** argv) {
+  /* argv: input file (all inputs' doubles stacked), input sizes..., then "--", output nnz */
+  FILE* f = fopen(argv[1], "rb");
+  int nin = 0; long sizes[8]; int k = 2;
+  while (argv[k][0] != '-') sizes[nin++] = atol(argv[k++]);
+  long nout = atol(argv[k + 1]);
+  const double* arg[16]; double* res[16];
+  for (int i = 0; i < nin; i++) { double* a = malloc(8 * (sizes[i] + 1)); fread(a, 8, sizes[i], f); arg[i] = a; }
+  double* out = calloc(nout + 1, 8); res[0] = out;
+  casadi_int sa, sr, si, sw; NAME_work(&sa, &sr, &si, &sw);
+  casadi_int* iw = calloc(si + 1, sizeof(casadi_int)); double* w = calloc(sw + 1, 8);
+  for (int i = nin; i < sa; i++) arg[i] = 0;
+  for (int i = 1; i < sr; i++) res[i] = 0;
+  double t0 = now(); NAME(arg, res, iw, w, 0); double once = now() - t0;
+  int calls = (int)(0.3 / once); if (calls < 10) calls = 10; if (calls > 300) calls = 300;
+  double medians[7]; double* times = malloc(sizeof(double) * calls);
+  for (int r = 0; r < 7; r++) {
+    for (int c = 0; c < calls; c++) { double t = now(); NAME(arg, res, iw, w, 0); times[c] = now() - t; }
+    qsort(times, calls, sizeof(double), cmp); medians[r] = times[calls / 2];
+  }
+  qsort(medians, 7, sizeof(double), cmp);
+  double sum = 0; for (long i = 0; i < nout; i++) sum += out[i];
+  printf("%.6f %.16e\n", 1e6 * medians[3], sum);
+  return 0;
+}
+"""
+
+
+def casadi_c(name, F, inputs, out_nnz, tmp):
+    cwd = os.getcwd()
+    os.chdir(tmp)
+    try:
+        F.generate(f"{name}.c")
+    finally:
+        os.chdir(cwd)
+    src = os.path.join(tmp, f"{name}.c")
+    t = time.perf_counter()
+    subprocess.run(["gcc", "-O3", "-march=native", "-c", src, "-o", src + ".o"], check=True)
+    gcc_s = time.perf_counter() - t
+    drv = os.path.join(tmp, f"{name}_main.c")
+    with open(drv, "w") as fh:
+        fh.write(DRIVER.replace("NAME", name))
+    exe = os.path.join(tmp, name)
+    subprocess.run(["gcc", "-O2", drv, src + ".o", "-o", exe, "-lm"], check=True)
+    data = os.path.join(tmp, f"{name}.bin")
+    np.concatenate([np.atleast_1d(np.asarray(a, dtype=float)) for a in inputs]).tofile(data)
+    sizes = [str(np.atleast_1d(a).size) for a in inputs]
+    out = subprocess.run([exe, data, *sizes, "--", str(out_nnz)], check=True,
+                         stdout=subprocess.PIPE, text=True).stdout.split()
+    return gcc_s, float(out[0]), float(out[1]), os.path.getsize(src)
+
+
+def run(d, args):
+    (x, f, g), funcs, syms, _, exprs = build_all(d)
+    n, m = d["n"], d["m"]
+    x0 = np.array([v["x0"] for v in d["variables"]])
+    lam0 = np.array([(i + 1) / m for i in range(m)])
+    inputs = {"grad_f": [x0], "jac_g": [x0], "hess_L": [x0, 1.0, lam0]}
+    rows = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, F in zip(["grad_f", "jac_g", "hess_L"], funcs):
+            ins = [ca.DM(a) for a in inputs[name]]
+            nnz = F(*ins).nnz()
+            rec = ca.Function(name + "_timed", exprs[name][0], [exprs[name][1]], {"record_time": True})
+            vm, _, _ = internal_times(rec, ins, 7, 300)
+            gcc_s, c_us, c_sum, size = casadi_c(name, F, inputs[name], nnz, tmp)
+            rows[name] = {"vm_us": vm * 1e6, "c_us": c_us, "gcc_s": gcc_s, "c_sum": c_sum, "c_bytes": size}
+            print(f"{name:7} casadi vm {vm * 1e6:9.2f} us  C {c_us:8.2f} us  gcc {gcc_s:7.1f} s  "
+                  f"({size / 1e6:.1f} MB)  sum {c_sum:.16e}", file=sys.stderr)
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--export-bin", required=True)
+    ap.add_argument("--no-symx", action="store_true", help="skip running the symx bench")
+    args = ap.parse_args()
+    d = json.loads(subprocess.run([args.export_bin], check=True, stdout=subprocess.PIPE).stdout)
+    result = {}
+    sys.setrecursionlimit(1_000_000)
+    threading.stack_size(512 * 1024 * 1024)
+    t = threading.Thread(target=lambda: result.update(rows=run(d, args)))
+    t.start()
+    t.join()
+    rows = result["rows"]
+    if not args.no_symx:
+        log = subprocess.run(["cargo", "bench", "--bench", "symx_eval", "--", "native_gap", "--noplot",
+                              "--warm-up-time", "0.1", "--measurement-time", "0.1"],
+                             check=True, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True).stderr
+        pat = re.compile(r"^native_gap (\w+)\s+instructions\s+(\d+)\s+jit compile\s+([\d.]+) ms\s+tape\s+([\d.]+) us\s+jit\s+([\d.]+) us")
+        for line in log.splitlines():
+            mt = pat.match(line)
+            if mt and mt.group(1) in rows:
+                rows[mt.group(1)].update(instructions=int(mt.group(2)), jit_ms=float(mt.group(3)),
+                                         tape_us=float(mt.group(4)), jit_us=float(mt.group(5)))
+        print("| function | symx tape | symx JIT | CasADi VM | CasADi C (gcc -O3 -march=native) "
+              "| JIT / C | JIT compile | gcc compile |")
+        print("|---|---:|---:|---:|---:|---:|---:|---:|")
+        for name, r in rows.items():
+            print(f"| {name} | {r['tape_us']:.1f} µs | {r['jit_us']:.2f} µs | {r['vm_us']:.1f} µs | "
+                  f"{r['c_us']:.2f} µs | {r['jit_us'] / r['c_us']:.2f} | {r['jit_ms'] / 1e3:.2f} s | "
+                  f"{r['gcc_s']:.1f} s |")
+    print(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,303 @@
+//! [`Function::to_rust`]: a function as a self-contained Rust module for deployment
+//! (`no_std`, no allocation, no dependency: the math functions are the C library's, which
+//! Rust's `std` calls too).
+use crate::error::SymxError;
+use crate::function::Function;
+use crate::op::Op;
+use rustc_hash::FxHashMap;
+use std::fmt::Write;
+
+/// Tape instructions per generated function (keeps rustc's compile time linear).
+const CHUNK: usize = 1024;
+
+/// The C library function computing a unary operation exactly as Rust's `std` does.
+fn libm_unary(op: Op) -> Option<&'static str> {
+    Some(match op {
+        Op::Exp => "exp",
+        Op::Log => "log",
+        Op::Sin => "sin",
+        Op::Cos => "cos",
+        Op::Tan => "tan",
+        Op::Asin => "asin",
+        Op::Acos => "acos",
+        Op::Atan => "atan",
+        Op::Sinh => "sinh",
+        Op::Cosh => "cosh",
+        Op::Tanh => "tanh",
+        Op::Log1p => "log1p",
+        Op::Expm1 => "expm1",
+        Op::Sqrt => "sqrt",
+        Op::Floor => "floor",
+        Op::Ceil => "ceil",
+        _ => return None,
+    })
+}
+
+/// The C library function computing a binary operation exactly as Rust's `std` does.
+fn libm_binary(op: Op) -> Option<&'static str> {
+    Some(match op {
+        Op::Atan2 => "atan2",
+        Op::Hypot => "hypot",
+        Op::Fmod => "fmod",
+        _ => return None,
+    })
+}
+
+struct Writer {
+    out: String,
+    /// Generated function name of each function met, by identity.
+    names: FxHashMap<u64, String>,
+}
+
+impl Writer {
+    /// Emits `f` (callees first) and returns the name of its `exec` function.
+    fn function(&mut self, f: &Function) -> Result<String, SymxError> {
+        if let Some(n) = self.names.get(&f.uid) {
+            return Ok(n.clone());
+        }
+        let mut callees = Vec::new();
+        for c in &f.calls {
+            callees.push(self.function(&c.function)?);
+        }
+        let name = format!("exec{}", self.names.len());
+        let mut chunks = Vec::new();
+        for (k, part) in f.tape.chunks(CHUNK).enumerate() {
+            let chunk = format!("{name}_{k}");
+            let o = &mut self.out;
+            writeln!(o, "#[inline(never)]\nunsafe fn {chunk}(w: *mut f64) {{").unwrap();
+            for ins in part {
+                let r = |i: u32| format!("*w.add({i})");
+                let (a, b, c) = (r(ins.a), r(ins.b), r(ins.c));
+                let v = match ins.op {
+                    Op::Add => format!("{a} + {b}"),
+                    Op::Sub => format!("{a} - {b}"),
+                    Op::Mul => format!("{a} * {b}"),
+                    Op::Div => format!("{a} / {b}"),
+                    Op::Neg => format!("-{a}"),
+                    Op::Sq => format!("{{ let a = {a}; a * a }}"),
+                    Op::Sym => a,
+                    Op::Abs => format!("f64::from_bits(({a}).to_bits() & !(1u64 << 63))"),
+                    Op::Sign => format!("{{ let a = {a}; if a > 0.0 {{ 1.0 }} else if a < 0.0 {{ -1.0 }} else {{ a * 0.0 }} }}"),
+                    Op::Not => format!("b2f({a} == 0.0)"),
+                    Op::Pow => format!("pow_({a}, {b})"),
+                    Op::Min => format!("f64::min({a}, {b})"),
+                    Op::Max => format!("f64::max({a}, {b})"),
+                    Op::Lt => format!("b2f({a} < {b})"),
+                    Op::Le => format!("b2f({a} <= {b})"),
+                    Op::Eq => format!("b2f({a} == {b})"),
+                    Op::Ne => format!("b2f({a} != {b})"),
+                    Op::And => format!("b2f({a} != 0.0 && {b} != 0.0)"),
+                    Op::Or => format!("b2f({a} != 0.0 || {b} != 0.0)"),
+                    Op::StrongMul => format!("{{ let a = {a}; if a == 0.0 {{ 0.0 }} else {{ a * {b} }} }}"),
+                    Op::IfElse => format!("if {a} != 0.0 {{ {b} }} else {{ {c} }}"),
+                    Op::Call => {
+                        let call = &f.calls[ins.d as usize];
+                        let g = &call.function;
+                        let s = f.call_scratch;
+                        let mut p = 0;
+                        for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
+                            for i in 0..n {
+                                writeln!(o, "    *w.add({}) = *w.add({});", s + at + i, call.args[p]).unwrap();
+                                p += 1;
+                            }
+                        }
+                        writeln!(o, "    {}(w.add({s}));", callees[ins.d as usize]).unwrap();
+                        let mut q = 0;
+                        for (&n, &at) in g.output_sizes.iter().zip(&g.output_offsets) {
+                            for i in 0..n {
+                                writeln!(o, "    *w.add({}) = *w.add({});", call.out as usize + q, s + at + i).unwrap();
+                                q += 1;
+                            }
+                        }
+                        continue;
+                    }
+                    op => match (libm_unary(op), libm_binary(op)) {
+                        (Some(h), _) => format!("{h}({a})"),
+                        (_, Some(h)) => format!("{h}({a}, {b})"),
+                        _ => {
+                            return Err(SymxError::Jit {
+                                message: format!(
+                                    "source generation does not support the operation '{}'",
+                                    op.name()
+                                ),
+                            })
+                        }
+                    },
+                };
+                writeln!(o, "    *w.add({}) = {v};", ins.d).unwrap();
+            }
+            writeln!(o, "}}\n").unwrap();
+            chunks.push(chunk);
+        }
+        let o = &mut self.out;
+        writeln!(o, "/// Runs the tape on a work vector whose inputs are filled.\nunsafe fn {name}(w: *mut f64) {{").unwrap();
+        let t: Vec<String> = f.template.iter().map(|v| lit(*v)).collect();
+        writeln!(
+            o,
+            "    const TEMPLATE: [f64; {}] = [{}];",
+            t.len(),
+            t.join(", ")
+        )
+        .unwrap();
+        writeln!(
+            o,
+            "    core::ptr::copy_nonoverlapping(TEMPLATE.as_ptr(), w.add({}), {});",
+            f.template_start,
+            t.len()
+        )
+        .unwrap();
+        for c in &chunks {
+            writeln!(o, "    {c}(w);").unwrap();
+        }
+        writeln!(o, "}}\n").unwrap();
+        self.names.insert(f.uid, name.clone());
+        Ok(name)
+    }
+}
+
+/// An `f64` literal with the exact bits of `v`.
+fn lit(v: f64) -> String {
+    format!("f64::from_bits({:#x})", v.to_bits())
+}
+
+const PRELUDE: &str = r#"// The C library's math functions: the ones Rust's std calls, so results equal symx's.
+unsafe extern "C" {
+    fn exp(x: f64) -> f64;
+    fn log(x: f64) -> f64;
+    fn sin(x: f64) -> f64;
+    fn cos(x: f64) -> f64;
+    fn tan(x: f64) -> f64;
+    fn asin(x: f64) -> f64;
+    fn acos(x: f64) -> f64;
+    fn atan(x: f64) -> f64;
+    fn sinh(x: f64) -> f64;
+    fn cosh(x: f64) -> f64;
+    fn tanh(x: f64) -> f64;
+    fn log1p(x: f64) -> f64;
+    fn expm1(x: f64) -> f64;
+    fn sqrt(x: f64) -> f64;
+    fn floor(x: f64) -> f64;
+    fn ceil(x: f64) -> f64;
+    fn atan2(y: f64, x: f64) -> f64;
+    fn hypot(x: f64, y: f64) -> f64;
+    fn fmod(x: f64, y: f64) -> f64;
+    fn pow(x: f64, y: f64) -> f64;
+}
+
+// Integer powers as Rust's `f64::powi` computes them (compiler-builtins).
+unsafe extern "C" {
+    fn __powidf2(a: f64, b: i32) -> f64;
+}
+
+#[inline(always)]
+fn b2f(b: bool) -> f64 {
+    if b { 1.0 } else { 0.0 }
+}
+
+/// symx's `pow`: integer exponents up to 64 by `powi`, others by the C library's `pow`.
+#[inline(always)]
+unsafe fn pow_(a: f64, b: f64) -> f64 {
+    if b == trunc(b) && f64::from_bits(b.to_bits() & !(1u64 << 63)) <= 64.0 {
+        __powidf2(a, b as i32)
+    } else {
+        pow(a, b)
+    }
+}
+
+unsafe extern "C" {
+    fn trunc(x: f64) -> f64;
+}
+"#;
+
+impl Function {
+    /// This function as the text of a self-contained Rust module: `no_std`, no allocation,
+    /// no dependency (the math functions are the C library's, which Rust's `std` calls
+    /// too, so the results equal the tape's bit for bit on the same platform, but for the
+    /// sign and payload of NaNs, which rustc need not keep). It defines the constants
+    /// `INPUT_SIZES`, `OUTPUT_SIZES` and `WORK_SIZE` and
+    /// `pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> Result<(), &'static str>`
+    /// (wrong counts or lengths are an `Err` naming the argument). Include it with
+    /// `include!` from a build script's output (docs/dsl.md has the recipe).
+    ///
+    /// `Err` for operations the module cannot compute exactly without a dependency:
+    /// lookup tables, `erf`, `asinh`, `acosh`, `atanh`.
+    pub fn to_rust(&self) -> Result<String, SymxError> {
+        let mut w = Writer {
+            out: String::new(),
+            names: FxHashMap::default(),
+        };
+        let main = w.function(self)?;
+        let mut o = String::new();
+        let list = |v: &[usize]| {
+            v.iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        writeln!(
+            o,
+            "// Generated by symx from the function '{}'. Do not edit.",
+            self.name
+        )
+        .unwrap();
+        writeln!(o, "#[allow(clippy::all, unused_parens, unused_unsafe, unsafe_op_in_unsafe_fn, dead_code)]").unwrap();
+        writeln!(o, "mod generated {{").unwrap();
+        o.push_str(PRELUDE);
+        o.push_str(&w.out);
+        writeln!(
+            o,
+            "/// Entries of each input.\npub const INPUT_SIZES: [usize; {}] = [{}];",
+            self.input_sizes.len(),
+            list(&self.input_sizes)
+        )
+        .unwrap();
+        writeln!(
+            o,
+            "/// Entries of each output.\npub const OUTPUT_SIZES: [usize; {}] = [{}];",
+            self.output_sizes.len(),
+            list(&self.output_sizes)
+        )
+        .unwrap();
+        writeln!(
+            o,
+            "/// Length of the work vector.\npub const WORK_SIZE: usize = {};",
+            self.work_size
+        )
+        .unwrap();
+        let ins = list(&self.input_offsets);
+        let outs = list(&self.output_offsets);
+        write!(
+            o,
+            r#"const INPUT_OFFSETS: [usize; {ni}] = [{ins}];
+const OUTPUT_OFFSETS: [usize; {no}] = [{outs}];
+
+/// Evaluates: `inputs[k]` holds `INPUT_SIZES[k]` numbers, `outputs[k]` `OUTPUT_SIZES[k]`,
+/// `work` at least `WORK_SIZE`. Allocates nothing.
+pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> Result<(), &'static str> {{
+    if inputs.len() != INPUT_SIZES.len() {{ return Err("wrong number of inputs"); }}
+    if outputs.len() != OUTPUT_SIZES.len() {{ return Err("wrong number of outputs"); }}
+    if inputs.iter().zip(INPUT_SIZES).any(|(x, n)| x.len() != n) {{ return Err("an input has the wrong length"); }}
+    if outputs.iter().zip(OUTPUT_SIZES).any(|(y, n)| y.len() != n) {{ return Err("an output has the wrong length"); }}
+    if work.len() < WORK_SIZE {{ return Err("the work vector is too short"); }}
+    for (k, x) in inputs.iter().enumerate() {{
+        work[INPUT_OFFSETS[k]..INPUT_OFFSETS[k] + x.len()].copy_from_slice(x);
+    }}
+    // SAFETY: the work vector holds WORK_SIZE numbers, the bound of every register.
+    unsafe {{ {main}(work.as_mut_ptr()) }};
+    for (k, y) in outputs.iter_mut().enumerate() {{
+        let n = y.len();
+        y.copy_from_slice(&work[OUTPUT_OFFSETS[k]..OUTPUT_OFFSETS[k] + n]);
+    }}
+    Ok(())
+}}
+}}
+#[allow(unused_imports)]
+pub use generated::{{eval, INPUT_SIZES, OUTPUT_SIZES, WORK_SIZE}};
+"#,
+            ni = self.input_offsets.len(),
+            no = self.output_offsets.len(),
+        )
+        .unwrap();
+        Ok(o)
+    }
+}

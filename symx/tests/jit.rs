@@ -1,0 +1,285 @@
+//! Native evaluation ([`Function::jit`]) against the tape, bit for bit: every operation on
+//! ordinary, signed-zero, infinite and NaN operands; random expression graphs (proptest);
+//! derivatives; call nodes (nested), `map`, lookup tables; tapes longer than one chunk.
+//! The tape is the reference: the JIT must perform the same IEEE operations in the same
+//! order and call the same math functions, so no tolerance is allowed anywhere here.
+use proptest::prelude::*;
+use symx::{
+    gradient, hessian, if_else, jacobian, parse, with_fresh_arena, Evaluator, Expr, Function,
+    Interpolant, Interpolant2, InterpolantN, Matrix,
+};
+
+/// Evaluates `f` and its JIT at `point` and asserts every output bit-identical (a NaN's
+/// payload included); returns the outputs.
+fn same_bits(f: &Function, inputs: &[&[f64]]) -> Vec<Vec<f64>> {
+    let native = f.jit().expect("jit");
+    assert_eq!(native.evaluator(), Evaluator::Jit);
+    let want = f.call(inputs).unwrap();
+    let got = native.call(inputs).unwrap();
+    for (k, (w, g)) in want.iter().zip(&got).enumerate() {
+        for (i, (a, b)) in w.iter().zip(g).enumerate() {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "output {k}[{i}]: tape {a:e}, jit {b:e}"
+            );
+        }
+    }
+    want
+}
+
+/// Operands covering signs, zeros of both signs, integers (pow's fast path), large values,
+/// infinities and NaN.
+const SPECIAL: [f64; 14] = [
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    0.5,
+    -2.5,
+    3.0,
+    1e300,
+    -1e-310,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NAN,
+    std::f64::consts::FRAC_PI_4,
+    64.0,
+];
+
+/// Every unary and binary operation, and `if_else`, on every pair of special operands.
+#[test]
+fn every_operation_matches_the_tape_on_special_values() {
+    let x = Expr::sym("x");
+    let y = Expr::sym("y");
+    let z = Expr::sym("z");
+    let unary = [
+        "neg", "sq", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos", "atan", "sinh",
+        "cosh", "tanh", "abs", "sign", "not", "floor", "ceil", "erf", "asinh", "acosh", "atanh",
+        "log1p", "expm1",
+    ];
+    let binary = [
+        "add",
+        "sub",
+        "mul",
+        "div",
+        "pow",
+        "atan2",
+        "min",
+        "max",
+        "lt",
+        "le",
+        "eq",
+        "ne",
+        "and",
+        "or",
+        "strong_mul",
+        "fmod",
+        "hypot",
+    ];
+    let syms = [x, y, z];
+    let mut outs: Vec<Expr> = unary
+        .iter()
+        .map(|n| parse(&format!("{n}(x)"), &syms).unwrap())
+        .chain(
+            binary
+                .iter()
+                .map(|n| parse(&format!("{n}(x,y)"), &syms).unwrap()),
+        )
+        .collect();
+    outs.push(if_else(x, y, z));
+    // Each parsed name really is that operation (the simplifier folds none of them).
+    for (e, n) in outs.iter().zip(unary.iter().chain(&binary)) {
+        assert_eq!(e.op().name(), *n);
+    }
+    let f = Function::new(&[&[x, y, z]], &[&outs]).unwrap();
+    for &a in &SPECIAL {
+        for &b in &SPECIAL {
+            same_bits(&f, &[&[a, b, -b]]);
+        }
+    }
+}
+
+/// A random straight-line program over three symbols: each step applies one of many
+/// operations to earlier values (indices taken modulo the number of values so far).
+fn program() -> impl Strategy<Value = Vec<(u8, usize, usize, usize)>> {
+    prop::collection::vec(
+        (0u8..24, any::<usize>(), any::<usize>(), any::<usize>()),
+        1..200,
+    )
+}
+
+fn build(prog: &[(u8, usize, usize, usize)], v: &mut Vec<Expr>) {
+    for &(op, i, j, k) in prog {
+        let n = v.len();
+        let (a, b, c) = (v[i % n], v[j % n], v[k % n]);
+        v.push(match op {
+            0 => a + b,
+            1 => a * b,
+            2 => a - b,
+            3 => a / b,
+            4 => a.sin(),
+            5 => a.exp(),
+            6 => a.sqrt(),
+            7 => a.ln(),
+            8 => a.powi(3),
+            9 => a.pow(b),
+            10 => a.min(b),
+            11 => a.max(b),
+            12 => if_else(symx::lt(a, b), b, c),
+            13 => a.abs(),
+            14 => a.tanh(),
+            15 => a.atan2(b),
+            16 => -a,
+            17 => a * 0.5 + 1.0,
+            18 => a.sq(),
+            19 => a.sign() * b,
+            20 => a.floor() + c,
+            21 => a.hypot(b),
+            22 => a.cos() * c,
+            _ => (a * b).cos(),
+        });
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    /// Values, gradient and Hessian of random programs: the JIT equals the tape bit for bit
+    /// at random points (NaN and inf arise freely from log, sqrt, division, pow).
+    #[test]
+    fn random_graphs_match_the_tape(prog in program(), p in prop::array::uniform3(-3.0f64..3.0)) {
+        with_fresh_arena(|| {
+            let xs = Matrix::sym_vec("x", 3);
+            let mut v = xs.entries().to_vec();
+            build(&prog, &mut v);
+            let last = *v.last().unwrap();
+            let g = gradient(last, &xs).unwrap();
+            let h = hessian(last, &xs).unwrap();
+            let f = Function::new(&[&xs], &[&v, &g, h.values()]).unwrap();
+            same_bits(&f, &[&p]);
+        });
+    }
+}
+
+/// Derivative functions are functions too: a Jacobian and a Hessian of a model with
+/// transcendental functions, equal bit for bit.
+#[test]
+fn derivatives_match_the_tape() {
+    let x = Matrix::sym_vec("x", 6);
+    let mut g = Vec::new();
+    for i in 0..5 {
+        g.push((x[i] * x[i + 1]).sin() + x[i].exp() / (1.0 + x[i + 1].sq()));
+    }
+    let f = g.iter().fold(Expr::zero(), |s, &e| s + e.sq());
+    let j = jacobian(&g, &x).unwrap();
+    let h = hessian(f, &x).unwrap();
+    let fun = Function::new(&[&x], &[&[f], j.values(), h.values()]).unwrap();
+    let p = [0.1, -0.3, 0.7, 1.1, -2.0, 0.25];
+    same_bits(&fun, &[&p]);
+}
+
+/// Calls of compiled functions (nested two deep, with outputs that are call outputs and
+/// inputs), their derivatives (Jacobian and vector-Jacobian functions called in turn), and
+/// `map` over a JIT-compiled function.
+#[test]
+fn calls_and_maps_match_the_tape() {
+    let x = Matrix::sym_vec("x", 2);
+    let inner = Function::named(
+        "inner",
+        &[("x", &x)],
+        &[("y", &[x[0] * x[1].sin(), x[1].exp() - x[0]])],
+    )
+    .unwrap();
+    let z = Matrix::sym_vec("z", 2);
+    let once = inner.apply(&[&z]).unwrap().remove(0);
+    let twice = inner.apply(&[&once]).unwrap().remove(0);
+    let outer = Function::named(
+        "outer",
+        &[("z", &z)],
+        &[("w", &[twice[0] + once[1], twice[1] * z[0]])],
+    )
+    .unwrap();
+    let u = Matrix::sym_vec("u", 2);
+    let w = outer.apply(&[&u]).unwrap().remove(0);
+    let s = w[0] * w[1] + w[0].sq();
+    let gs = gradient(s, &u).unwrap();
+    let hs = hessian(s, &u).unwrap();
+    let top = Function::new(&[&u], &[&w, &[s], &gs, hs.values(), &[w[0], u[1]]]).unwrap();
+    for p in [
+        [0.3, -0.8],
+        [0.0, -0.0],
+        [f64::NAN, 1.0],
+        [1e3, f64::INFINITY],
+    ] {
+        same_bits(&top, &[&p]);
+    }
+    // map: 5 points, serial and on 2 threads.
+    let native = top.jit().unwrap();
+    let xs: Vec<f64> = (0..10).map(|k| 0.1 * k as f64 - 0.4).collect();
+    let n_out: usize = top.output_sizes().iter().sum();
+    let run = |f: &Function, threads| {
+        let map = f.map(5).parallel(threads).unwrap();
+        let mut outs: Vec<Vec<f64>> = f.output_sizes().iter().map(|&n| vec![0.0; 5 * n]).collect();
+        let mut refs: Vec<&mut [f64]> = outs.iter_mut().map(|v| v.as_mut_slice()).collect();
+        let mut work = vec![0.0; map.work_size()];
+        map.eval(&[&xs], &mut refs, &mut work).unwrap();
+        outs.concat()
+    };
+    let want = run(&top, 1);
+    assert_eq!(want.len(), 5 * n_out);
+    for threads in [1, 2] {
+        let got = run(&native, threads);
+        assert!(want
+            .iter()
+            .zip(&got)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+}
+
+/// Lookup tables of one, two and three dimensions (inside and outside their grids) and
+/// their derivatives.
+#[test]
+fn lookup_tables_match_the_tape() {
+    let grid: Vec<f64> = (0..6).map(|k| k as f64 * 0.5).collect();
+    let vals: Vec<f64> = grid.iter().map(|g| (g * 1.3).sin()).collect();
+    let t1 = Interpolant::bspline(&grid, &vals).unwrap();
+    let vals2: Vec<f64> = (0..36).map(|k| (k as f64 * 0.37).cos()).collect();
+    let t2 = Interpolant2::bspline(&grid, &grid, &vals2).unwrap();
+    let vals3: Vec<f64> = (0..216).map(|k| (k as f64 * 0.11).sin()).collect();
+    let t3 = InterpolantN::linear(&[&grid, &grid, &grid], &vals3).unwrap();
+    let x = Matrix::sym_vec("x", 3);
+    let e = t1.eval(x[0]) * t2.eval(x[1], x[2]) + t3.eval(&x).unwrap();
+    let g = gradient(e, &x).unwrap();
+    let f = Function::new(&[&x], &[&[e], &g]).unwrap();
+    for p in [[0.3, 1.2, 2.2], [-1.0, 0.0, 5.0], [2.6, 2.4, 0.1]] {
+        same_bits(&f, &[&p]);
+    }
+}
+
+/// A tape several chunks long (a long chain: values computed in one chunk and read in later
+/// ones, outputs written in every chunk); evaluating twice gives the same bits (no state).
+#[test]
+fn long_tapes_match_the_tape() {
+    let x = Matrix::sym_vec("x", 4);
+    let mut outs = Vec::new();
+    let mut s = x[0];
+    for k in 0..20_000 {
+        s = (s * 0.999 + x[k % 4]).sin() + s.sq() * 1e-3;
+        if k % 997 == 0 {
+            outs.push(s);
+        }
+    }
+    outs.push(s);
+    outs.push(x[1]);
+    let f = Function::new(&[&x], &[&outs]).unwrap();
+    assert!(f.instruction_count() > 50_000);
+    let p = [0.1, 0.2, -0.3, 0.4];
+    let first = same_bits(&f, &[&p]);
+    let native = f.jit().unwrap();
+    let mut work = vec![f64::NAN; native.work_size()];
+    let mut out = vec![0.0; outs.len()];
+    native.eval(&[&p], &mut [&mut out], &mut work).unwrap();
+    assert_eq!(out, first[0]);
+    assert_eq!(native.tape().evaluator(), Evaluator::Tape);
+}

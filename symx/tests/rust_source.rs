@@ -1,0 +1,110 @@
+//! `Function::to_rust`: the generated module is compiled by rustc (as a subprocess, with
+//! `-O`, as a user's release build would) into a program that evaluates it and prints the
+//! outputs' bits; they must equal the tape's bit for bit (same IEEE operations, same C
+//! library math functions as Rust's std), except for the sign and payload of NaNs.
+use std::process::Command;
+use symx::{gradient, hessian, if_else, lt, Function, Matrix, SymxError};
+
+/// Compiles `f.to_rust()` with a `main` evaluating it at `point` and returns the outputs.
+fn run_generated(f: &Function, point: &[f64], tag: &str) -> Vec<f64> {
+    let dir = std::env::temp_dir().join(format!("symx_rust_source_{}_{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let module = f.to_rust().unwrap();
+    std::fs::write(dir.join("generated.rs"), &module).unwrap();
+    let bits: Vec<String> = point
+        .iter()
+        .map(|v| format!("f64::from_bits({:#x})", v.to_bits()))
+        .collect();
+    let main = format!(
+        r#"mod f {{ include!("generated.rs"); }}
+fn main() {{
+    let x = [{}];
+    let mut outs: Vec<Vec<f64>> = f::OUTPUT_SIZES.iter().map(|&n| vec![0.0; n]).collect();
+    let mut refs: Vec<&mut [f64]> = outs.iter_mut().map(|v| v.as_mut_slice()).collect();
+    let mut work = vec![0.0; f::WORK_SIZE];
+    f::eval(&[&x], &mut refs, &mut work).unwrap();
+    assert_eq!(f::eval(&[], &mut refs, &mut work), Err("wrong number of inputs"));
+    assert_eq!(f::INPUT_SIZES.len(), 1);
+    for v in outs.concat() {{ println!("{{:x}}", v.to_bits()); }}
+}}"#,
+        bits.join(", ")
+    );
+    std::fs::write(dir.join("main.rs"), main).unwrap();
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let exe = dir.join("main");
+    let status = Command::new(rustc)
+        .args(["-O", "--edition", "2021", "-o"])
+        .arg(&exe)
+        .arg(dir.join("main.rs"))
+        .status()
+        .expect("rustc runs");
+    assert!(status.success(), "the generated module does not compile");
+    let out = Command::new(&exe).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| f64::from_bits(u64::from_str_radix(l, 16).unwrap()))
+        .collect()
+}
+
+/// Values, gradient and Hessian of a function with transcendental functions, powers,
+/// branches, NaN-producing operations and a call of another function.
+#[test]
+fn generated_rust_matches_the_tape() {
+    let y = Matrix::sym_vec("y", 2);
+    let inner = Function::named(
+        "inner",
+        &[("y", &y)],
+        &[("v", &[y[0].sin() * y[1], y[1].exp() - y[0].powi(3)])],
+    )
+    .unwrap();
+    let x = Matrix::sym_vec("x", 3);
+    let c = inner.apply(&[&[x[0], x[2]]]).unwrap().remove(0);
+    let f = (x[0] * x[1]).cos()
+        + x[2].pow(x[0])
+        + if_else(lt(x[0], x[1]), x[0].atan2(x[2]), x[1].sqrt())
+        + x[1].ln() * c[0]
+        + c[1].tanh()
+        + x[0].hypot(x[1])
+        + x[2].abs().sign()
+        + x[0].min(x[2])
+        + x[1].powi(-2);
+    let g = gradient(f, &x).unwrap();
+    let h = hessian(f, &x).unwrap();
+    let fun = Function::new(&[&x], &[&[f], &g, h.values()]).unwrap();
+    for (k, p) in [
+        [0.3, 1.7, -0.4],
+        [-2.0, 0.5, 3.0],
+        [0.0, -1.0, f64::INFINITY],
+    ]
+    .iter()
+    .enumerate()
+    {
+        let want = fun.call(&[p]).unwrap().concat();
+        let got = run_generated(&fun, p, &k.to_string());
+        assert_eq!(want.len(), got.len());
+        for (i, (a, b)) in want.iter().zip(&got).enumerate() {
+            // A NaN's sign and payload are not kept: rustc may swap the operands of a
+            // commutative operation, and x86 returns the first operand's NaN.
+            let same = a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+            assert!(same, "point {k}, output {i}: tape {a:e}, generated {b:e}");
+        }
+    }
+}
+
+/// Operations without an exact dependency-free counterpart are refused, by name.
+#[test]
+fn unsupported_operations_are_errors() {
+    let x = Matrix::sym_vec("x", 1);
+    let f = Function::new(&[&x], &[&[x[0].erf()]]).unwrap();
+    match f.to_rust() {
+        Err(SymxError::Jit { message }) => assert!(message.contains("erf"), "{message}"),
+        other => panic!("{other:?}"),
+    }
+}

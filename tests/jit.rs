@@ -1,0 +1,170 @@
+//! Native evaluators (`symx::Function::jit`, through `Compiled::with_evaluator`) on whole
+//! problems, against the tape bit for bit: every corpus family at its smallest size, the
+//! gap-crossing model (∇f, Jacobian, Hessian), and solves of the quadrotor and Van der Pol
+//! multiple-shooting examples, whose iterates must be identical (same iteration count, same
+//! solution bits). No tolerance: the JIT performs the tape's operations in the tape's order.
+//! Times are printed for information only (`--nocapture`), never asserted.
+#![allow(dead_code)] // the examples' `main`s are not called here
+
+#[path = "../examples/vdp_multiple_shooting.rs"]
+mod vdp_multiple_shooting;
+
+#[path = "../examples/quadrotor.rs"]
+mod quadrotor;
+
+use std::time::Instant;
+use symnlp::nlp::ocp::{ButcherTableau, Method, Transcription};
+use symnlp::nlp::{Compiled, Ipm, NumericNlp};
+use symnlp::symx::Evaluator;
+
+/// All five evaluations of `c` at `x` (σ = 0.7, λᵢ = (i+1)/m − 0.5), stacked.
+fn evaluations(c: &mut Compiled, x: &[f64]) -> Vec<f64> {
+    let (n, m) = (c.n(), c.m());
+    let mut out = vec![c.eval_f(x)];
+    let mut grad = vec![0.0; n];
+    c.eval_grad_f(x, &mut grad);
+    let mut g = vec![0.0; m];
+    c.eval_g(x, &mut g);
+    let mut jac = vec![0.0; c.jac_g_sparsity().compute_nnz()];
+    c.eval_jac_g(x, &mut jac);
+    let lambda: Vec<f64> = (0..m).map(|i| (i + 1) as f64 / m as f64 - 0.5).collect();
+    let mut hess = vec![0.0; c.hess_l_sparsity().compute_nnz()];
+    c.eval_hess_l(x, 0.7, &lambda, &mut hess);
+    for v in [grad, g, jac, hess] {
+        out.extend(v);
+    }
+    out
+}
+
+/// Compiles `c`'s evaluators natively (timed) and checks them bit for bit against the
+/// tape at the initial point and at a perturbed point; returns the compile time (s).
+fn check_problem(name: &str, c: &Compiled) -> f64 {
+    let t = Instant::now();
+    let mut native = c.clone().with_evaluator(Evaluator::Jit).unwrap();
+    let compile = t.elapsed().as_secs_f64();
+    assert_eq!(native.evaluator(), Evaluator::Jit);
+    let mut tape = c.clone();
+    assert_eq!(tape.evaluator(), Evaluator::Tape);
+    let mut x0 = vec![0.0; c.n()];
+    tape.initial_point(&mut x0);
+    let shifted: Vec<f64> = x0
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v + 0.01 * ((i % 7) as f64 - 3.0))
+        .collect();
+    for x in [&x0, &shifted] {
+        let (want, got) = (evaluations(&mut tape, x), evaluations(&mut native, x));
+        assert_eq!(want.len(), got.len());
+        for (k, (a, b)) in want.iter().zip(&got).enumerate() {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "{name}: entry {k}: tape {a:e}, jit {b:e}"
+            );
+        }
+    }
+    compile
+}
+
+/// Every corpus family at its smallest size (optimal control and CUTEst-style).
+#[test]
+fn corpus_problems_match_the_tape() {
+    let mut families = 0;
+    for family in corpus::families() {
+        let instance = corpus::Instance {
+            family,
+            size: family.sizes[0],
+        };
+        let c = instance.build().unwrap().compile().unwrap();
+        let secs = check_problem(&instance.name(), &c);
+        eprintln!("{}: jit compile {:.3} s", instance.name(), secs);
+        families += 1;
+    }
+    assert!(families > 20, "the corpus has {families} families");
+}
+
+/// The gap-crossing model (crawl, default scenario, 60 stances): ∇f, g, the Jacobian and
+/// the Hessian of the Lagrangian (the functions of `benches/symx_eval.rs`'s gap group).
+#[test]
+fn gap_model_matches_the_tape() {
+    use gap_crossing::model::{self, Formulation};
+    use gap_crossing::{gait, scenario::Scenario, terrain::GapTerrain};
+    let s = Scenario::default();
+    let m = model::build(
+        &s,
+        &GapTerrain { gap: s.gap },
+        &Formulation::Scheduled(gait::crawl_schedule(s.n_step)),
+        &gait::crawl(&s),
+    )
+    .unwrap();
+    let c = m.problem.compile().unwrap();
+    let secs = check_problem("gap crossing", &c);
+    eprintln!(
+        "gap crossing (n {}, m {}): jit compile of its 5 functions {secs:.2} s",
+        c.n(),
+        c.m()
+    );
+}
+
+/// Solves `tr` with the tape and with native evaluators, three times each, interleaved:
+/// identical iteration counts and solution bits; prints the median times and their ratio.
+fn same_solve(name: &str, tr: &Transcription) {
+    let tape = tr.compile().unwrap();
+    let native = tape.clone().with_evaluator(Evaluator::Jit).unwrap();
+    let mut times = [Vec::new(), Vec::new()];
+    let mut sols = Vec::new();
+    for _ in 0..3 {
+        for (k, c) in [&tape, &native].into_iter().enumerate() {
+            let mut c = c.clone();
+            let t = Instant::now();
+            let sol = Ipm::default().solve(&mut c).unwrap();
+            times[k].push(t.elapsed().as_secs_f64());
+            sols.push(sol);
+        }
+    }
+    let first = &sols[0];
+    for s in &sols[1..] {
+        assert_eq!(s.status, first.status, "{name}: status");
+        assert_eq!(
+            s.stats.iterations, first.stats.iterations,
+            "{name}: iterations"
+        );
+        let same =
+            s.x.iter()
+                .zip(&first.x)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{name}: solutions differ");
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[1]
+    };
+    let (t_tape, t_jit) = (median(&mut times[0]), median(&mut times[1]));
+    eprintln!(
+        "{name}: {} iterations; tape {:.1} ms, jit {:.1} ms, ratio {:.2}",
+        first.stats.iterations,
+        1e3 * t_tape,
+        1e3 * t_jit,
+        t_jit / t_tape
+    );
+}
+
+/// The quadrotor (N = 320, RK4 multiple shooting) and Van der Pol (N = 20, RK4 with four
+/// steps per interval) examples, inlined and through call nodes.
+#[test]
+fn ocp_examples_solve_identically() {
+    same_solve("quadrotor N=320", &quadrotor::transcription(320).unwrap());
+    same_solve(
+        "quadrotor N=320 calls",
+        &quadrotor::transcription_with_calls(320).unwrap(),
+    );
+    let rk4 = || Method::multiple_shooting(ButcherTableau::rk4(), 4);
+    let calls = || Method::multiple_shooting_with_calls(ButcherTableau::rk4(), 4);
+    let vdp = vdp_multiple_shooting::van_der_pol().unwrap();
+    same_solve("van der pol N=20", &vdp.transcribe(&rk4(), 20).unwrap());
+    let vdp = vdp_multiple_shooting::van_der_pol_with_calls().unwrap();
+    same_solve(
+        "van der pol N=20 calls",
+        &vdp.transcribe(&calls(), 20).unwrap(),
+    );
+}
