@@ -420,8 +420,8 @@ pub fn solve_mpcc(
 }
 
 /// [`solve_mpcc`] with a per-iteration callback, forwarded to every phase's solve (see
-/// [`Ipm::solve_with_callback`]); [`IterationView::phase`] tells which phase an iteration
-/// belongs to. [`ControlFlow::Break`] ends the whole driver: the stopped phase's point is
+/// [`Ipm::solve_with_callback`](crate::Ipm::solve_with_callback));
+/// [`IterationView::phase`] tells which phase an iteration belongs to. [`ControlFlow::Break`] ends the whole driver: the stopped phase's point is
 /// returned with status [`Status::UserRequestedStop`] and no later phase runs.
 pub fn solve_mpcc_with_callback(
     problem: &Problem,
