@@ -1,12 +1,10 @@
 #!/usr/bin/env bash
-# Runs every test of the repository: the Rust workspace, then the Python package's pytest
-# suite in a virtual environment under .venv (created on first use; re-runs reuse it and
-# only rebuild what changed). Extra arguments go to pytest, e.g. `scripts/test.sh -k hs071`.
+# Runs the Python package's pytest suite in a virtual environment under .venv (created on
+# first use; re-runs reuse it and only rebuild what changed). The README's test command runs
+# it after `cargo test --workspace --release`, whose release artefacts the package build
+# reuses. Extra arguments go to pytest, e.g. `scripts/test-python.sh -k hs071`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-
-echo "== cargo test --workspace --release"
-cargo test --workspace --release
 
 echo "== Python: .venv, the symnlp package, pytest"
 PY="${PYTHON:-python3}"
