@@ -130,22 +130,30 @@ impl SqpState<'_> {
         gt: &[f64],
         ct: &[f64],
         bound: f64,
+        delta: f64,
     ) -> Option<Trial> {
         let (m, n_cone) = (self.shape.m, self.shape.n_cone);
         let gh: Vec<f64> = (0..m).map(|i| gt[i] - model.jd[i]).collect();
         let chat: Vec<f64> = (0..n_cone).map(|k| ct[k] - model.cd[k]).collect();
-        let (geo, x) = (&self.geo, &self.it.x);
-        let t_qp = Instant::now();
-        let r2 = self
-            .qp
-            .resolve_with_g(x, &geo.x_l, &geo.x_u, &gh, &geo.g_l, &geo.g_u, &chat);
-        self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
-        self.work.n_qp += 1;
-        let r2 = r2.ok()?;
-        self.work.qp_iterations += r2.iterations as u64;
-        if !matches!(r2.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
-            return None;
-        }
+        let start = self.working_set.clone();
+        let r2 = match self.active_set_qp(Some(&gh), delta, start, false) {
+            Some(r) => r,
+            None => {
+                let (geo, x) = (&self.geo, &self.it.x);
+                let t_qp = Instant::now();
+                let r2 = self
+                    .qp
+                    .resolve_with_g(x, &geo.x_l, &geo.x_u, &gh, &geo.g_l, &geo.g_u, &chat);
+                self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
+                self.work.n_qp += 1;
+                let r2 = r2.ok()?;
+                self.work.qp_iterations += r2.iterations as u64;
+                if !matches!(r2.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
+                    return None;
+                }
+                r2
+            }
+        };
         let (xs, fs, gs, cs) = self.evaluate(&r2.d, 1.0);
         let phis = fs + self.geo.penalty(&gs, &cs, &self.merit_w, self.rho);
         (phis.is_finite() && phis <= bound).then_some(Trial {
@@ -206,7 +214,7 @@ impl SqpState<'_> {
                 }
                 if alpha == 1.0 && o.second_order_correction && pred > 0.0 {
                     let bound = phi0 - o.armijo * pred + slack;
-                    if let Some(t) = self.second_order_correction(&model, &gt, &ct, bound) {
+                    if let Some(t) = self.second_order_correction(&model, &gt, &ct, bound, delta) {
                         out.trial = Some(t);
                         out.soc_used = true;
                         return out;

@@ -42,6 +42,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+mod active_set;
 mod bfgs;
 mod convexify;
 mod geometry;

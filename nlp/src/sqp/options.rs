@@ -84,6 +84,14 @@ pub struct SqpOptions {
     /// problem; on reduced Hessians with curvatures far apart its step error stalled the
     /// SQP (docs/performance.md, "SQP on the flagship"). Default true.
     pub qp_polish: bool,
+    /// Solve each QP first with the warm-started primal-dual active-set method over the
+    /// faer LDLᵀ (from the previous QP's working set), and with clarabel only when that
+    /// fails (cycling, iteration limit, singular or non-convex working set, a multiplier
+    /// above ρ) or cones or BFGS are in use. Default true.
+    pub qp_active_set: bool,
+    /// Most iterations (factorisations) of the active-set method per QP before clarabel
+    /// takes over. Default 50.
+    pub qp_active_set_max_iter: u32,
 }
 
 crate::frontend::strict_options_serde!(SqpOptions);
@@ -111,6 +119,8 @@ impl Default for SqpOptions {
             qp_max_iter: 200,
             elastic_tol: 1e-8,
             qp_polish: true,
+            qp_active_set: true,
+            qp_active_set_max_iter: 50,
         }
     }
 }
@@ -178,6 +188,9 @@ impl SqpOptions {
         }
         if self.qp_max_iter == 0 {
             return Err(bad("qp_max_iter", "must be at least 1"));
+        }
+        if self.qp_active_set_max_iter == 0 {
+            return Err(bad("qp_active_set_max_iter", "must be at least 1"));
         }
         Ok(())
     }

@@ -26,8 +26,8 @@ use super::qp::{QpData, QpResult};
 use crate::kkt::Kkt;
 
 /// Side of a row or bound in the working set.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Side {
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub(super) enum Side {
     Free,
     Lower,
     Upper,
@@ -36,9 +36,10 @@ enum Side {
 
 /// Clarabel's active set W: the side of each row and bound, active when its multiplier
 /// exceeds its slack (the larger of the complementary pair).
-struct WorkingSet {
-    rows: Vec<Side>,
-    vars: Vec<Side>,
+#[derive(Clone, PartialEq, Eq, Hash, Debug)]
+pub(super) struct WorkingSet {
+    pub rows: Vec<Side>,
+    pub vars: Vec<Side>,
 }
 
 impl WorkingSet {
@@ -95,7 +96,7 @@ impl WorkingSet {
 }
 
 /// J·v for the Jacobian values of `p`.
-fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64]) -> Vec<f64> {
+pub(super) fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64]) -> Vec<f64> {
     let mut jd = vec![0.0; p.g.len()];
     for c in 0..p.x.len() {
         for q in jp.col_range(c) {
@@ -107,8 +108,12 @@ fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64]) -> Vec<f64
 
 /// The equality QP on W: `[B, J_Wᵀ; J_W, 0]·(d, λ) = (−∇f, r_W)`, the bounds of W fixed by
 /// a large diagonal and the zero block recovered from a 1e-10 regularisation by
-/// iterative refinement. `None` unless the inertia is (n, m) and the solve accurate.
-fn equality_qp_step(
+/// iterative refinement. The augmented term of rows and bounds outside W enters exactly:
+/// a row i with weight w_i > 0 gets the diagonal −1/w_i (its multiplier is then
+/// w_i·J_i d, the term's gradient), a bound weight is added to the diagonal of B (rows
+/// and bounds of W need neither: the term is constant on W). `None` unless the inertia is
+/// (n, m) and the solve accurate.
+pub(super) fn equality_qp_step(
     kkt: &mut Kkt,
     p: &QpData,
     w: &WorkingSet,
@@ -118,11 +123,22 @@ fn equality_qp_step(
     let hmax = p.hess.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let big = 1e14 * hmax;
     let dx: Vec<f64> = (0..n)
-        .map(|j| p.shift + if w.vars[j] == Side::Free { 0.0 } else { big })
+        .map(|j| {
+            p.shift
+                + if w.vars[j] == Side::Free {
+                    p.bound_weight[j]
+                } else {
+                    big
+                }
+        })
         .collect();
     const REG: f64 = 1e-10;
     let dc: Vec<f64> = (0..m)
-        .map(|i| if w.rows[i] == Side::Free { 1e20 } else { REG })
+        .map(|i| match (w.rows[i], p.row_weight[i]) {
+            (Side::Free, r) if r > 0.0 => 1.0 / r,
+            (Side::Free, _) => 1e20,
+            _ => REG,
+        })
         .collect();
     *n_fact += 1;
     match kkt.factorize(p.hess, &dx, p.jac, &dc) {
@@ -167,24 +183,21 @@ fn equality_qp_step(
         }
     }
     for i in 0..m {
-        if w.rows[i] == Side::Free {
+        if w.rows[i] == Side::Free && p.row_weight[i] == 0.0 {
             lambda[i] = 0.0;
         }
     }
     Some((d, lambda))
 }
 
-/// Bound multipliers from the QP's stationarity, z_l − z_u = B d + ∇f + Jᵀλ (with the
-/// augmented weight ρ_a of an active bound in B: the QP's own bound multiplier, as
-/// clarabel's), and the multiplier tolerance; `None` when a free variable is not
-/// stationary or a bound multiplier of W has the wrong sign.
-fn bound_multipliers(
+/// The QP's stationarity residual without bound multipliers, B d + ∇f + Jᵀλ (with the
+/// bound weights of B; `lambda` the rows' total multipliers, augmented term included).
+pub(super) fn stationarity(
     p: &QpData,
     (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
-    w: &WorkingSet,
     d: &[f64],
     lambda: &[f64],
-) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+) -> Vec<f64> {
     let n = p.x.len();
     let mut s = p.grad.to_vec();
     for c in 0..n {
@@ -200,6 +213,22 @@ fn bound_multipliers(
             s[c] += p.jac[q] * lambda[jp.row_idx()[q]];
         }
     }
+    s
+}
+
+/// Bound multipliers from the QP's stationarity, z_l − z_u = B d + ∇f + Jᵀλ (with the
+/// augmented weight ρ_a of an active bound in B: the QP's own bound multiplier, as
+/// clarabel's), and the multiplier tolerance; `None` when a free variable is not
+/// stationary or a bound multiplier of W has the wrong sign.
+fn bound_multipliers(
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    w: &WorkingSet,
+    d: &[f64],
+    lambda: &[f64],
+) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    let n = p.x.len();
+    let s = stationarity(p, (jp, hp), d, lambda);
     let mut z_l = vec![0.0; n];
     let mut z_u = vec![0.0; n];
     let lam_max = lambda.iter().chain(&s).fold(1.0f64, |a, v| a.max(v.abs()));

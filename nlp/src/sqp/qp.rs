@@ -144,6 +144,9 @@ pub(crate) struct Qp {
     cone_blocks: Vec<(usize, usize)>,
     /// Whether P holds the augmented term ρ_a·J_AᵀJ_A.
     aug: bool,
+    /// Whether the values of the last `load` have not reached clarabel yet (the QP was
+    /// solved by the active-set method): the next clarabel solve updates them all.
+    stale: bool,
     /// Jacobian entries (column, storage position) of each row of g.
     jrows: Vec<Vec<(usize, usize)>>,
     /// Products of the augmented term: (row, position of J_ia, of J_ib, P position).
@@ -485,11 +488,24 @@ impl Qp {
             solver: None,
             cone_blocks: st.cone_blocks.to_vec(),
             aug,
+            stale: false,
             jrows: a.jrows,
             jtj: pl.jtj,
             jac_copy: Vec::new(),
             weight_copy: vec![0.0; m],
         }
+    }
+
+    /// Number of elastic variables.
+    pub fn n_elastic(&self) -> usize {
+        self.n_e
+    }
+
+    /// Writes the values of `data` without solving (the active-set method solved this
+    /// QP): a later [`Qp::resolve_with_g`] then hands all of them to clarabel.
+    pub fn load(&mut self, data: &QpData) {
+        self.fill(data);
+        self.stale = true;
     }
 
     /// Whether the QP has the auxiliary variables of the augmented-Lagrangian term.
@@ -636,6 +652,7 @@ impl Qp {
     }
 
     fn run(&mut self, all: bool) -> Result<QpResult, QpError> {
+        let all = all || std::mem::take(&mut self.stale);
         let mut fresh = false;
         match self.solver.as_mut() {
             None => {

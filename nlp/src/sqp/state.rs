@@ -16,6 +16,7 @@ use super::geometry::Geometry;
 use super::iterate::{Iterate, Mult};
 use super::line_search::{LineSearch, Trial};
 use super::options::{HessianApproximation, SqpOptions};
+use super::polish::WorkingSet;
 use super::qp::{Qp, QpResult, QpStructure};
 use super::stop::{StepError, Stop};
 use crate::callback::Observer;
@@ -69,6 +70,8 @@ pub(super) struct Work {
     pub factor_seconds: f64,
     pub n_fact: usize,
     pub n_polished: usize,
+    /// QPs solved by the active-set method (the others by clarabel).
+    pub n_active_set: usize,
 }
 
 /// Everything one SQP solve carries from iteration to iteration.
@@ -84,6 +87,8 @@ pub(super) struct SqpState<'a> {
     /// KKT matrix for the convexity test and polishing (`None` with BFGS).
     pub kkt: Option<Kkt>,
     pub qp: Qp,
+    /// The working set of the last QP the active-set method solved (its warm start).
+    pub working_set: Option<WorkingSet>,
     /// ℓ1 penalty ρ.
     pub rho: f64,
     /// Merit weights w_i.
@@ -260,6 +265,7 @@ impl<'a> SqpState<'a> {
             curv,
             kkt: None,
             qp,
+            working_set: None,
             rho: o.penalty_init,
             merit_w: vec![0.0; m],
             work: Work::default(),

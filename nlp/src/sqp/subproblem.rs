@@ -7,10 +7,11 @@ use std::time::Instant;
 use clarabel::solver::SolverStatus as S;
 use faer::sparse::SymbolicSparseColMat;
 
+use super::active_set;
 use super::geometry::Geometry;
 use super::iterate::Iterate;
 use super::options::SqpOptions;
-use super::polish;
+use super::polish::{self, WorkingSet};
 use super::qp::{QpData, QpResult};
 use super::state::{Curvature, SqpState};
 use super::stop::StepError;
@@ -23,6 +24,64 @@ use crate::kkt::Kkt;
 const MAX_UNBOUNDED_RETRIES: usize = 7;
 const MAX_FAILED_QP_RETRIES: usize = 3;
 const MAX_PENALTY_INCREASES: usize = 11;
+
+impl SqpState<'_> {
+    /// The QP at the iterate with shift `delta` (and the constraint values `g` instead
+    /// of the iterate's: a second-order correction) solved by the active-set method
+    /// (`active_set.rs`) from the working set `start` (the last QP's) or, without one,
+    /// from the iterate's multipliers; `None` when the method does not apply (option
+    /// off, BFGS, cones) or gives up. The working set of a solved QP is kept for the next
+    /// one, and clarabel's copy of the QP is brought up to date (`Qp::load`) for a
+    /// fallback.
+    pub fn active_set_qp(
+        &mut self,
+        g: Option<&[f64]>,
+        delta: f64,
+        start: Option<WorkingSet>,
+        may_raise_penalty: bool,
+    ) -> Option<QpResult> {
+        let o = self.o;
+        if !o.qp_active_set || self.shape.dense || self.shape.n_cone > 0 {
+            return None;
+        }
+        let mut data = qp_data(&self.it, &self.geo, &self.curv, false, delta, self.rho);
+        if let Some(g) = g {
+            data.g = g;
+        }
+        let data = &data;
+        let kkt = self.kkt.as_mut()?;
+        let start = start
+            .filter(|w| active_set::fits(w, data))
+            .unwrap_or_else(|| active_set::guess(data, &self.it.mult));
+        let t_qp = Instant::now();
+        let solved = active_set::solve(
+            kkt,
+            data,
+            (&self.shape.jp, &self.shape.hp),
+            start,
+            (o.qp_active_set_max_iter as usize, self.qp.n_elastic()),
+            &mut self.work.n_fact,
+        );
+        self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
+        let solved = solved.ok()?;
+        // ρ as the elastic mode would raise it (not in a second-order correction, whose
+        // merit is that of the step's ρ).
+        let increases = if may_raise_penalty {
+            MAX_PENALTY_INCREASES
+        } else {
+            0
+        };
+        let limits = (o.penalty_increase, increases, o.penalty_max);
+        let rho = active_set::penalty_for(solved.max_multiplier, self.rho, limits)?;
+        self.rho = rho;
+        self.work.n_qp += 1;
+        self.work.n_active_set += 1;
+        self.work.qp_iterations += solved.iterations as u64;
+        self.qp.load(data);
+        self.working_set = Some(solved.working_set);
+        Some(solved.res)
+    }
+}
 
 /// The QP data at iterate `it` with shift `shift` and penalty `rho`.
 fn qp_data<'d>(
@@ -60,6 +119,11 @@ impl SqpState<'_> {
     pub fn subproblem(&mut self, delta: f64) -> Result<(QpResult, f64), StepError> {
         let o = self.o;
         let t_qp_loop = Instant::now();
+        let start = self.working_set.take();
+        if let Some(res) = self.active_set_qp(None, delta, start, true) {
+            self.work.factor_seconds += t_qp_loop.elapsed().as_secs_f64();
+            return Ok((res, delta));
+        }
         let dense = self.shape.dense;
         let mut qp_shift = delta;
         let (mut unbounded_retries, mut failed_retries, mut penalty_increases) = (0, 0, 0);

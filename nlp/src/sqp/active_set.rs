@@ -1,0 +1,574 @@
+//! A warm-started primal-dual active-set method for the SQP's QP subproblem (without
+//! elastic variables, cones or a dense BFGS matrix):
+//!
+//! ```text
+//! min ½ dᵀ B d + ∇fᵀ d   s.t.  g_l ≤ g + J d ≤ g_u,   x_l ≤ x + d ≤ x_u
+//! ```
+//!
+//! with B = H + δI + ρ_a·(J_AᵀJ_A + I_b) as `Convexify` built it. Each iteration solves
+//! the equality QP of a working set W exactly with the faer LDLᵀ of the KKT matrix
+//! (`polish::equality_qp_step`, whose inertia test also certifies that B is positive
+//! definite on the null space of W) and then moves every row and bound whose sign test
+//! fails (Hintermüller, Ito & Kunisch 2002, the primal-dual active-set strategy as a
+//! semismooth Newton method): a row or bound outside W that the step violates enters W
+//! on the violated side; a row or bound of W whose multiplier has the wrong sign leaves.
+//! When nothing moves, the step and its multipliers are a KKT point of the QP, checked
+//! with the same tolerances as polishing. Started from the previous QP's working set
+//! (qpOASES' hot start), a QP of an SQP near convergence, or of a warm-started MPC step,
+//! usually needs one or two factorisations where clarabel's interior point needs 10–20.
+//!
+//! When a working set repeats, the method changes one entry per iteration (the largest
+//! violation) from then on. It gives up (`Err`, and the caller solves the QP with
+//! clarabel) when a working set repeats again, after `max_iter` iterations, and when the
+//! equality QP of a working set is singular or has the wrong inertia (dependent active
+//! rows, or B not convex on W's null space). A solution whose multipliers exceed the ℓ1
+//! penalty ρ is the elastic QP's only for a larger ρ ([`penalty_for`]).
+
+use std::collections::HashSet;
+
+use faer::sparse::SymbolicSparseColMat;
+
+use super::iterate::Mult;
+use super::polish::{equality_qp_step, jac_times, stationarity, Side, WorkingSet};
+use super::qp::{QpData, QpResult};
+use crate::kkt::Kkt;
+
+/// Why the active-set method gave up on a QP (the caller falls back to clarabel).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Failure {
+    /// The KKT matrix or the problem sizes do not fit.
+    Shape,
+    /// The equality QP of a working set was singular, had the wrong inertia or was
+    /// solved inaccurately.
+    EqualityQp,
+    /// A working set came back (cycling).
+    Cycle,
+    /// `max_iter` iterations without a KKT point.
+    IterationLimit,
+}
+
+/// A solved QP: the result (in the convention of [`QpResult`]), its working set and the
+/// number of active-set iterations (= factorisations).
+pub(super) struct Solved {
+    pub res: QpResult,
+    pub working_set: WorkingSet,
+    pub iterations: usize,
+    /// The largest |λ_i| of the rows: the solution is the elastic QP's (zero elastic
+    /// variables) only for ρ ≥ this (see [`penalty_for`]).
+    pub max_multiplier: f64,
+}
+
+/// The ℓ1 penalty for which a QP solution with multipliers up to `max_multiplier` is
+/// also the elastic QP's: `rho` itself when it suffices, otherwise the first of
+/// ρ·f, ρ·f², … (`f` = `increase`, at most `max_increases` times, at most `rho_max`) that
+/// does: the ρ that clarabel's elastic mode reaches by the same increases, each of which
+/// lowers its Σe while the linearisation is consistent. `None` when no allowed ρ does.
+pub(super) fn penalty_for(
+    max_multiplier: f64,
+    rho: f64,
+    (increase, max_increases, rho_max): (f64, usize, f64),
+) -> Option<f64> {
+    let mut r = rho;
+    for _ in 0..max_increases {
+        if max_multiplier <= r {
+            return Some(r);
+        }
+        r = (r * increase).min(rho_max);
+    }
+    (max_multiplier <= r).then_some(r)
+}
+
+/// The working set guessed from multipliers at the point of `p` (a warm start without a
+/// previous QP): equality rows and fixed variables always; an inequality side or a
+/// bound when its multiplier has the side's sign and exceeds its slack.
+pub(super) fn guess(p: &QpData, mult: &Mult) -> WorkingSet {
+    let (n, m) = (p.x.len(), p.g.len());
+    let rows = (0..m)
+        .map(|i| {
+            let l = mult.lambda[i];
+            if p.g_l[i] == p.g_u[i] {
+                Side::Both
+            } else if p.g_u[i].is_finite() && l > 0.0 && l > p.g_u[i] - p.g[i] {
+                Side::Upper
+            } else if p.g_l[i].is_finite() && l < 0.0 && -l > p.g[i] - p.g_l[i] {
+                Side::Lower
+            } else {
+                Side::Free
+            }
+        })
+        .collect();
+    let vars = (0..n)
+        .map(|j| {
+            let (zl, zu) = (mult.z_l[j], mult.z_u[j]);
+            if p.x_l[j] == p.x_u[j] {
+                Side::Both
+            } else if p.x_u[j].is_finite() && zu > 0.0 && zu > p.x_u[j] - p.x[j] {
+                Side::Upper
+            } else if p.x_l[j].is_finite() && zl > 0.0 && zl > p.x[j] - p.x_l[j] {
+                Side::Lower
+            } else {
+                Side::Free
+            }
+        })
+        .collect();
+    WorkingSet { rows, vars }
+}
+
+/// Whether `w` fits the problem of `p` (sizes, and fixed entries where `p` has them).
+pub(super) fn fits(w: &WorkingSet, p: &QpData) -> bool {
+    w.rows.len() == p.g.len()
+        && w.vars.len() == p.x.len()
+        && (0..p.g.len()).all(|i| (w.rows[i] == Side::Both) == (p.g_l[i] == p.g_u[i]))
+        && (0..p.x.len()).all(|j| (w.vars[j] == Side::Both) == (p.x_l[j] == p.x_u[j]))
+}
+
+/// Solves the QP of `p` from the working set `start` (see the module documentation).
+/// `jp`, `hp`: the patterns of `p.jac` and `p.hess`; `n_elastic`: the length of the
+/// (zero) elastic part of the result; every factorisation is counted in `n_fact`.
+pub(super) fn solve(
+    kkt: &mut Kkt,
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    start: WorkingSet,
+    (max_iter, n_elastic): (usize, usize),
+    n_fact: &mut usize,
+) -> Result<Solved, Failure> {
+    let (n, m) = (p.x.len(), p.g.len());
+    if kkt.n() != n || kkt.m() != m || !fits(&start, p) {
+        return Err(Failure::Shape);
+    }
+    let tol = |b: f64| 1e-9 * (1.0 + b.abs());
+    let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+    let mut w = start;
+    let mut seen: HashSet<WorkingSet> = HashSet::new();
+    // After a repeated working set, one change per iteration (the largest violation).
+    let mut one_at_a_time = false;
+    for iteration in 1..=max_iter {
+        let (d, lambda) = equality_qp_step(kkt, p, &w, n_fact).ok_or(Failure::EqualityQp)?;
+        let s = stationarity(p, (jp, hp), &d, &lambda);
+        let jd = jac_times(p, jp, &d);
+        let lam_max = lambda.iter().chain(&s).fold(1.0f64, |a, v| a.max(v.abs()));
+        let mult_tol = 1e-8 * lam_max;
+        // Every change as (index: rows then variables, new side, size of the violation).
+        let mut changes: Vec<(usize, Side, f64)> = Vec::new();
+        for i in 0..m {
+            let lin = p.g[i] + jd[i];
+            // The QP's own multiplier (the augmented term's share ρ_a·J_i d removed).
+            let l_qp = lambda[i] - p.row_weight[i] * jd[i];
+            let change = match w.rows[i] {
+                Side::Free if lin > p.g_u[i] + tol(p.g_u[i]) => Some((Side::Upper, lin - p.g_u[i])),
+                Side::Free if lin < p.g_l[i] - tol(p.g_l[i]) => Some((Side::Lower, p.g_l[i] - lin)),
+                Side::Upper if l_qp < -mult_tol => Some((Side::Free, -l_qp)),
+                Side::Lower if l_qp > mult_tol => Some((Side::Free, l_qp)),
+                _ => None,
+            };
+            if let Some((side, v)) = change {
+                changes.push((i, side, v));
+            }
+        }
+        for j in 0..n {
+            let xn = p.x[j] + d[j];
+            // s_j = z_l − z_u: a lower bound needs s_j ≥ 0, an upper one s_j ≤ 0.
+            let change = match w.vars[j] {
+                Side::Free if xn > p.x_u[j] + tol(p.x_u[j]) => Some((Side::Upper, xn - p.x_u[j])),
+                Side::Free if xn < p.x_l[j] - tol(p.x_l[j]) => Some((Side::Lower, p.x_l[j] - xn)),
+                Side::Upper if s[j] > mult_tol => Some((Side::Free, s[j])),
+                Side::Lower if s[j] < -mult_tol => Some((Side::Free, -s[j])),
+                _ => None,
+            };
+            if let Some((side, v)) = change {
+                changes.push((m + j, side, v));
+            }
+        }
+        if !changes.is_empty() {
+            if one_at_a_time {
+                // The largest violation; ties to the first index (deterministic).
+                let k = (0..changes.len()).fold(
+                    0,
+                    |b, k| {
+                        if changes[k].2 > changes[b].2 {
+                            k
+                        } else {
+                            b
+                        }
+                    },
+                );
+                changes = vec![changes[k]];
+            }
+            let mut next = w.clone();
+            for &(k, side, _) in &changes {
+                if k < m {
+                    next.rows[k] = side;
+                } else {
+                    next.vars[k - m] = side;
+                }
+            }
+            seen.insert(std::mem::replace(&mut w, next));
+            if seen.contains(&w) {
+                if one_at_a_time {
+                    return Err(Failure::Cycle);
+                }
+                one_at_a_time = true;
+                seen.clear();
+            }
+            continue;
+        }
+        // A KKT point of the QP if the solve was accurate: free variables stationary,
+        // the rows of W met.
+        let met = |i: usize| {
+            let lin = p.g[i] + jd[i];
+            match w.rows[i] {
+                Side::Free => true,
+                Side::Lower => (lin - p.g_l[i]).abs() <= tol(p.g_l[i]),
+                Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= tol(p.g_u[i]),
+            }
+        };
+        if (0..n).any(|j| w.vars[j] == Side::Free && s[j].abs() > 1e-8 * grad_max)
+            || !(0..m).all(met)
+        {
+            return Err(Failure::EqualityQp);
+        }
+        let z_w: Vec<f64> = (0..m).map(|i| p.row_weight[i] * jd[i]).collect();
+        let lambda_qp: Vec<f64> = (0..m).map(|i| lambda[i] - z_w[i]).collect();
+        let max_multiplier = lambda_qp.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let mut z_l = vec![0.0; n];
+        let mut z_u = vec![0.0; n];
+        for j in 0..n {
+            if w.vars[j] != Side::Free {
+                z_l[j] = s[j].max(0.0);
+                z_u[j] = (-s[j]).max(0.0);
+            }
+        }
+        return Ok(Solved {
+            res: QpResult {
+                d,
+                e: vec![0.0; n_elastic],
+                lambda: lambda_qp,
+                z_l,
+                z_u,
+                z_cone: Vec::new(),
+                z_w,
+                status: clarabel::solver::SolverStatus::Solved,
+                iterations: iteration as u32,
+            },
+            working_set: w,
+            iterations: iteration,
+            max_multiplier,
+        });
+    }
+    Err(Failure::IterationLimit)
+}
+
+#[cfg(test)]
+mod tests {
+    //! The active-set method against clarabel (`Qp`, the SQP's elastic QP with a penalty
+    //! far above the multipliers, so that its elastic variables are zero) on random
+    //! strictly convex QPs with equality rows, two-sided and one-sided inequalities,
+    //! bounds and fixed variables, feasible by construction; and on degenerate ones
+    //! (duplicated rows, a bound duplicating a row), where the method may give up but
+    //! must not return a wrong answer.
+    use super::*;
+    use crate::sqp::qp::{Qp, QpStructure};
+    use crate::test_support::{pattern, Rng};
+
+    struct Case {
+        n: usize,
+        m: usize,
+        hp: SymbolicSparseColMat<usize>,
+        jp: SymbolicSparseColMat<usize>,
+        hess: Vec<f64>,
+        jac: Vec<f64>,
+        x: Vec<f64>,
+        x_l: Vec<f64>,
+        x_u: Vec<f64>,
+        g: Vec<f64>,
+        g_l: Vec<f64>,
+        g_u: Vec<f64>,
+        grad: Vec<f64>,
+        zeros_n: Vec<f64>,
+        zeros_m: Vec<f64>,
+    }
+
+    impl Case {
+        fn data(&self) -> QpData<'_> {
+            QpData {
+                x: &self.x,
+                x_l: &self.x_l,
+                x_u: &self.x_u,
+                g: &self.g,
+                g_l: &self.g_l,
+                g_u: &self.g_u,
+                grad: &self.grad,
+                jac: &self.jac,
+                cone: &[],
+                cone_jac: &[],
+                hess: &self.hess,
+                shift: 0.0,
+                bound_weight: &self.zeros_n,
+                row_weight: &self.zeros_m,
+                dense_b: None,
+                rho: 1e6,
+            }
+        }
+    }
+
+    /// A random QP: B = LLᵀ + 0.1 I stored as its dense lower triangle; J dense m×n (with
+    /// `dup` rows copied from row 0); the bounds around a random feasible step d₀ so that
+    /// some constraints are active at the solution and others not.
+    fn random_case(rng: &mut Rng, n: usize, m: usize, dup: usize, bound_dup: bool) -> Case {
+        let mut he = Vec::new();
+        for c in 0..n {
+            for r in c..n {
+                he.push((r, c));
+            }
+        }
+        let hp = pattern(n, n, &he);
+        let l: Vec<f64> = rng.vec(n * n);
+        let mut hess = vec![0.0; he.len()];
+        for c in 0..n {
+            for p in hp.col_range(c) {
+                let r = hp.row_idx()[p];
+                let v: f64 = (0..n).map(|k| l[r * n + k] * l[c * n + k]).sum();
+                hess[p] = v + if r == c { 0.1 } else { 0.0 };
+            }
+        }
+        let mut je = Vec::new();
+        for r in 0..m {
+            for c in 0..n {
+                je.push((r, c));
+            }
+        }
+        let jp = pattern(m, n, &je);
+        let mut jd = vec![vec![0.0; n]; m];
+        for r in 0..m {
+            for c in 0..n {
+                jd[r][c] = if r > 0 && r <= dup {
+                    jd[0][c]
+                } else {
+                    rng.sym()
+                };
+            }
+        }
+        if bound_dup && m > 0 {
+            // Row 0 is a multiple of variable 0 alone.
+            for c in 1..n {
+                jd[0][c] = 0.0;
+            }
+            jd[0][0] = 2.0;
+        }
+        let mut jac = vec![0.0; je.len()];
+        for c in 0..n {
+            for p in jp.col_range(c) {
+                jac[p] = jd[jp.row_idx()[p]][c];
+            }
+        }
+        let x = rng.vec(n);
+        let d0 = rng.vec(n);
+        let g = rng.vec(m);
+        let grad: Vec<f64> = rng.vec(n).iter().map(|v| 5.0 * v).collect();
+        let (mut g_l, mut g_u) = (vec![0.0; m], vec![0.0; m]);
+        for i in 0..m {
+            let lin: f64 = g[i] + (0..n).map(|c| jd[i][c] * d0[c]).sum::<f64>();
+            let kind = if i > 0 && i <= dup {
+                1
+            } else {
+                (rng.next() * 4.0) as usize
+            };
+            (g_l[i], g_u[i]) = match kind {
+                0 => (lin, lin),
+                1 => (lin - 0.1 * rng.next(), lin + 0.1 * rng.next()),
+                2 => (f64::NEG_INFINITY, lin + 0.1 * rng.next()),
+                _ => (lin - 0.1 * rng.next(), f64::INFINITY),
+            };
+        }
+        if bound_dup && m > 0 {
+            g_l[0] = f64::NEG_INFINITY;
+            g_u[0] = g[0] + 2.0 * d0[0];
+        }
+        let (mut x_l, mut x_u) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..n {
+            let xn = x[j] + d0[j];
+            (x_l[j], x_u[j]) = match (rng.next() * 5.0) as usize {
+                0 => (f64::NEG_INFINITY, f64::INFINITY),
+                1 if j > 0 => (x[j], x[j]),
+                2 => (xn - 0.05 * rng.next(), f64::INFINITY),
+                3 => (f64::NEG_INFINITY, xn + 0.05 * rng.next()),
+                _ => (xn - 0.2 * rng.next(), xn + 0.2 * rng.next()),
+            };
+            if x_l[j] == x_u[j] {
+                // A fixed variable: the step must be zero, and d₀ with it.
+                continue;
+            }
+            x_l[j] = x_l[j].min(x[j]);
+            x_u[j] = x_u[j].max(x[j]);
+        }
+        if bound_dup {
+            x_l[0] = f64::NEG_INFINITY;
+            x_u[0] = x[0] + d0[0];
+        }
+        // Fixed variables make d₀ infeasible; make the rows accept d₀ with d_j = 0 there.
+        let mut d0f = d0.clone();
+        for j in 0..n {
+            if x_l[j] == x_u[j] {
+                d0f[j] = 0.0;
+            }
+        }
+        for i in 0..m {
+            let lin: f64 = g[i] + (0..n).map(|c| jd[i][c] * d0f[c]).sum::<f64>();
+            let sh = lin - (g[i] + (0..n).map(|c| jd[i][c] * d0[c]).sum::<f64>());
+            g_l[i] += sh;
+            g_u[i] += sh;
+        }
+        Case {
+            n,
+            m,
+            hp,
+            jp,
+            hess,
+            jac,
+            x,
+            x_l,
+            x_u,
+            g,
+            g_l,
+            g_u,
+            grad,
+            zeros_n: vec![0.0; n],
+            zeros_m: vec![0.0; m],
+        }
+    }
+
+    fn objective(c: &Case, d: &[f64]) -> f64 {
+        let mut f: f64 = c.grad.iter().zip(d).map(|(a, b)| a * b).sum();
+        for col in 0..c.n {
+            for p in c.hp.col_range(col) {
+                let r = c.hp.row_idx()[p];
+                let v = c.hess[p] * d[r] * d[col];
+                f += if r == col { 0.5 * v } else { v };
+            }
+        }
+        f
+    }
+
+    fn clarabel(c: &Case) -> QpResult {
+        let st = QpStructure {
+            jac: &c.jp,
+            x_l: &c.x_l,
+            x_u: &c.x_u,
+            g_l: &c.g_l,
+            g_u: &c.g_u,
+            cone_blocks: &[],
+            cone_jac: None,
+            skip_rows: &c.zeros_m.iter().map(|_| false).collect::<Vec<_>>(),
+        };
+        let mut qp = Qp::new(&c.hp, &st, false, false, 1e-10, 200);
+        qp.solve(&c.data()).unwrap()
+    }
+
+    fn cold(c: &Case) -> WorkingSet {
+        let mult = Mult::zeros(c.n, c.m, 0);
+        guess(&c.data(), &mult)
+    }
+
+    /// Runs the active-set method (cold, then warm from its own working set) and compares
+    /// with clarabel; returns whether it solved the QP.
+    fn check(c: &Case, label: &str) -> bool {
+        let reference = clarabel(c);
+        assert!(
+            matches!(reference.status, clarabel::solver::SolverStatus::Solved),
+            "{label}: clarabel {:?}",
+            reference.status
+        );
+        assert!(
+            reference.e.iter().all(|v| v.abs() < 1e-7),
+            "{label}: elastic"
+        );
+        let mut kkt = Kkt::new(c.n, c.m, &c.hp, &c.jp).unwrap();
+        let mut n_fact = 0;
+        let data = c.data();
+        let s = match solve(
+            &mut kkt,
+            &data,
+            (&c.jp, &c.hp),
+            cold(c),
+            (50, 0),
+            &mut n_fact,
+        ) {
+            Ok(s) => s,
+            Err(f) => {
+                eprintln!("{label}: {f:?}");
+                return false;
+            }
+        };
+        // Tolerances: clarabel stops at gap/feasibility 1e-10 of its equilibrated
+        // problem, the active-set step is exact to rounding; the objective is strictly
+        // convex, so the minimisers agree to about sqrt of clarabel's gap.
+        let (fa, fc) = (objective(c, &s.res.d), objective(c, &reference.d));
+        assert!(
+            (fa - fc).abs() <= 1e-7 * (1.0 + fc.abs()),
+            "{label}: objective {fa} vs clarabel {fc}"
+        );
+        for j in 0..c.n {
+            assert!(
+                (s.res.d[j] - reference.d[j]).abs() <= 1e-5 * (1.0 + reference.d[j].abs()),
+                "{label}: d[{j}] {} vs clarabel {}",
+                s.res.d[j],
+                reference.d[j]
+            );
+        }
+        // Warm from its own working set: one factorisation, the same step.
+        let before = n_fact;
+        let warm = solve(
+            &mut kkt,
+            &data,
+            (&c.jp, &c.hp),
+            s.working_set.clone(),
+            (50, 0),
+            &mut n_fact,
+        )
+        .unwrap_or_else(|f| panic!("{label}: warm start failed: {f:?}"));
+        assert_eq!(n_fact - before, 1, "{label}");
+        assert_eq!(warm.res.d, s.res.d, "{label}");
+        true
+    }
+
+    #[test]
+    fn matches_clarabel_on_random_convex_qps() {
+        let mut solved = 0u64;
+        let total = 200u64;
+        for seed in 0..total {
+            let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ (seed + 1));
+            let n = 2 + (rng.next() * 10.0) as usize;
+            let m = (rng.next() * n as f64) as usize;
+            let c = random_case(&mut rng, n, m, 0, false);
+            solved += check(&c, &format!("seed {seed} (n {n}, m {m})")) as u64;
+        }
+        // Not a method that gives up: cold starts on non-degenerate QPs succeed.
+        assert!(solved >= total * 9 / 10, "solved {solved} of {total}");
+    }
+
+    #[test]
+    fn degenerate_qps_are_solved_right_or_handed_back() {
+        for seed in 0..100 {
+            let mut rng = Rng(0x2545_f491_4f6c_dd1d ^ (seed + 1));
+            let n = 3 + (rng.next() * 6.0) as usize;
+            let m = 3 + (rng.next() * (n - 2) as f64) as usize;
+            let c = random_case(&mut rng, n, m, 2, seed % 2 == 0);
+            check(&c, &format!("degenerate seed {seed} (n {n}, m {m})"));
+        }
+    }
+
+    #[test]
+    fn the_penalty_grows_as_the_elastic_mode_would() {
+        let f = (10.0, 11, 1e8);
+        assert_eq!(penalty_for(5.0, 10.0, f), Some(10.0));
+        assert_eq!(penalty_for(10.0, 10.0, f), Some(10.0));
+        assert_eq!(penalty_for(10.5, 10.0, f), Some(100.0));
+        assert_eq!(penalty_for(2e4, 10.0, f), Some(1e5));
+        assert_eq!(penalty_for(2e8, 10.0, f), None);
+        assert_eq!(penalty_for(2e4, 10.0, (10.0, 2, 1e8)), None);
+        assert_eq!(penalty_for(2e3, 10.0, (10.0, 2, 1e8)), None);
+        assert_eq!(penalty_for(500.0, 10.0, (10.0, 2, 1e8)), Some(1000.0));
+        assert_eq!(penalty_for(5e7, 1e7, (10.0, 11, 3e7)), None);
+    }
+}
