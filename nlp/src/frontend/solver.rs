@@ -81,6 +81,62 @@ pub trait Solver: Send + Sync {
     }
 }
 
+/// The [`Solver`] entry points as inherent methods of a back end, each one call of
+/// [`Solver::solve_dyn`]: callers need no `use nlp::Solver` and pass callbacks by value.
+/// `$warm` documents what the back end's `solve_warm` reuses.
+macro_rules! solver_entry_points {
+    ($solver:ident, $warm:literal) => {
+        impl $solver {
+            /// Solves from the problem's initial point.
+            pub fn solve(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, None, None)
+            }
+
+            #[doc = $warm]
+            pub fn solve_warm(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+                previous: &$crate::solution::Solution,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, Some(previous), None)
+            }
+
+            /// `solve` with a per-iteration callback (IPOPT's `intermediate_callback`):
+            /// `callback` sees every iteration, restoration iterations and iteration 0
+            /// included, once per row of `Solution::stats.records`, before the
+            /// convergence test; returning [`ControlFlow::Break`](std::ops::ControlFlow::Break)
+            /// ends the solve with [`Status::UserRequestedStop`](crate::Status::UserRequestedStop)
+            /// at that point. See [`crate::callback`].
+            pub fn solve_with_callback(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+                mut callback: impl FnMut(
+                    &$crate::callback::IterationView<'_>,
+                ) -> std::ops::ControlFlow<()>,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, None, Some(&mut callback))
+            }
+
+            /// `solve_warm` with a per-iteration callback (see `solve_with_callback`).
+            pub fn solve_warm_with_callback(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+                previous: &$crate::solution::Solution,
+                mut callback: impl FnMut(
+                    &$crate::callback::IterationView<'_>,
+                ) -> std::ops::ControlFlow<()>,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, Some(previous), Some(&mut callback))
+            }
+        }
+    };
+}
+
+pub(crate) use solver_entry_points;
+
 /// The options of one back end ([`IpmOptions`] or [`SqpOptions`]) behind a `&dyn`, so
 /// that a driver holding either sets them by name, reads their common part and builds
 /// their solver without matching on the back end.
