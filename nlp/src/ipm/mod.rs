@@ -5,7 +5,7 @@
 //! scaled problem `frontend/scaled.rs`),
 //! `core` (iteration, KKT step with inertia correction, line search with second-order
 //! corrections), `filter`, `barrier` (μ updates), `restoration` (ℓ1 restoration
-//! phase solved by the same core).
+//! phase solved by the same core), `workspace` (what an `Ipm` keeps between solves).
 
 #![allow(clippy::needless_range_loop)]
 
@@ -22,7 +22,7 @@ use std::time::Instant;
 
 use crate::callback::{IterationCallback, Observer};
 use crate::error::SolveError;
-use crate::frontend::solver::solver_entry_points;
+use crate::frontend::solver::{impl_solver_options, solver_entry_points};
 use crate::frontend::user_solution::{conclude, user_solution, UserPoint};
 use crate::frontend::validate::{validate, Validated};
 use crate::frontend::Solver;
@@ -64,6 +64,8 @@ solver_entry_points!(
      previous solve with this solver when the problem's structure (after removing fixed \
      variables) is the same, as in an MPC loop; the iterates are those of a fresh solver."
 );
+
+impl_solver_options!(IpmOptions => Ipm);
 
 impl Ipm {
     fn run(

@@ -26,7 +26,8 @@
 //! (tol 1e-8, s_max, dual_inf_tol, constr_viol_tol, compl_inf_tol, acceptable_*), on
 //! the problem scaled by the same gradient-based factors.
 //!
-//! In the iteration table, `lg(mu)` is log10 of the augmented weight ρ_a ("-" when 0),
+//! In the iteration table, `lg(mu)` is log10 of the augmented weight ρ_a (the record's
+//! `augmented_weight`; "-" when 0),
 //! `lg(rg)` is the Hessian shift δ,
 //! the 'r' mark after the iteration number flags elastic mode, and the step character
 //! is 'S' for an accepted second-order correction, 'f' otherwise.
@@ -58,7 +59,7 @@ use std::time::Instant;
 
 use crate::callback::{IterationCallback, Observer};
 use crate::error::SolveError;
-use crate::frontend::solver::solver_entry_points;
+use crate::frontend::solver::{impl_solver_options, solver_entry_points};
 use crate::frontend::user_solution::conclude;
 use crate::frontend::validate::validate;
 use crate::frontend::{Solver, Termination};
@@ -104,6 +105,8 @@ solver_entry_points!(
     "Starts from a previous solution's x and multipliers (λ, z_L, z_U): with a good \
      guess the first QPs already have the right active set."
 );
+
+impl_solver_options!(SqpOptions => Sqp);
 
 impl Sqp {
     fn run(
@@ -178,10 +181,11 @@ fn iterate(
             objective: 0.0,
             inf_pr: 0.0,
             inf_du: 0.0,
-            mu: s.curv.rho_a_last,
+            mu: 0.0,
             d_norm: ls.d_norm,
             regularization: delta,
             jacobian_regularization: 0.0,
+            augmented_weight: s.curv.rho_a_last,
             alpha_du: ls.alpha,
             alpha_pr: ls.alpha,
             alpha_pr_char: if ls.soc_used {
