@@ -166,7 +166,7 @@ impl Settings {
     }
 
     fn print_level(&self) -> u8 {
-        self.options().common().print_level
+        self.options().print_level
     }
 
     /// The chosen back end with its options.
@@ -846,6 +846,7 @@ mod tests {
             d_norm: 1.0,
             regularization: 0.0,
             jacobian_regularization: 0.0,
+            augmented_weight: 0.0,
             alpha_du: 1.0,
             alpha_pr,
             alpha_pr_char: 'h',
