@@ -63,6 +63,10 @@ struct ReplanArgs {
     /// Measured position of a foot at stance K, m (repeatable), e.g. `--foot FR=2.02,0,0`.
     #[arg(long = "foot", value_name = "FOOT=X,Y,Z", allow_hyphen_values = true)]
     foot: Vec<String>,
+    /// Then improve the re-plan by the free gait's schedule search (slower; the foot
+    /// schedule from stance K on may change).
+    #[arg(long)]
+    improve: bool,
     /// Output directory.
     #[arg(long, value_name = "DIR", default_value = "out")]
     out: PathBuf,
@@ -427,11 +431,12 @@ fn replan_cmd(a: &ReplanArgs) -> Result<ExitCode, CliError> {
         feet.push((foot, triple(at, &format!("--foot {}", foot.name()))?));
     }
     let settings = settings(&a.solver, 5)?;
-    let outcome = replan::replan(
+    let outcome = replan::replan_with(
         &old,
         a.stance,
         &Perturbation { com_offset, feet },
         &settings,
+        a.improve,
     )?;
     report(&outcome, &a.out)
 }

@@ -227,6 +227,19 @@ pub fn replan(
     p: &Perturbation,
     settings: &Settings,
 ) -> Result<Outcome, ReplanError> {
+    replan_with(file, stance, p, settings, false)
+}
+
+/// [`replan`], then, with `improve`, the free gait's schedule search from the re-plan
+/// (the foot schedule of stances K.. may change; [`crate::solve::plan_warm`]); the best
+/// plan is kept, so it costs no more than [`replan`]'s.
+pub fn replan_with(
+    file: &SolutionFile,
+    stance: usize,
+    p: &Perturbation,
+    settings: &Settings,
+    improve: bool,
+) -> Result<Outcome, ReplanError> {
     validate(file, stance, p, None)?;
     let s = &file.scenario;
     let k0 = stance - 1;
@@ -258,7 +271,14 @@ pub fn replan(
     let local = frame::translated(&sub, d);
     frame::translate_plan(&mut guess, d);
     let started = Instant::now();
-    let sub_out = solve::plan_warm(&local, &*terrain::of(&local), &schedule, &guess, settings)?;
+    let sub_out = solve::plan_warm(
+        &local,
+        &*terrain::of(&local),
+        &schedule,
+        &guess,
+        settings,
+        improve,
+    )?;
     let mut tail = sub_out.file.plan();
     frame::translate_plan(&mut tail, [-d[0], -d[1]]);
     // The measured stance is what was measured, exactly (its forces are re-planned).

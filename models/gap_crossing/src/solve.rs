@@ -502,13 +502,16 @@ pub fn plan_on(
 /// plan of `s`, e.g. the rest of an earlier plan: the re-plan of [`crate::replan`]), with
 /// the warm-start settings of the schedule search (barrier parameter [`SEARCH_MU_INIT`],
 /// bound push [`SEARCH_BOUND_PUSH`], at most [`SEARCH_MAX_ITER`] iterations). The
-/// certificates are decided first, as in [`plan_on`].
+/// certificates are decided first, as in [`plan_on`]. With `improve`, the free gait's
+/// schedule search ([`crate::schedule_search`], up to [`SEARCH_ROUNDS`] rounds) then
+/// starts from the warm solve's plan, and the best plan is kept.
 pub fn plan_warm(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     schedule: &[Foot],
     guess: &Plan,
     settings: &Settings,
+    improve: bool,
 ) -> Result<Outcome, PlanningError> {
     crate::limits::check(s)?;
     if let Some(out) = proved_impossible(s, settings) {
@@ -526,7 +529,17 @@ pub fn plan_warm(
         &mut phases,
         "re-plan",
     )?;
-    finish(s, settings, last, None, phases, started)
+    if !improve {
+        return finish(s, settings, last, None, phases, started);
+    }
+    let mut best = last;
+    for solved in search_from(s, terrain, &settings.candidate(), &best, "re-plan")? {
+        let next = record(solved, settings, &mut phases);
+        if next.beats(&best) {
+            best = next;
+        }
+    }
+    finish(s, settings, best, None, phases, started)
 }
 
 /// The outcome of a planning run whose chosen solve is `last`: the plan, its solver

@@ -269,3 +269,20 @@ fn replan_command_exit_codes() {
         assert!(err.contains(needle), "{all:?}: {err}");
     }
 }
+
+/// `improve`: the schedule search from the re-plan keeps the best plan, so the result is
+/// checked, keeps stances 1–9, and costs no more than the plain re-plan.
+#[test]
+fn improved_replan_is_no_worse() {
+    let old = default_plan();
+    let p = Perturbation {
+        com_offset: [0.03, 0.02, 0.0],
+        feet: vec![],
+    };
+    let plain = replan(old, 10, &p, &settings()).unwrap();
+    let better = gap_crossing::replan::replan_with(old, 10, &p, &settings(), true).unwrap();
+    assert!(better.status.is_solved(), "{}", better.status);
+    assert!(check::check(&better.file).ok());
+    assert_eq!(better.file.stances[..9], old.stances[..9]);
+    assert!(better.file.solver.objective <= plain.file.solver.objective);
+}
