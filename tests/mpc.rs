@@ -201,6 +201,7 @@ fn mpc_refuses_a_fixed_initial_state_and_a_free_horizon() {
     let mut o = Ocp::new(&["x"], &["u"]);
     o.set_dynamics(|x, u, _p| Matrix::from_vec(vec![u[0] - x[0]]));
     o.set_initial_state(&[1.0]).unwrap();
+    o.set_horizon(Horizon::Fixed(1.0)).unwrap();
     let tr = o
         .transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 4)
         .unwrap();

@@ -25,6 +25,7 @@ use symx::Matrix;
 /// let mut ocp = Ocp::new(&["x"], &["u"]);
 /// ocp.set_dynamics(|x, u, _p| Matrix::from_vec(vec![u[0] - x[0]]));
 /// ocp.set_initial_state_parameter("x0", &[1.0]).unwrap();
+/// ocp.set_horizon(nlp::ocp::Horizon::Fixed(1.0)).unwrap();
 /// let tr = ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 3).unwrap();
 /// let shift = tr.shift_plan().unwrap();
 /// // x = (X0, X1, X2, X3, U0, U1, U2): each stage takes the next one's value.
@@ -121,7 +122,7 @@ impl Transcription {
         };
         columns(self.states(), n + 1, 1)?;
         if self.controls().nrows() > 0 {
-            columns(self.controls(), n, 1)?;
+            columns(self.controls(), self.controls().ncols(), 1)?;
         }
         if let Some(xc) = self.collocation_states() {
             columns(xc, n, xc.ncols() / n)?;

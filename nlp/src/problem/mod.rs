@@ -270,6 +270,11 @@ impl Problem {
         Ok(())
     }
 
+    /// The initial guess of every variable, in variable order (0 where none was set).
+    pub fn initial_point(&self) -> &[f64] {
+        &self.initial
+    }
+
     /// Sets the initial guess of the entries of `x` (one finite value each).
     pub fn set_initial(&mut self, x: &[Expr], values: &[f64]) -> Result<(), BuildError> {
         let idx = self.variable_positions(x, "set_initial")?;
