@@ -61,6 +61,7 @@ fn labelled(c: &Compiled, tr: &Transcription) -> Solution {
         constr_viol: 0.0,
         dual_inf: 0.0,
         compl: 0.0,
+        parameters: c.parameter_values().to_vec(),
         message: String::new(),
         stats: Default::default(),
     }

@@ -36,7 +36,7 @@ use symx::Matrix;
 ///     lambda: vec![5.0, 20.0, 21.0, 22.0],
 ///     z_l: vec![0.0; 7], z_u: vec![0.0; 7], g: vec![0.0; 4],
 ///     objective: 0.0, constr_viol: 0.0, dual_inf: 0.0, compl: 0.0,
-///     message: String::new(), stats: Default::default(),
+///     message: String::new(), stats: Default::default(), parameters: vec![1.0],
 /// };
 /// shift.apply(&mut sol).unwrap();
 /// assert_eq!(sol.lambda, [5.0, 21.0, 22.0, 22.0]); // the initial state's row stays
