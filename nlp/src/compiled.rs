@@ -187,6 +187,12 @@ impl Compiled {
         Ok(())
     }
 
+    /// Sets all parameter entries at once (`p` as long as [`Compiled::parameter_values`],
+    /// finite: checked by the caller).
+    pub(crate) fn set_parameter_vector(&mut self, p: &[f64]) {
+        self.params.copy_from_slice(p);
+    }
+
     /// The values of all parameter entries, in declaration order.
     pub fn parameter_values(&self) -> &[f64] {
         &self.params

@@ -7,11 +7,13 @@ pub mod bounds;
 pub mod complementarity;
 pub mod cone;
 pub mod error;
+pub mod to_function;
 
 pub use bounds::PerEntry;
 pub use complementarity::ComplementarityReport;
 pub use cone::{Cone, CONE_SMOOTHING};
 pub use error::BuildError;
+pub use to_function::{SolverFunction, ToFunctionError};
 
 use crate::compiled::{CompileOptions, Compiled};
 use crate::constraint::{Constraint, Row};
