@@ -141,6 +141,12 @@ fn user_given_grid() {
     close(t.objective, 3.9997756677774317, 1e-9);
     assert_eq!(t.time[10], 0.25);
     assert!((t.time[11] - 0.2875).abs() < 1e-15);
+    // Shifting by one stage (MPC) needs equal stages: refused on this grid.
+    let tr = bryson_denham()
+        .transcribe_on(&Method::hermite_simpson(), &grid)
+        .unwrap();
+    let err = tr.shift_plan().unwrap_err().to_string();
+    assert!(err.contains("uniform grid"), "{err}");
 }
 
 #[test]

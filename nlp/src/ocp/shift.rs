@@ -105,8 +105,17 @@ impl Shift {
 impl Transcription {
     /// The plan of [`Shift`] for this transcription (computed once; apply it every MPC
     /// step). Call it after any [`Transcription::problem_mut`] additions. An error names a
-    /// per-stage constraint group whose rows are simple bounds at some stages only.
+    /// per-stage constraint group whose rows are simple bounds at some stages only, or a
+    /// grid that is not uniform.
     pub fn shift_plan(&self) -> Result<Shift, OcpError> {
+        if !self.grid().is_uniform() {
+            // One stage is one sampling period only when every interval has the same length.
+            return Err(OcpError::Invalid {
+                what: "shift".into(),
+                why: "needs a uniform grid (Grid::uniform): one stage must be one sampling period"
+                    .into(),
+            });
+        }
         let pb = self.problem();
         let n = self.intervals();
         let mut variable_moves = Vec::new();
