@@ -35,7 +35,9 @@ pub use error::SolveError;
 pub use frontend::{CommonOptions, Solver, SolverOptions};
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;
-pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};
+pub use problem::{
+    Block, BuildError, ComplementarityReport, PerEntry, Problem, SolverFunction, ToFunctionError,
+};
 
 pub use log::{format_summary, format_table};
 pub use mpc::{ClosedLoop, Mpc, MpcError, StepReport};

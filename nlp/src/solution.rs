@@ -195,6 +195,11 @@ pub struct Solution {
     pub message: String,
     /// Statistics.
     pub stats: Stats,
+    /// The parameter values the problem was solved with, in declaration order (empty for a
+    /// problem without parameters, and in files written before this field existed).
+    /// [`crate::Problem::value`] evaluates expressions with them.
+    #[serde(default)]
+    pub parameters: Vec<f64>,
 }
 
 impl Solution {

@@ -78,6 +78,7 @@ pub(crate) fn user_solution(
     } = p;
     let (n, m) = (x.len(), lambda.len());
     let nlp = sc.user();
+    let parameters = nlp.parameter_values().to_vec();
     let jp = nlp.jac_g_sparsity().clone();
     let cp = nlp.cone_jac_sparsity().cloned();
     let t = Instant::now();
@@ -173,6 +174,7 @@ pub(crate) fn user_solution(
         compl,
         message,
         stats: Stats::default(),
+        parameters,
     }
 }
 
