@@ -408,6 +408,22 @@ impl Function {
         w: *mut f64,
         p: usize,
     ) {
+        if let Some(native) = &self.native {
+            let (n_in, n_out) = (inputs.len(), self.output_sizes.len());
+            if n_in <= crate::native::MAX_DIRECT && n_out <= crate::native::MAX_DIRECT {
+                // The machine code reads the inputs and writes the outputs in place.
+                let mut args = [std::ptr::null::<f64>(); crate::native::MAX_DIRECT];
+                let mut res = [std::ptr::null_mut::<f64>(); crate::native::MAX_DIRECT];
+                for (k, x) in inputs.iter().enumerate() {
+                    args[k] = x.as_ptr().add(p * self.input_sizes.get_unchecked(k));
+                }
+                for (k, r) in res.iter_mut().enumerate().take(n_out) {
+                    let n = *self.output_sizes.get_unchecked(k);
+                    *r = (*outputs.add(k)).cast::<f64>().add(p * n);
+                }
+                return (native.entry)(w, args.as_ptr(), res.as_ptr());
+            }
+        }
         for (k, x) in inputs.iter().enumerate() {
             if *self.input_used.get_unchecked(k) {
                 let n = *self.input_sizes.get_unchecked(k);
@@ -435,7 +451,7 @@ impl Function {
     pub(crate) unsafe fn exec(&self, w: *mut f64) {
         if let Some(native) = &self.native {
             // SAFETY: the code does what the tape does (same registers, same template).
-            return (native.entry)(w);
+            return (native.entry)(w, std::ptr::null(), std::ptr::null());
         }
         std::ptr::copy_nonoverlapping(
             self.template.as_ptr(),
