@@ -408,21 +408,8 @@ impl Function {
         w: *mut f64,
         p: usize,
     ) {
-        if let Some(native) = &self.native {
-            let (n_in, n_out) = (inputs.len(), self.output_sizes.len());
-            if n_in <= crate::native::MAX_DIRECT && n_out <= crate::native::MAX_DIRECT {
-                // The machine code reads the inputs and writes the outputs in place.
-                let mut args = [std::ptr::null::<f64>(); crate::native::MAX_DIRECT];
-                let mut res = [std::ptr::null_mut::<f64>(); crate::native::MAX_DIRECT];
-                for (k, x) in inputs.iter().enumerate() {
-                    args[k] = x.as_ptr().add(p * self.input_sizes.get_unchecked(k));
-                }
-                for (k, r) in res.iter_mut().enumerate().take(n_out) {
-                    let n = *self.output_sizes.get_unchecked(k);
-                    *r = (*outputs.add(k)).cast::<f64>().add(p * n);
-                }
-                return (native.entry)(w, args.as_ptr(), res.as_ptr());
-            }
+        if self.native.is_some() && self.run_native(inputs, outputs, w, p) {
+            return;
         }
         for (k, x) in inputs.iter().enumerate() {
             if *self.input_used.get_unchecked(k) {
@@ -441,6 +428,40 @@ impl Function {
             let y = (*outputs.add(k)).cast::<f64>();
             std::ptr::copy_nonoverlapping(w.add(at), y.add(p * n), n);
         }
+    }
+
+    /// [`Function::run`] by the machine code reading the inputs and writing the outputs in
+    /// place; `false` (nothing done) if there are too many inputs or outputs for that.
+    /// Kept out of line so that the tape's loop in `run` is compiled as before.
+    ///
+    /// # Safety
+    /// As for [`Function::run`].
+    #[inline(never)]
+    unsafe fn run_native(
+        &self,
+        inputs: &[&[f64]],
+        outputs: *const *mut [f64],
+        w: *mut f64,
+        p: usize,
+    ) -> bool {
+        let Some(native) = &self.native else {
+            return false;
+        };
+        let (n_in, n_out) = (inputs.len(), self.output_sizes.len());
+        if n_in > crate::native::MAX_DIRECT || n_out > crate::native::MAX_DIRECT {
+            return false;
+        }
+        let mut args = [std::ptr::null::<f64>(); crate::native::MAX_DIRECT];
+        let mut res = [std::ptr::null_mut::<f64>(); crate::native::MAX_DIRECT];
+        for (k, x) in inputs.iter().enumerate() {
+            args[k] = x.as_ptr().add(p * self.input_sizes.get_unchecked(k));
+        }
+        for (k, r) in res.iter_mut().enumerate().take(n_out) {
+            let n = *self.output_sizes.get_unchecked(k);
+            *r = (*outputs.add(k)).cast::<f64>().add(p * n);
+        }
+        (native.entry)(w, args.as_ptr(), res.as_ptr());
+        true
     }
 
     /// Runs the tape on a work vector whose input registers are filled.
