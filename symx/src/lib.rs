@@ -50,7 +50,7 @@ pub use graph::{node_count, with_fresh_arena};
 pub use interpolant::{Interpolant, Interpolant2, InterpolantN};
 pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
-pub use native::Evaluator;
+pub use native::{Evaluator, SourceOptions};
 pub use op::Op;
 pub use sparsity::Sparsity;
 
