@@ -222,6 +222,7 @@ impl Function {
     /// `Err` for operations the module cannot compute exactly without a dependency:
     /// lookup tables, `erf`, `asinh`, `acosh`, `atanh`.
     pub fn to_rust(&self) -> Result<String, SymxError> {
+        self.refuse_external("to_rust")?;
         let mut w = Writer {
             out: String::new(),
             names: FxHashMap::default(),
