@@ -7,6 +7,7 @@ pub mod derivative_check;
 pub mod dump;
 pub mod error;
 pub mod frontend;
+pub mod integrator;
 pub mod ipm;
 pub(crate) mod kkt;
 pub(crate) mod lbfgs;
@@ -33,6 +34,7 @@ pub use derivative_check::{check_derivatives, DerivativeCheckOptions, Derivative
 pub use dump::{DumpError, DumpVerification, ProblemDump};
 pub use error::SolveError;
 pub use frontend::{CommonOptions, Solver, SolverOptions};
+pub use integrator::{Integrator, IntegratorError, IntegratorOptions};
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;
 pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};
