@@ -23,6 +23,7 @@ pub mod problem;
 pub(crate) mod scaling;
 pub mod sensitivity;
 pub mod solution;
+pub mod solution_file;
 pub mod sqp;
 #[cfg(test)]
 mod test_support;
@@ -54,4 +55,5 @@ pub use options::{
 };
 pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};
+pub use solution_file::{SolutionFileError, SOLUTION_FILE_VERSION};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};
