@@ -8,6 +8,9 @@ use std::time::Instant;
 use symnlp::nlp::integrator::{Integrator, IntegratorOptions};
 use symnlp::symx::{Function, Matrix};
 
+/// A test problem: name, right-hand side, x0, p, T, CVODES reference x(T).
+type Case<'a> = (&'a str, &'a Function, Vec<f64>, Vec<f64>, f64, Vec<f64>);
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let x = Matrix::sym_vec("x", 2);
     let mu = Matrix::sym_vec("mu", 1);
@@ -26,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ]],
     )?;
     // (name, ode, x0, p, T, CVODES reference x(T) from integrator_casadi.json)
-    let problems: [(&str, &Function, Vec<f64>, Vec<f64>, f64, Vec<f64>); 3] = [
+    let problems: [Case; 3] = [
         (
             "vdp1",
             &vdp,

@@ -70,7 +70,7 @@ fn shooting_with_the_integrator_reaches_the_rk_optimum() {
         let end = f.apply(&[&start, &[uu[k]]]).unwrap().remove(0);
         pb.subject_to((end[0] - x[2 * k + 2]).eq(0.0)).unwrap();
         pb.subject_to((end[1] - x[2 * k + 3]).eq(0.0)).unwrap();
-        cost = cost + end[2];
+        cost += end[2];
         pb.subject_to(bounded(-1.0, uu[k], 1.0)).unwrap();
     }
     for k in 0..=N {
