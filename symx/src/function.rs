@@ -27,6 +27,7 @@
 use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
+use crate::external::External;
 use crate::graph;
 use crate::native::{self, Evaluator, NativeCode};
 use crate::op::{self, Op};
@@ -95,6 +96,8 @@ pub struct Function {
     pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
     /// Machine code computing what the tape computes (see [`Function::jit`]).
     pub(crate) native: Option<Arc<NativeCode>>,
+    /// User code computing the outputs, for an external function (its tape is empty).
+    pub(crate) external: Option<Arc<External>>,
 }
 
 /// The output slices as raw pointers, for [`Function::run`]: `&mut [f64]` and
@@ -240,6 +243,7 @@ impl Function {
         if self.native.is_some() {
             return Ok(self.clone());
         }
+        self.refuse_external("jit")?;
         let code = native::compile(self)?;
         Ok(Function {
             native: Some(Arc::new(code)),
@@ -473,6 +477,10 @@ impl Function {
         if let Some(native) = &self.native {
             // SAFETY: the code does what the tape does (same registers, same template).
             return (native.entry)(w, std::ptr::null(), std::ptr::null());
+        }
+        if let Some(ext) = &self.external {
+            // SAFETY: the work vector of an external function is `[inputs | outputs]`.
+            return ext.run(w);
         }
         std::ptr::copy_nonoverlapping(
             self.template.as_ptr(),

@@ -269,6 +269,7 @@ impl Function {
 
     /// [`Function::to_c`] with output sparsity patterns (`f_sparsity_out`) from `options`.
     pub fn to_c_with(&self, options: &SourceOptions) -> Result<String, SymxError> {
+        self.refuse_external("to_c")?;
         let name = self.name.as_str();
         let valid = name
             .chars()

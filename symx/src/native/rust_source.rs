@@ -200,6 +200,7 @@ impl Function {
     /// assert!(module.contains("pub const OUTPUT_SPARSITY: [Pattern; 1]"));
     /// ```
     pub fn to_rust_with(&self, options: &SourceOptions) -> Result<String, SymxError> {
+        self.refuse_external("to_rust")?;
         let patterns = options.output_patterns(self)?;
         let mut w = Writer {
             out: String::new(),
