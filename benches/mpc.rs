@@ -1,6 +1,9 @@
 //! One warm interior-point re-solve of the cart-pole MPC (examples/mpc_cart_pole.rs,
 //! N = 40, 204 variables, 164 rows) after 50 closed-loop steps: the plan shifted and
 //! re-solved warm from the new state — the work of a typical step of the loop.
+//! `mpc_cart_pole_ipm_warm_resolve`: by one `Ipm` across the loop, as `Mpc` does (its KKT
+//! symbolic analysis kept between solves); `mpc_cart_pole_ipm_warm_resolve_fresh_solver`:
+//! by a new `Ipm` each time (the analysis rebuilt), for the ratio.
 //!
 //! ```text
 //! cargo bench --bench mpc
@@ -41,6 +44,15 @@ fn warm_resolve(c: &mut Criterion) {
     );
     c.bench_function("mpc_cart_pole_ipm_warm_resolve", |b| {
         b.iter(|| black_box(ipm.solve_warm(compiled, &shifted).expect("warm solve")))
+    });
+    c.bench_function("mpc_cart_pole_ipm_warm_resolve_fresh_solver", |b| {
+        b.iter(|| {
+            black_box(
+                Ipm::default()
+                    .solve_warm(compiled, &shifted)
+                    .expect("warm solve"),
+            )
+        })
     });
 }
 

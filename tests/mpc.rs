@@ -61,6 +61,7 @@ fn labelled(c: &Compiled, tr: &Transcription) -> Solution {
         constr_viol: 0.0,
         dual_inf: 0.0,
         compl: 0.0,
+        parameters: c.parameter_values().to_vec(),
         message: String::new(),
         stats: Default::default(),
     }
@@ -201,6 +202,7 @@ fn mpc_refuses_a_fixed_initial_state_and_a_free_horizon() {
     let mut o = Ocp::new(&["x"], &["u"]);
     o.set_dynamics(|x, u, _p| Matrix::from_vec(vec![u[0] - x[0]]));
     o.set_initial_state(&[1.0]).unwrap();
+    o.set_horizon(Horizon::Fixed(1.0)).unwrap();
     let tr = o
         .transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 4)
         .unwrap();

@@ -15,8 +15,12 @@ For each function:
 Run (takes several minutes, mostly gcc):
   cargo build --release -p gap_crossing --example export
   python3 benches/reference/native_casadi.py --export-bin target/release/examples/export
+With `--keep DIR` the C files and executables stay in DIR, and a later run with the same DIR
+reuses them (the gcc time recorded the first time), so repeated side-by-side timings take
+seconds.
 """
 import argparse
+import contextlib
 import json
 import os
 import re
@@ -71,21 +75,29 @@ int main(int argc, char** argv) {
 
 
 def casadi_c(name, F, inputs, out_nnz, tmp):
-    cwd = os.getcwd()
-    os.chdir(tmp)
-    try:
-        F.generate(f"{name}.c")
-    finally:
-        os.chdir(cwd)
     src = os.path.join(tmp, f"{name}.c")
-    t = time.perf_counter()
-    subprocess.run(["gcc", "-O3", "-march=native", "-c", src, "-o", src + ".o"], check=True)
-    gcc_s = time.perf_counter() - t
-    drv = os.path.join(tmp, f"{name}_main.c")
-    with open(drv, "w") as fh:
-        fh.write(DRIVER.replace("NAME", name))
     exe = os.path.join(tmp, name)
-    subprocess.run(["gcc", "-O2", drv, src + ".o", "-o", exe, "-lm"], check=True)
+    timing = os.path.join(tmp, f"{name}.gcc_s")
+    if os.path.exists(exe) and os.path.exists(timing):
+        # Kept from an earlier run (--keep): time the executable again, no gcc.
+        with open(timing) as fh:
+            gcc_s = float(fh.read())
+    else:
+        cwd = os.getcwd()
+        os.chdir(tmp)
+        try:
+            F.generate(f"{name}.c")
+        finally:
+            os.chdir(cwd)
+        t = time.perf_counter()
+        subprocess.run(["gcc", "-O3", "-march=native", "-c", src, "-o", src + ".o"], check=True)
+        gcc_s = time.perf_counter() - t
+        drv = os.path.join(tmp, f"{name}_main.c")
+        with open(drv, "w") as fh:
+            fh.write(DRIVER.replace("NAME", name))
+        subprocess.run(["gcc", "-O2", drv, src + ".o", "-o", exe, "-lm"], check=True)
+        with open(timing, "w") as fh:
+            fh.write(f"{gcc_s}")
     data = os.path.join(tmp, f"{name}.bin")
     np.concatenate([np.atleast_1d(np.asarray(a, dtype=float)) for a in inputs]).tofile(data)
     sizes = [str(np.atleast_1d(a).size) for a in inputs]
@@ -101,7 +113,8 @@ def run(d, args):
     lam0 = np.array([(i + 1) / m for i in range(m)])
     inputs = {"grad_f": [x0], "jac_g": [x0], "hess_L": [x0, 1.0, lam0]}
     rows = {}
-    with tempfile.TemporaryDirectory() as tmp:
+    with (contextlib.nullcontext(args.keep) if args.keep else tempfile.TemporaryDirectory()) as tmp:
+        os.makedirs(tmp, exist_ok=True)
         for name, F in zip(["grad_f", "jac_g", "hess_L"], funcs):
             ins = [ca.DM(a) for a in inputs[name]]
             nnz = F(*ins).nnz()
@@ -118,6 +131,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--export-bin", required=True)
     ap.add_argument("--no-symx", action="store_true", help="skip running the symx bench")
+    ap.add_argument("--keep", metavar="DIR", help="keep the generated C and executables in DIR and "
+                    "reuse them on later runs (no gcc: repeat the timings side by side)")
     args = ap.parse_args()
     d = json.loads(subprocess.run([args.export_bin], check=True, stdout=subprocess.PIPE).stdout)
     result = {}

@@ -172,7 +172,9 @@ impl Compiled {
     /// Sets parameter values (finite numbers), by handle or by name: the same call as
     /// [`Problem::set_value`](crate::Problem::set_value). Handles only work on the thread
     /// that built the problem ([`BuildError::ForeignThread`] elsewhere); names work on
-    /// any thread.
+    /// any thread. A later solve's [`Solution::parameters`](crate::Solution::parameters)
+    /// records the values it used, and [`Problem::value`](crate::Problem::value) reads
+    /// expressions with them.
     pub fn set_value<'a>(
         &mut self,
         p: impl Into<ParameterKey<'a>>,
@@ -185,12 +187,34 @@ impl Compiled {
         Ok(())
     }
 
+    /// Sets all parameter entries at once (`p` as long as [`Compiled::parameter_values`],
+    /// finite: checked by the caller).
+    pub(crate) fn set_parameter_vector(&mut self, p: &[f64]) {
+        self.params.copy_from_slice(p);
+    }
+
     /// The values of all parameter entries, in declaration order.
     pub fn parameter_values(&self) -> &[f64] {
         &self.params
     }
 
-    /// Replaces the initial guess (e.g. for a new solve after changing parameters).
+    /// Replaces the initial guess (one finite value per variable, in variable order): the
+    /// way to cold-start the next solve from a new point on an already compiled problem
+    /// (`solve` starts from this point; `solve_warm` from a previous solution instead).
+    /// An error names a wrong length or the first non-finite entry's variable.
+    ///
+    /// ```
+    /// use nlp::{Ipm, Problem};
+    /// let mut pb = Problem::new();
+    /// let x = pb.scalar_variable("x")?;
+    /// pb.minimize((x.sq() - 1.0).sq()); // two minima, x = ±1
+    /// let mut compiled = pb.compile()?;
+    /// compiled.set_initial_point(&[-3.0])?; // start near the left one
+    /// let sol = Ipm::default().solve(&mut compiled)?;
+    /// assert!((sol.x[0] + 1.0).abs() < 1e-8);
+    /// assert!(compiled.set_initial_point(&[f64::NAN]).is_err());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn set_initial_point(&mut self, x0: &[f64]) -> Result<(), BuildError> {
         if x0.len() != self.n {
             return Err(BuildError::Size {
@@ -255,6 +279,9 @@ impl std::fmt::Debug for Compiled {
 impl NumericNlp for Compiled {
     fn n(&self) -> usize {
         self.n
+    }
+    fn parameter_values(&self) -> &[f64] {
+        &self.params
     }
     fn m(&self) -> usize {
         self.m

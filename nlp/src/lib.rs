@@ -7,6 +7,7 @@ pub mod derivative_check;
 pub mod dump;
 pub mod error;
 pub mod frontend;
+pub mod integrator;
 pub mod ipm;
 pub(crate) mod kkt;
 pub(crate) mod lbfgs;
@@ -22,6 +23,7 @@ pub mod problem;
 pub(crate) mod scaling;
 pub mod sensitivity;
 pub mod solution;
+pub mod solution_file;
 pub mod sqp;
 #[cfg(test)]
 mod test_support;
@@ -33,9 +35,12 @@ pub use derivative_check::{check_derivatives, DerivativeCheckOptions, Derivative
 pub use dump::{DumpError, DumpVerification, ProblemDump};
 pub use error::SolveError;
 pub use frontend::{CommonOptions, Solver, SolverOptions};
+pub use integrator::{Integrator, IntegratorError, IntegratorOptions};
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;
-pub use problem::{Block, BuildError, ComplementarityReport, PerEntry, Problem};
+pub use problem::{
+    Block, BuildError, ComplementarityReport, PerEntry, Problem, SolverFunction, ToFunctionError,
+};
 
 pub use log::{format_summary, format_table};
 pub use mpc::{ClosedLoop, Mpc, MpcError, StepReport};
@@ -52,4 +57,5 @@ pub use options::{
 };
 pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};
+pub use solution_file::{SolutionFileError, SOLUTION_FILE_VERSION};
 pub use sqp::{HessianApproximation, Sqp, SqpOptions};

@@ -9,7 +9,8 @@ pub fn header() -> String {
     "iter    objective    inf_pr   inf_du lg(mu)  ||d||  lg(rg) alpha_du alpha_pr  ls".to_string()
 }
 
-/// One formatted table row.
+/// One formatted table row. The lg(mu) column shows the interior point's μ, or in the
+/// SQP's rows (μ = 0) its augmented weight ρ_a.
 pub fn format_record(r: &IterationRecord) -> String {
     let lg = |v: f64| {
         if v > 0.0 {
@@ -25,7 +26,7 @@ pub fn format_record(r: &IterationRecord) -> String {
         r.objective,
         r.inf_pr,
         r.inf_du,
-        lg(r.mu),
+        lg(if r.mu > 0.0 { r.mu } else { r.augmented_weight }),
         r.d_norm,
         lg(r.regularization),
         r.alpha_du,

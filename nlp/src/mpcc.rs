@@ -365,7 +365,7 @@ impl Budget<'_> {
 
     fn limited(&self, iters: usize, secs: f64) -> Box<dyn Solver> {
         let mut o = self.options.backend_options(self.backend);
-        let c = o.common_mut();
+        let c = &mut **o;
         c.max_iter = c.max_iter.min(iters);
         c.max_wall_time = c.max_wall_time.min(secs);
         o.solver()

@@ -59,6 +59,11 @@ pub trait NumericNlp {
     fn eval_cone_entries(&mut self, _x: &[f64], _out: &mut [f64]) {}
     /// Values of the cone-entry Jacobian in `cone_jac_sparsity` order.
     fn eval_cone_jac(&mut self, _x: &[f64], _values: &mut [f64]) {}
+    /// The parameter values the functions are evaluated with (default: none); solvers
+    /// copy them into [`crate::Solution::parameters`].
+    fn parameter_values(&self) -> &[f64] {
+        &[]
+    }
 }
 
 /// A second-order cone `‖v(x)‖ ≤ t(x)` whose entries are affine in x, exposed by

@@ -70,7 +70,9 @@ impl Status {
     }
 }
 
-/// One row of the IPOPT-style iteration table.
+/// One row of the IPOPT-style iteration table. The columns both back ends fill mean the
+/// same in both; `mu` and `jacobian_regularization` are the interior point's (0 in the
+/// SQP's rows), `augmented_weight` the SQP's (0 in the interior point's rows).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IterationRecord {
     /// Iteration number. The counter runs on through a restoration phase (IPOPT's
@@ -89,7 +91,7 @@ pub struct IterationRecord {
     /// (IPOPT prints the scaled value; the two differ when the objective is scaled). In
     /// restoration: the restoration problem's, as in IPOPT.
     pub inf_du: f64,
-    /// Barrier parameter μ (printed as lg(mu)).
+    /// Barrier parameter μ of the interior point (printed as lg(mu)); 0 in the SQP's rows.
     pub mu: f64,
     /// Max-norm of the primal step.
     pub d_norm: f64,
@@ -100,6 +102,11 @@ pub struct IterationRecord {
     /// leaves it 0). Absent in records serialised before it existed (read as 0).
     #[serde(default)]
     pub jacobian_regularization: f64,
+    /// The SQP's augmented weight ρ_a of its convexified Hessian (0: none; printed in the
+    /// lg(mu) column of the SQP's table); 0 in the interior point's rows. Absent in records
+    /// serialised before it existed (read as 0).
+    #[serde(default)]
+    pub augmented_weight: f64,
     /// Dual step size.
     pub alpha_du: f64,
     /// Primal step size.
@@ -188,6 +195,11 @@ pub struct Solution {
     pub message: String,
     /// Statistics.
     pub stats: Stats,
+    /// The parameter values the problem was solved with, in declaration order (empty for a
+    /// problem without parameters, and in files written before this field existed).
+    /// [`crate::Problem::value`] evaluates expressions with them.
+    #[serde(default)]
+    pub parameters: Vec<f64>,
 }
 
 impl Solution {

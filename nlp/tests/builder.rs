@@ -358,6 +358,37 @@ fn detected_rows_become_bounds() {
 }
 
 #[test]
+fn affine_single_variable_rows_become_bounds() {
+    // As CasADi's detect_simple_bounds: a row a·xⱼ + b with constant a ≠ 0, b is the bound
+    // (lo − b)/a ≤ xⱼ ≤ (hi − b)/a (sides swapped when a < 0). Values worked by hand.
+    let mut pb = Problem::new();
+    let x = pb.variable("x", 4).unwrap();
+    let p = pb.parameter("p", 1).unwrap();
+    pb.set_value(&p, &[1.0]).unwrap();
+    pb.minimize(x[0].sq() + x[1].sq() + x[2].sq() + x[3].sq());
+    pb.subject_to_named("shifted", (x[0] - 1.0).eq(0.0))
+        .unwrap(); // x₀ = 1
+    pb.subject_to_named("scaled", bounded(1.0, 2.0 * x[1] - 1.0, 3.0))
+        .unwrap(); // 1 ≤ x₁ ≤ 2
+    pb.subject_to_named("flipped", (3.0 - x[2] / 2.0).le(1.0))
+        .unwrap(); // x₂ ≥ 4
+    pb.subject_to_named("cancelled", (x[3] + x[0] - x[0]).ge(0.0))
+        .unwrap(); // a row: two variables written (no symbolic cancellation is assumed)
+    pb.subject_to_named("parametric", (x[3] - p[0]).ge(0.0))
+        .unwrap(); // a row: involves a parameter
+    pb.subject_to_named("nonlinear", x[3].sq().le(4.0)).unwrap(); // a row
+    let c = pb.compile().unwrap();
+    let (xl, xu, _, _) = bounds_of(&c);
+    assert_eq!(xl[..3], [1.0, 1.0, 4.0]);
+    assert_eq!(xu[..3], [1.0, 2.0, INF]);
+    let names: Vec<String> = (0..c.m()).map(|i| c.constraint_name(i)).collect();
+    assert_eq!(names, ["cancelled", "parametric", "nonlinear"]);
+    // With detection off every row stays a row.
+    pb.set_detect_simple_bounds(false);
+    assert_eq!(pb.compile().unwrap().m(), 6);
+}
+
+#[test]
 fn both_settings_reach_the_same_optimum() {
     // Rosenbrock with x₀ ≤ 0.5 written as a row: f* = 0.25 at (0.5, 0.25) (the constrained
     // minimiser of (1 − x₀)² + 100(x₁ − x₀²)² is on x₀ = 0.5 with x₁ = x₀²).

@@ -208,6 +208,11 @@ fn mistakes_are_reported() {
 
     let mut wrong = Ocp::new(&["x", "y"], &["u"]);
     wrong.set_dynamics(|x, _u, _p| Matrix::from_vec(vec![x[0]]));
+    // No final time: an error naming set_horizon, not a silent T = 1.
+    let err = wrong.transcribe(&m, 5).err().unwrap();
+    assert_eq!(err, OcpError::NoHorizon);
+    assert!(err.to_string().contains("set_horizon"), "{err}");
+    wrong.set_horizon(Horizon::Fixed(1.0)).unwrap();
     assert!(matches!(
         wrong.transcribe(&m, 5),
         Err(OcpError::Size {

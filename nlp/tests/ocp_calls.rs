@@ -151,6 +151,7 @@ fn bad_dynamics_functions_are_errors() {
     let x1 = Matrix::sym_vec("x", 1);
     let f = Function::new(&[&x1, &u, &p], &[&[x1[0] * p[0]]]).unwrap();
     ocp.set_dynamics_function(f).unwrap();
+    ocp.set_horizon(Horizon::Fixed(1.0)).unwrap();
     let err = ocp.transcribe(
         &Method::multiple_shooting_with_calls(ButcherTableau::rk4(), 1),
         3,

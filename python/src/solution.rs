@@ -97,6 +97,7 @@ fn record_dict<'py>(py: Python<'py>, r: &nlp::IterationRecord) -> PyResult<Bound
     d.set_item("inf_du", r.inf_du)?;
     d.set_item("lg_mu", r.mu.log10())?;
     d.set_item("mu", r.mu)?;
+    d.set_item("augmented_weight", r.augmented_weight)?;
     d.set_item("d_norm", r.d_norm)?;
     d.set_item("regularization", r.regularization)?;
     d.set_item("alpha_du", r.alpha_du)?;

@@ -568,7 +568,7 @@ pub fn forward(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
     let wrt = symbol_ids(inputs, "forward: inputs")?;
     check_len("seeds (one per input)", inputs.len(), seeds.len())?;
     let out = ids(outputs);
-    Ok(graph::with(|g| {
+    checked(|g| {
         let mut s = Sweep::new(g.len());
         s.set_wrt(&wrt);
         s.collect(g, &out, u32::MAX);
@@ -588,7 +588,7 @@ pub fn forward(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
                 })
             })
             .collect()
-    }))
+    })
 }
 
 /// Vector-Jacobian product: `Σᵢ seedᵢ · ∂outputᵢ/∂inputⱼ` for each input.
@@ -598,7 +598,7 @@ pub fn reverse(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
     let wrt = symbol_ids(inputs, "reverse: inputs")?;
     check_len("seeds (one per output)", outputs.len(), seeds.len())?;
     let out = ids(outputs);
-    Ok(graph::with(|g| {
+    checked(|g| {
         let mut s = Sweep::new(g.len());
         s.set_wrt(&wrt);
         s.collect(g, &out, u32::MAX);
@@ -609,7 +609,20 @@ pub fn reverse(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
         }
         reverse_pass(g, &mut s);
         wrt.iter().map(|&w| Expr::from_id(adjoint(&s, w))).collect()
-    }))
+    })
+}
+
+/// Runs a derivative sweep on this thread's graph; `Err` if it met an external function
+/// without a Jacobian (the expressions it built for it are then not used).
+fn checked<R>(sweep: impl FnOnce(&mut Graph) -> R) -> Result<R, SymxError> {
+    graph::with(|g| {
+        g.derivative_error = None;
+        let r = sweep(g);
+        match g.derivative_error.take() {
+            Some(e) => Err(e),
+            None => Ok(r),
+        }
+    })
 }
 
 /// `Σᵢ seedᵢ ∂outputᵢ/∂inputⱼ` for symbol nodes `inputs`, with every product guarded
@@ -710,7 +723,7 @@ fn sparse_from_entries(
 pub fn jacobian(outputs: &[Expr], inputs: &[Expr]) -> Result<SparseMatrix, SymxError> {
     let wrt = symbol_ids(inputs, "jacobian: inputs")?;
     let out = ids(outputs);
-    let entries = graph::with(|g| jacobian_rows(g, &out, &wrt, false));
+    let entries = checked(|g| jacobian_rows(g, &out, &wrt, false))?;
     Ok(sparse_from_entries(outputs.len(), inputs.len(), entries))
 }
 
@@ -719,7 +732,7 @@ pub fn hessian(f: Expr, inputs: &[Expr]) -> Result<SparseMatrix, SymxError> {
     let grad = gradient(f, inputs)?;
     let wrt = symbol_ids(inputs, "hessian: inputs")?;
     let out = ids(&grad);
-    let entries = graph::with(|g| jacobian_rows(g, &out, &wrt, true));
+    let entries = checked(|g| jacobian_rows(g, &out, &wrt, true))?;
     Ok(sparse_from_entries(inputs.len(), inputs.len(), entries))
 }
 

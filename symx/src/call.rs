@@ -233,16 +233,25 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
         return j.clone();
     }
     // A lookup function (`InterpolantN`) has no graph form: its partial derivatives are
-    // calls of the lookup functions of its derivative tables.
+    // calls of the lookup functions of its derivative tables. An external function has
+    // none either: its partial derivatives are the outputs of a call of its Jacobian
+    // function (or, without one, an error for the caller of the derivative builder).
     let lookup = f.lookup_table().cloned();
-    let (inputs, outputs) = match lookup {
-        Some(_) => (input_symbols(g, f), Vec::new()),
-        None => instantiate(g, f),
+    let external = f.external.as_ref().map(|e| e.jacobian.clone());
+    let missing = matches!(external, Some(None));
+    if missing {
+        g.derivative_error.get_or_insert(SymxError::NoDerivative {
+            name: f.name.clone(),
+        });
+    }
+    let (inputs, outputs) = match (&lookup, &external) {
+        (None, None) => instantiate(g, f),
+        _ => (input_symbols(g, f), Vec::new()),
     };
     let columns: Vec<usize> = (0..inputs.len()).filter(|&j| wrt[j]).collect();
     let wrt_syms: Vec<u32> = columns.iter().map(|&j| inputs[j]).collect();
-    let entries = match &lookup {
-        Some(table) => columns
+    let entries: Vec<(usize, usize, u32)> = match (&lookup, &external) {
+        (Some(table), _) => columns
             .iter()
             .enumerate()
             .map(|(c, &j)| {
@@ -250,7 +259,24 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
                 (0, c, g.call(&d, inputs.clone())[0])
             })
             .collect(),
-        None => crate::ad::jacobian_rows(g, &outputs, &wrt_syms, false),
+        (None, Some(Some((pattern, jac)))) => {
+            let jac = g.function_arc(jac);
+            let nonzeros = g.call(&jac, inputs.clone());
+            let mut column_of = vec![usize::MAX; inputs.len()];
+            for (c, &j) in columns.iter().enumerate() {
+                column_of[j] = c;
+            }
+            let mut e: Vec<(usize, usize, u32)> = crate::sparsity::entries(pattern)
+                .into_iter()
+                .zip(nonzeros)
+                .filter(|&((_, j), _)| wrt[j])
+                .map(|((i, j), v)| (i, column_of[j], v))
+                .collect();
+            e.sort_unstable_by_key(|&(i, c, _)| (i, c));
+            e
+        }
+        (None, Some(None)) => Vec::new(),
+        (None, None) => crate::ad::jacobian_rows(g, &outputs, &wrt_syms, false),
     };
     let (n_in, n_out) = (inputs.len(), f.output_sizes.iter().sum());
     let mut by_input = vec![Vec::new(); n_in];
@@ -279,12 +305,17 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
         .map(|k| g.symbol(&format!("{}.adj[{k}]", f.name)))
         .collect();
     let mut xbar = vec![Expr::zero(); n_in];
-    let vjp = match lookup {
-        Some(_) => entries
-            .iter()
-            .map(|e| g.binary(Op::StrongMul, ybar[0], e.2))
-            .collect(),
-        None => crate::ad::guarded_vjp(g, &outputs, &wrt_syms, &ybar),
+    let vjp = match (&lookup, &external) {
+        (None, None) => crate::ad::guarded_vjp(g, &outputs, &wrt_syms, &ybar),
+        // x̄_c = Σₖ ȳₖ ⊛ Jₖc over the nonzeros.
+        _ => {
+            let mut sums = vec![Expr::zero().id; columns.len()];
+            for &(k, c, e) in &entries {
+                let term = g.binary(Op::StrongMul, ybar[k], e);
+                sums[c] = g.binary(Op::Add, sums[c], term);
+            }
+            sums
+        }
     };
     for (&j, d) in columns.iter().zip(vjp) {
         xbar[j] = Expr::from_id(d);
@@ -303,5 +334,10 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
         by_input,
         by_output,
     });
+    if missing {
+        // Not kept: the derivative builder returns the error, and a later attempt
+        // (after the user adds a Jacobian, a new function) must fail again.
+        return jac;
+    }
     cache(f).entry(wrt.to_vec()).or_insert(jac).clone()
 }

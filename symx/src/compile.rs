@@ -254,6 +254,7 @@ pub(crate) fn compile(
         dependencies: OnceLock::new(),
         jacobians: Default::default(),
         native: None,
+        external: None,
     })
 }
 

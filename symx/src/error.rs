@@ -48,6 +48,14 @@ pub enum SymxError {
     /// without its `jit` feature.
     #[error("native code generation failed: {message}")]
     Jit { message: String },
+    /// [`crate::Function::with_jacobian`] on a function that is not external.
+    #[error("function '{name}' is not external: only an external function takes a user-supplied Jacobian")]
+    NotExternal { name: String },
+    /// A derivative through an external function that has none (see
+    /// [`crate::Function::with_jacobian`]); for a second derivative, `name` is the
+    /// Jacobian function (give it a Jacobian of its own).
+    #[error("cannot differentiate external function '{name}': it has no Jacobian (give one with Function::with_jacobian)")]
+    NoDerivative { name: String },
     /// A syntax error in [`crate::parse`].
     #[error("parse error at byte {position}: {message}")]
     Parse { position: usize, message: String },

@@ -27,6 +27,7 @@
 use crate::call::{CallInstr, JacobianCache};
 use crate::error::SymxError;
 use crate::expr::Expr;
+use crate::external::External;
 use crate::graph;
 use crate::native::{self, Evaluator, NativeCode};
 use crate::op::{self, Op};
@@ -95,6 +96,8 @@ pub struct Function {
     pub(crate) jacobians: Arc<Mutex<JacobianCache>>,
     /// Machine code computing what the tape computes (see [`Function::jit`]).
     pub(crate) native: Option<Arc<NativeCode>>,
+    /// User code computing the outputs, for an external function (its tape is empty).
+    pub(crate) external: Option<Arc<External>>,
 }
 
 /// The output slices as raw pointers, for [`Function::run`]: `&mut [f64]` and
@@ -240,6 +243,7 @@ impl Function {
         if self.native.is_some() {
             return Ok(self.clone());
         }
+        self.refuse_external("jit")?;
         let code = native::compile(self)?;
         Ok(Function {
             native: Some(Arc::new(code)),
@@ -408,6 +412,9 @@ impl Function {
         w: *mut f64,
         p: usize,
     ) {
+        if self.native.is_some() && self.run_native(inputs, outputs, w, p) {
+            return;
+        }
         for (k, x) in inputs.iter().enumerate() {
             if *self.input_used.get_unchecked(k) {
                 let n = *self.input_sizes.get_unchecked(k);
@@ -427,6 +434,40 @@ impl Function {
         }
     }
 
+    /// [`Function::run`] by the machine code reading the inputs and writing the outputs in
+    /// place; `false` (nothing done) if there are too many inputs or outputs for that.
+    /// Kept out of line so that the tape's loop in `run` is compiled as before.
+    ///
+    /// # Safety
+    /// As for [`Function::run`].
+    #[inline(never)]
+    unsafe fn run_native(
+        &self,
+        inputs: &[&[f64]],
+        outputs: *const *mut [f64],
+        w: *mut f64,
+        p: usize,
+    ) -> bool {
+        let Some(native) = &self.native else {
+            return false;
+        };
+        let (n_in, n_out) = (inputs.len(), self.output_sizes.len());
+        if n_in > crate::native::MAX_DIRECT || n_out > crate::native::MAX_DIRECT {
+            return false;
+        }
+        let mut args = [std::ptr::null::<f64>(); crate::native::MAX_DIRECT];
+        let mut res = [std::ptr::null_mut::<f64>(); crate::native::MAX_DIRECT];
+        for (k, x) in inputs.iter().enumerate() {
+            args[k] = x.as_ptr().add(p * self.input_sizes.get_unchecked(k));
+        }
+        for (k, r) in res.iter_mut().enumerate().take(n_out) {
+            let n = *self.output_sizes.get_unchecked(k);
+            *r = (*outputs.add(k)).cast::<f64>().add(p * n);
+        }
+        (native.entry)(w, args.as_ptr(), res.as_ptr());
+        true
+    }
+
     /// Runs the tape on a work vector whose input registers are filled.
     ///
     /// # Safety
@@ -435,7 +476,11 @@ impl Function {
     pub(crate) unsafe fn exec(&self, w: *mut f64) {
         if let Some(native) = &self.native {
             // SAFETY: the code does what the tape does (same registers, same template).
-            return (native.entry)(w);
+            return (native.entry)(w, std::ptr::null(), std::ptr::null());
+        }
+        if let Some(ext) = &self.external {
+            // SAFETY: the work vector of an external function is `[inputs | outputs]`.
+            return ext.run(w);
         }
         std::ptr::copy_nonoverlapping(
             self.template.as_ptr(),

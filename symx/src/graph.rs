@@ -75,6 +75,9 @@ pub(crate) struct Graph {
     pub call_index: FxHashMap<(u64, Vec<u32>), u32>,
     /// The called functions, by [`crate::Function`] identity, shared by their call sites.
     pub functions: FxHashMap<u64, Arc<crate::Function>>,
+    /// The first failure of the derivative sweep running (an external function without a
+    /// Jacobian), returned by the public derivative builders.
+    pub derivative_error: Option<crate::SymxError>,
 }
 
 thread_local! {
@@ -101,6 +104,7 @@ impl Graph {
             calls: Vec::new(),
             call_index: FxHashMap::default(),
             functions: FxHashMap::default(),
+            derivative_error: None,
         };
         // Indices 0 and 1 are the constants 0 and 1, used everywhere.
         g.intern(Node::constant(0.0));

@@ -318,6 +318,7 @@ impl Function {
             dependencies: OnceLock::new(),
             jacobians: Default::default(),
             native: None,
+            external: None,
         }
     }
 

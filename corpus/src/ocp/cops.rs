@@ -8,6 +8,18 @@ use symx::Expr;
 /// Goddard rocket: maximise the final altitude, `nh` trapezoidal intervals, free final
 /// time (`step` = tf/nh is a variable). n = 4(nh+1)+1.
 pub fn rocket(nh: usize) -> Result<Problem, BuildError> {
+    rocket_with(nh, false)
+}
+
+/// The Goddard rocket exactly as COPS writes it: the boundary values h(0), v(0), m(0) and
+/// m(T) as equality rows `x − value = 0` with those entries' simple bounds dropped. Same
+/// optimum as [`rocket`]; with simple bound detection on (the default) the rows become
+/// the bounds [`rocket`] sets.
+pub fn rocket_rows(nh: usize) -> Result<Problem, BuildError> {
+    rocket_with(nh, true)
+}
+
+fn rocket_with(nh: usize, boundary_rows: bool) -> Result<Problem, BuildError> {
     let (h0, v0, m0, g0): (f64, f64, f64, f64) = (1.0, 0.0, 1.0, 1.0);
     let (tc, hc, vc, mc) = (3.5, 500.0, 620.0, 0.6);
     let c = 0.5 * (g0 * h0).sqrt();
@@ -52,7 +64,20 @@ pub fn rocket(nh: usize) -> Result<Problem, BuildError> {
             step,
         )?;
     }
-    fix(&mut pb, &[h[0], v[0], m[0], m[nh]], &[h0, v0, m0, mf])?;
+    let ends = [h[0], v[0], m[0], m[nh]];
+    let values = [h0, v0, m0, mf];
+    if boundary_rows {
+        for x in ends {
+            pb.set_bounds(&[x], f64::NEG_INFINITY, f64::INFINITY)?;
+        }
+        let rows = ends
+            .iter()
+            .zip(values)
+            .map(|(&x, value)| (x - value).eq(0.0));
+        pb.subject_to_named("boundary", Constraint::all(rows))?;
+    } else {
+        fix(&mut pb, &ends, &values)?;
+    }
     pb.minimize(-h[nh]);
     Ok(pb)
 }

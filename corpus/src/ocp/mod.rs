@@ -85,6 +85,15 @@ pub static FAMILIES: &[Family] = &[
         references: &[Reference { size: 400, value: -1.01283, source: COPS_OPTIMA }],
     },
     Family {
+        name: "rocket_rows_trap",
+        kind: Kind::Ocp,
+        transcription: "trapezoidal",
+        source: "COPS 3.0 §7 Goddard rocket as COPS writes it (boundary values as equality rows, their bounds dropped); statement read in MadNLP/COPSBenchmark.jl ext/COPSBenchmarkJuMP/rocket.jl",
+        sizes: &[400, 1600, 6000],
+        build: cops::rocket_rows,
+        references: &[Reference { size: 400, value: -1.01283, source: COPS_OPTIMA }],
+    },
+    Family {
         name: "glider_trap",
         kind: Kind::Ocp,
         transcription: "trapezoidal",

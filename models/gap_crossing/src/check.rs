@@ -8,7 +8,10 @@
 //! Labels: `(2)`…`(11)` are the source's equations; `gap` is the terrain's keep-out (the
 //! widened gap; for other terrains, outside every allowed region); `start` is stance 1 = the scenario's start; `goal` is the final CoMs within 0.05 m
 //! of their goals; `crawl` (crawl gait mode only) is a foot moving out of its turn;
-//! `n_step` is a stance count that differs from the scenario's.
+//! `n_step` is a stance count that differs from the scenario's; `replanned` is a re-planned
+//! file whose measured stance is not one of its stances. A re-planned file's measured
+//! stance ([`crate::plan::Replanned`]) is checked for (2), (3), (4) and the keep-out only,
+//! and the transition into it is not checked: it is the perturbation.
 
 use crate::gait;
 use crate::plan::{SolutionFile, Stance};
@@ -206,7 +209,9 @@ impl Checker<'_> {
         }
     }
 
-    fn stance(&mut self, k: usize, st: &Stance) {
+    /// The checks of stance `k`; a `measured` stance (the state a re-plan started from,
+    /// [`crate::plan::Replanned`]) is not held to (6)–(9) and (11).
+    fn stance(&mut self, k: usize, st: &Stance, measured: bool) {
         let s = self.s;
         let m = s.masses.total();
         let w = (v3(st.com.b) * s.masses.b + v3(st.com.f) * s.masses.f) / m;
@@ -262,13 +267,15 @@ impl Checker<'_> {
             // (11) rigid legs.
             let j = i.biped();
             let l2 = dist2(st.com.get(j), p);
-            self.test(
-                "(11)",
-                &format!("leg length ‖r_{j} − r_foot‖² − {} (m²)", s.leg_length_sq),
-                k,
-                name.clone(),
-                (l2 - s.leg_length_sq).abs(),
-            );
+            if !measured {
+                self.test(
+                    "(11)",
+                    &format!("leg length ‖r_{j} − r_foot‖² − {} (m²)", s.leg_length_sq),
+                    k,
+                    name.clone(),
+                    (l2 - s.leg_length_sq).abs(),
+                );
+            }
             // Keep-out: distance from the nearest region where feet may stand.
             let inside = self.terrain.keep_out_depth(p[0], p[1]);
             if p[0].is_nan() || p[1].is_nan() || inside > 0.0 {
@@ -280,6 +287,9 @@ impl Checker<'_> {
                     inside,
                 );
             }
+        }
+        if measured {
+            return;
         }
         // (6)–(9) foot distances.
         let pairs = [
@@ -391,12 +401,30 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
             amount: (st.len() as f64 - s.n_step as f64).abs(),
         });
     }
+    // A re-planned file's measured stance (1-based), see [`crate::plan::Replanned`].
+    let measured = file.replanned.as_ref().map(|r| r.stance);
+    if let Some(m) = measured.filter(|&m| m < 2 || m > st.len()) {
+        c.out.push(Violation {
+            equation: "replanned".into(),
+            name: format!(
+                "measured stance outside 2..={} (the stances of the plan)",
+                st.len()
+            ),
+            stance: m,
+            foot: None,
+            amount: f64::NAN,
+        });
+    }
     for (k, stance) in st.iter().enumerate() {
-        c.stance(k + 1, stance);
+        c.stance(k + 1, stance, measured == Some(k + 1));
     }
     let schedule = gait::crawl_schedule(st.len());
     let mut moves = 0;
     for k in 0..st.len().saturating_sub(1) {
+        // The way into a measured stance is the perturbation, not a planned step.
+        if measured == Some(k + 2) {
+            continue;
+        }
         let turn = (s.gait == Gait::Crawl).then(|| schedule[k]);
         moves += c.transition(k + 1, &st[k], &st[k + 1], turn);
     }

@@ -15,6 +15,7 @@
 //!   beyond a gap), [`crossing_search`]: solving them, on the plan's walking horizon;
 //! - [`frame`]: the translation to the start's frame every plan is solved in;
 //! - [`reach`]: geometric certificates that a goal is unreachable;
+//! - [`replan`]: re-planning the rest of a plan from a measured (perturbed) stance;
 //! - [`status`]: the typed outcome of planning (solved, gap not crossable, goal not
 //!   reached, solver failed, check failed) and its exit code;
 //! - [`check`]: the independent checker, recomputing every residual from a solution file
@@ -42,6 +43,7 @@ pub mod output;
 pub mod plan;
 pub mod reach;
 pub mod render;
+pub mod replan;
 pub mod scenario;
 pub mod schedule_search;
 pub mod solve;

@@ -11,7 +11,7 @@
 //! "Size limit"), rounded up. It is compared
 //! with the memory the system reports available (`MemAvailable` of `/proc/meminfo`; when
 //! that cannot be read, [`FALLBACK_AVAILABLE_BYTES`]).
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, TerrainSpec};
 
 /// Fixed part of the memory estimate (bytes).
 pub const BASE_BYTES: u64 = 64 << 20;
@@ -27,22 +27,50 @@ pub const BYTES_PER_STANCE: u64 = 3 << 18;
 /// Memory assumed available when the system does not say (bytes).
 pub const FALLBACK_AVAILABLE_BYTES: u64 = 4 << 30;
 
+/// Memory per stance and per height-map node (bytes), 12 KiB: the model states a height
+/// map's height and slope as a sum over every node of the grid, at every foot query.
+/// Peak resident memory of the release CLI, crawl gait, n_step 60, 2026-11-27 (machine
+/// loaded; `/usr/bin/time -f %M`): 162 MiB on a 21 × 7 grid (147 nodes), 319 MiB on
+/// 41 × 13 (533 nodes); issue 20 reports 2.0 GB on a 0.1 m grid over 10 m × 3 m (3131
+/// nodes). With [`BYTES_PER_STANCE`] and [`BASE_BYTES`] the estimate is 212 MiB, 484 MiB
+/// and 2.3 GiB: 1.1–1.5× those peaks.
+pub const BYTES_PER_STANCE_NODE: u64 = 12 << 10;
+
 /// A problem too large for the memory available.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "n_step = {n_step} is too large: building and solving it needs about {} of memory \
-     (estimate {} + {} per stance), but {} is available; at most n_step = {max_n_step} fits",
-    gib(*estimate), gib(BASE_BYTES), mib(BYTES_PER_STANCE), gib(*available)
+    "n_step = {n_step}{} is too large: building and solving it needs about {} of memory \
+     (estimate {} + {} per stance{}), but {} is available; at most n_step = {max_n_step} fits",
+    grid_text(*nodes), gib(*estimate), gib(BASE_BYTES), mib(BYTES_PER_STANCE),
+    node_text(*nodes), gib(*available)
 )]
 pub struct TooLarge {
     /// The scenario's `n_step`.
     pub n_step: usize,
+    /// Nodes of the scenario's height map (0 for other terrains).
+    pub nodes: usize,
     /// Estimated peak memory (bytes).
     pub estimate: u64,
     /// Memory available (bytes).
     pub available: u64,
     /// The largest `n_step` whose estimate fits.
     pub max_n_step: usize,
+}
+
+fn grid_text(nodes: usize) -> String {
+    if nodes == 0 {
+        String::new()
+    } else {
+        format!(" on a height map of {nodes} nodes")
+    }
+}
+
+fn node_text(nodes: usize) -> String {
+    if nodes == 0 {
+        String::new()
+    } else {
+        format!(" + {} per stance and node", kib(BYTES_PER_STANCE_NODE))
+    }
 }
 
 fn gib(b: u64) -> String {
@@ -53,9 +81,31 @@ fn mib(b: u64) -> String {
     format!("{:.2} MiB", b as f64 / (1u64 << 20) as f64)
 }
 
-/// Estimated peak memory of planning `n_step` stances (bytes).
+fn kib(b: u64) -> String {
+    format!("{:.0} KiB", b as f64 / 1024.0)
+}
+
+/// Estimated peak memory of planning `n_step` stances on flat or analytic terrain (bytes).
 pub fn memory_estimate(n_step: usize) -> u64 {
-    BASE_BYTES.saturating_add(BYTES_PER_STANCE.saturating_mul(n_step as u64))
+    memory_estimate_on_grid(n_step, 0)
+}
+
+/// Estimated peak memory of planning `n_step` stances on a height map of `nodes` nodes
+/// (0: another terrain), bytes.
+pub fn memory_estimate_on_grid(n_step: usize, nodes: usize) -> u64 {
+    BASE_BYTES.saturating_add(per_stance(nodes).saturating_mul(n_step as u64))
+}
+
+fn per_stance(nodes: usize) -> u64 {
+    BYTES_PER_STANCE.saturating_add(BYTES_PER_STANCE_NODE.saturating_mul(nodes as u64))
+}
+
+/// The number of nodes of `s`'s height map (0 for other terrains).
+pub fn grid_nodes(s: &Scenario) -> usize {
+    match &s.terrain {
+        TerrainSpec::HeightMap { heights, .. } => heights.iter().map(Vec::len).sum(),
+        _ => 0,
+    }
 }
 
 /// The memory available, from `/proc/meminfo` (`MemAvailable`), if readable.
@@ -68,15 +118,17 @@ pub fn available_memory() -> Option<u64> {
 
 /// Refuses `s` when its estimate exceeds `available` bytes.
 pub fn check_with(s: &Scenario, available: u64) -> Result<(), TooLarge> {
-    let estimate = memory_estimate(s.n_step);
+    let nodes = grid_nodes(s);
+    let estimate = memory_estimate_on_grid(s.n_step, nodes);
     if estimate <= available {
         return Ok(());
     }
     Err(TooLarge {
         n_step: s.n_step,
+        nodes,
         estimate,
         available,
-        max_n_step: (available.saturating_sub(BASE_BYTES) / BYTES_PER_STANCE) as usize,
+        max_n_step: (available.saturating_sub(BASE_BYTES) / per_stance(nodes)) as usize,
     })
 }
 
@@ -104,6 +156,31 @@ mod tests {
         let msg = e.to_string();
         assert!(
             msg.contains("n_step = 100000") && msg.contains("GiB"),
+            "{msg}"
+        );
+    }
+
+    /// A height map's grid counts: 2000 × 2000 nodes at n_step 60 need terabytes and are
+    /// refused with the grid in the message; the 16 × 5 hills grid fits.
+    #[test]
+    fn counts_the_height_map_grid() {
+        let grid = |nx: usize, ny: usize| Scenario {
+            terrain: TerrainSpec::HeightMap {
+                file: "x.csv".into(),
+                origin: [0.0, 0.0],
+                spacing: [0.1, 0.1],
+                heights: vec![vec![0.0; nx]; ny],
+            },
+            ..Scenario::default()
+        };
+        let avail = 16u64 << 30;
+        assert!(check_with(&grid(16, 5), avail).is_ok());
+        let e = check_with(&grid(2000, 2000), avail).unwrap_err();
+        assert_eq!(e.nodes, 4_000_000);
+        assert_eq!(e.max_n_step, 0);
+        let msg = e.to_string();
+        assert!(
+            msg.contains("height map of 4000000 nodes") && msg.contains("per stance and node"),
             "{msg}"
         );
     }

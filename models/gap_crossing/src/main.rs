@@ -3,7 +3,8 @@
 //! Exit codes (docs/gap-crossing.md, "Exit codes"; `status::StatusKind::exit_code`):
 //! 0 success; 1 `solve`: solver failure or checker rejection, `check`: violations,
 //! `sweep`: some point not solved; 2 any error (bad arguments, bad files, invalid
-//! scenario or grid); 3 `solve`: gap not crossable; 4 `solve`: goal not reached.
+//! scenario or grid); 3 gap not crossable; 4 goal not reached; 5 infeasible; 6 no plan
+//! found (`solve` and `replan`).
 //! Errors go to stderr.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -43,6 +44,34 @@ enum Command {
     Sweep(SweepArgs),
     /// Write an initial guess (not a solution) as a plan file, with its plan.svg.
     Guess(GuessArgs),
+    /// Re-plan the rest of a plan from a measured stance (a perturbed CoM or foot): the
+    /// stances before it are kept, the rest re-solved warm; writes the files of `solve`.
+    Replan(ReplanArgs),
+}
+
+#[derive(Args, Debug)]
+struct ReplanArgs {
+    /// The plan to re-plan (a solution file, e.g. out/solution.json).
+    #[arg(long, value_name = "FILE")]
+    plan: PathBuf,
+    /// The measured stance K (1-based, 2..n_step−1): stances before it are kept.
+    #[arg(long, value_name = "K")]
+    stance: usize,
+    /// Measured offset of the CoM at stance K (added to both bipeds' CoMs), m.
+    #[arg(long, value_name = "DX,DY,DZ", allow_hyphen_values = true)]
+    com_offset: Option<String>,
+    /// Measured position of a foot at stance K, m (repeatable), e.g. `--foot FR=2.02,0,0`.
+    #[arg(long = "foot", value_name = "FOOT=X,Y,Z", allow_hyphen_values = true)]
+    foot: Vec<String>,
+    /// Then improve the re-plan by the free gait's schedule search (slower; the foot
+    /// schedule from stance K on may change).
+    #[arg(long)]
+    improve: bool,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    out: PathBuf,
+    #[command(flatten)]
+    solver: SolverArgs,
 }
 
 /// Scenario selection shared by `solve` and `guess`.
@@ -190,6 +219,10 @@ enum CliError {
     Threads(usize, String),
     #[error("{0}")]
     Opt(String),
+    #[error(transparent)]
+    Replan(#[from] gap_crossing::replan::ReplanError),
+    #[error("{0}")]
+    Perturbation(String),
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
@@ -267,7 +300,14 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     let s = scenario(&a.scenario)?;
     let settings = settings(&a.solver, 5)?;
     let outcome = solve::plan(&s, &settings)?;
+    report(&outcome, &a.out)
+}
+
+/// Writes a planning outcome's files in `out` (all or none) and prints its summary;
+/// the exit code of its status.
+fn report(outcome: &solve::Outcome, out: &Path) -> Result<ExitCode, CliError> {
     let file = &outcome.file;
+    let s = &file.scenario;
     let report = check::check(file);
 
     // Convergence history of all solver runs, numbered on, with the residual of (10) at
@@ -285,7 +325,7 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     // A plan that is not solved is written too, so that no older result stays in DIR:
     // its solution.json says why (`solver.status`, `solver.reason`).
     output::write_all(
-        &a.out,
+        out,
         &[
             ("solution.json", file.to_json().as_bytes()),
             ("convergence.json", history_json.as_bytes()),
@@ -308,14 +348,12 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
         }
         eprintln!(
             "wrote {}/solution.json with status {kind} (not a valid plan) and its drawings",
-            a.out.display()
+            out.display()
         );
         return Ok(ExitCode::from(kind.exit_code()));
     }
 
-    let moves = gap_crossing::plan::Plan::from_flat(&s, &file.plan().to_flat())
-        .map(|p| foot_moves(&p))
-        .unwrap_or_default();
+    let moves = foot_moves(&file.plan());
     println!();
     for phase in &outcome.phases {
         println!(
@@ -341,9 +379,66 @@ fn solve(a: &SolveArgs) -> Result<ExitCode, CliError> {
     println!("checker:    {}", report.summary());
     println!(
         "wrote {}/{{solution.json, plan.svg, plan.html, convergence.svg, convergence.json}}",
-        a.out.display()
+        out.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Three comma-separated numbers.
+fn triple(text: &str, what: &str) -> Result<[f64; 3], CliError> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| CliError::Perturbation(format!("{what} {text:?}: {e}")))?;
+    <[f64; 3]>::try_from(v).map_err(|v| {
+        CliError::Perturbation(format!(
+            "{what} {text:?}: expected 3 numbers x,y,z, got {}",
+            v.len()
+        ))
+    })
+}
+
+fn replan_cmd(a: &ReplanArgs) -> Result<ExitCode, CliError> {
+    use gap_crossing::replan::{self, Perturbation};
+    use gap_crossing::scenario::Foot;
+    let old = SolutionFile::read(&a.plan)?;
+    old.scenario
+        .validate()
+        .map_err(|source| CliError::FileScenario {
+            path: a.plan.clone(),
+            source,
+        })?;
+    let com_offset = match &a.com_offset {
+        Some(t) => triple(t, "--com-offset")?,
+        None => [0.0; 3],
+    };
+    let mut feet = Vec::new();
+    for f in &a.foot {
+        let (name, at) = f.split_once('=').ok_or_else(|| {
+            CliError::Perturbation(format!(
+                "--foot {f:?}: expected FOOT=X,Y,Z, e.g. FR=2.02,0,0"
+            ))
+        })?;
+        let foot = Foot::ALL
+            .into_iter()
+            .find(|i| i.name().eq_ignore_ascii_case(name.trim()))
+            .ok_or_else(|| {
+                CliError::Perturbation(format!(
+                    "--foot {f:?}: unknown foot {name:?} (BR, BL, FR or FL)"
+                ))
+            })?;
+        feet.push((foot, triple(at, &format!("--foot {}", foot.name()))?));
+    }
+    let settings = settings(&a.solver, 5)?;
+    let outcome = replan::replan_with(
+        &old,
+        a.stance,
+        &Perturbation { com_offset, feet },
+        &settings,
+        a.improve,
+    )?;
+    report(&outcome, &a.out)
 }
 
 /// "BR 15, BL 14, ..." from a plan.
@@ -622,6 +717,7 @@ fn main() -> ExitCode {
         Some(Command::Render(a)) => render_cmd(a),
         Some(Command::Sweep(a)) => sweep(a),
         Some(Command::Guess(a)) => guess_cmd(a),
+        Some(Command::Replan(a)) => replan_cmd(a),
     };
     match result {
         Ok(code) => code,

@@ -225,6 +225,27 @@ pub struct SolutionFile {
     pub solver: SolverInfo,
     /// Stances 1..n_step.
     pub stances: Vec<Stance>,
+    /// Present when the plan was re-planned from a measured stance
+    /// (`gap-crossing replan`, [`crate::replan`]); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replanned: Option<Replanned>,
+}
+
+/// How a re-planned file was made ([`crate::replan`]): stances before `stance` are the
+/// earlier plan's, stance `stance` is the measured state (the earlier plan's stance with
+/// the perturbation applied; its forces re-solved) and the later stances are re-planned.
+/// The checker holds the measured stance only to what a measurement must satisfy:
+/// (2), (3), (4) and the keep-out, not (6)–(9), (11), nor (5) and (10) on the way into it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Replanned {
+    /// The measured stance (1-based, at least 2).
+    pub stance: usize,
+    /// The offset applied to both CoMs of that stance (m).
+    pub com_offset: Vec3,
+    /// The feet given a measured position, by name (`"FR"`), with that position (m).
+    #[serde(default)]
+    pub feet: std::collections::BTreeMap<String, Vec3>,
 }
 
 fn scenario_with_defaults<'de, D: Deserializer<'de>>(d: D) -> Result<Scenario, D::Error> {
@@ -267,6 +288,7 @@ impl SolutionFile {
             scenario,
             solver,
             stances: plan.stances,
+            replanned: None,
         }
     }
 

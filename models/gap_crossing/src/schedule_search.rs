@@ -76,7 +76,7 @@ impl StanceSolver {
         let problem = build_stance(s, terrain)?;
         let compiled = problem.compile()?;
         let mut settings = settings.clone();
-        let common = settings.options_mut().common_mut();
+        let common = &mut **settings.options_mut();
         common.max_iter = common.max_iter.min(STANCE_MAX_ITER);
         common.print_level = 0;
         Ok(StanceSolver {

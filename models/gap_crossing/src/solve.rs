@@ -166,7 +166,7 @@ impl Settings {
     }
 
     fn print_level(&self) -> u8 {
-        self.options().common().print_level
+        self.options().print_level
     }
 
     /// The chosen back end with its options.
@@ -495,6 +495,63 @@ pub fn plan_on(
         }
         Gait::Free => free_gait(s, terrain, settings, &mut phases)?,
     };
+    finish(s, settings, last, without_10, phases, started)
+}
+
+/// Plans `s` by one warm solve of its scheduled problem with `schedule` from `guess` (a
+/// plan of `s`, e.g. the rest of an earlier plan: the re-plan of [`crate::replan`]), with
+/// the warm-start settings of the schedule search (barrier parameter [`SEARCH_MU_INIT`],
+/// bound push [`SEARCH_BOUND_PUSH`], at most [`SEARCH_MAX_ITER`] iterations). The
+/// certificates are decided first, as in [`plan_on`]. With `improve`, the free gait's
+/// schedule search ([`crate::schedule_search`], up to [`SEARCH_ROUNDS`] rounds) then
+/// starts from the warm solve's plan, and the best plan is kept.
+pub fn plan_warm(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    schedule: &[Foot],
+    guess: &Plan,
+    settings: &Settings,
+    improve: bool,
+) -> Result<Outcome, PlanningError> {
+    crate::limits::check(s)?;
+    if let Some(out) = proved_impossible(s, settings) {
+        return Ok(out);
+    }
+    let settings = &settings.consistent_with_checker(s, terrain).warm();
+    let started = Instant::now();
+    let mut phases = Vec::new();
+    let last = run(
+        s,
+        terrain,
+        schedule,
+        &guess.to_flat(),
+        settings,
+        &mut phases,
+        "re-plan",
+    )?;
+    if !improve {
+        return finish(s, settings, last, None, phases, started);
+    }
+    let mut best = last;
+    for solved in search_from(s, terrain, &settings.candidate(), &best, "re-plan")? {
+        let next = record(solved, settings, &mut phases);
+        if next.beats(&best) {
+            best = next;
+        }
+    }
+    finish(s, settings, best, None, phases, started)
+}
+
+/// The outcome of a planning run whose chosen solve is `last`: the plan, its solver
+/// report and the verdict ([`decide`]).
+fn finish(
+    s: &Scenario,
+    settings: &Settings,
+    last: Run,
+    without_10: Option<f64>,
+    phases: Vec<Phase>,
+    started: Instant,
+) -> Result<Outcome, PlanningError> {
     let plan = Plan::from_flat(s, &last.flat)?;
     let solver = SolverInfo {
         name: settings.options().solver().name().into(),
@@ -846,6 +903,7 @@ mod tests {
             d_norm: 1.0,
             regularization: 0.0,
             jacobian_regularization: 0.0,
+            augmented_weight: 0.0,
             alpha_du: 1.0,
             alpha_pr,
             alpha_pr_char: 'h',

@@ -470,10 +470,16 @@ impl HeightMap {
         (-1..=self.nx() as isize, -1..=self.heights.len() as isize)
     }
 
-    /// Height and gradient at a point (plain numbers).
+    /// Height and gradient at a point (plain numbers), from the at most 4 × 4 nodes whose
+    /// kernel reaches the point (the kernel vanishes beyond 2 spacings): O(1) in the
+    /// grid's size.
     fn eval(&self, x: f64, y: f64) -> (f64, [f64; 2]) {
         let (is, js) = self.indices();
         let [dx, dy] = self.spacing;
+        let (is, js) = (
+            support(is, (x - self.origin[0]) / dx),
+            support(js, (y - self.origin[1]) / dy),
+        );
         let (mut h, mut hx, mut hy) = (0.0, 0.0, 0.0);
         for j in js {
             let ty = (y - self.origin[1]) / dy - j as f64;
@@ -493,7 +499,9 @@ impl HeightMap {
         (h, [hx, hy])
     }
 
-    /// Height and gradient as expressions.
+    /// Height and gradient as expressions: a sum over every node of the grid (symx has no
+    /// lookup of a piecewise polynomial other than its own splines), so the model grows
+    /// with the grid ([`crate::limits::BYTES_PER_STANCE_NODE`]).
     fn expr(&self, x: Expr, y: Expr) -> (Expr, [Expr; 2]) {
         let (is, js) = self.indices();
         let [dx, dy] = self.spacing;
@@ -519,6 +527,18 @@ impl HeightMap {
         }
         (h, [hx, hy])
     }
+}
+
+/// The node indices of `all` whose Catmull-Rom kernel is non-zero at grid coordinate `u`
+/// (`|u − i| < 2`); all of them when `u` is not finite (the sum is then NaN, as it was).
+fn support(all: std::ops::RangeInclusive<isize>, u: f64) -> std::ops::RangeInclusive<isize> {
+    if !u.is_finite() {
+        return all;
+    }
+    let (lo, hi) = (*all.start() as f64, *all.end() as f64);
+    let a = (u - 2.0).floor().clamp(lo, hi) as isize;
+    let b = (u + 2.0).ceil().clamp(lo, hi) as isize;
+    a..=b
 }
 
 impl Terrain for HeightMap {
@@ -619,6 +639,60 @@ mod tests {
     /// linearly extrapolated), and is C¹: at the cell boundaries (integer t, where the
     /// kernel's pieces meet) the one-sided difference quotients of h and of its gradient
     /// agree to O(step).
+    /// The local evaluation (at most 4 × 4 nodes) gives exactly the sum over the whole
+    /// grid (every other term is a zero kernel value), inside the grid, on its edges and
+    /// beyond them.
+    #[test]
+    fn height_map_local_evaluation_equals_the_full_sum() {
+        let heights: Vec<Vec<f64>> = (0..20)
+            .map(|j| {
+                (0..30)
+                    .map(|i| ((i * 7 + j * 13) % 11) as f64 * 0.01 - 0.03)
+                    .collect()
+            })
+            .collect();
+        let m = HeightMap {
+            origin: [-1.0, 0.5],
+            spacing: [0.1, 0.2],
+            heights,
+        };
+        let full = |x: f64, y: f64| {
+            let (is, js) = m.indices();
+            let (mut h, mut hx, mut hy) = (0.0, 0.0, 0.0);
+            for j in js {
+                let ty = (y - m.origin[1]) / m.spacing[1] - j as f64;
+                let (ky, dky) = (catmull_rom(ty), catmull_rom_slope(ty) / m.spacing[1]);
+                for i in is.clone() {
+                    let tx = (x - m.origin[0]) / m.spacing[0] - i as f64;
+                    let (kx, dkx) = (catmull_rom(tx), catmull_rom_slope(tx) / m.spacing[0]);
+                    let z = m.node(i, j);
+                    h += z * kx * ky;
+                    hx += z * dkx * ky;
+                    hy += z * kx * dky;
+                }
+            }
+            (h, [hx, hy])
+        };
+        for a in 0..=70 {
+            for b in 0..=50 {
+                let (x, y) = (-1.3 + 0.0471 * a as f64, 0.2 + 0.0853 * b as f64);
+                let (h, g) = m.eval(x, y);
+                let (h0, g0) = full(x, y);
+                assert!(
+                    (h - h0).abs() <= 1e-15
+                        && (g[0] - g0[0]).abs() <= 1e-13
+                        && (g[1] - g0[1]).abs() <= 1e-13,
+                    "({x}, {y}): {h} {g:?} vs {h0} {g0:?}"
+                );
+            }
+        }
+        // Grid nodes and cell corners exactly.
+        assert_eq!(
+            m.eval(-1.0 + 0.1 * 4.0, 0.5 + 0.2 * 3.0).0,
+            full(-1.0 + 0.1 * 4.0, 0.5 + 0.2 * 3.0).0
+        );
+    }
+
     #[test]
     fn height_map_interpolates_and_is_c1() {
         let m = hills();

@@ -197,18 +197,33 @@ impl TerrainSpec {
     }
 }
 
-/// Reads a height-map CSV: rows of comma-separated numbers, `#` comment lines and blank
+/// The largest height-map CSV file read (bytes): 16 MiB, about a million nodes written
+/// with 15 characters each. Larger grids would not fit the planner's memory at any useful
+/// n_step ([`crate::limits::BYTES_PER_STANCE_NODE`]: a million nodes need 12 GiB per
+/// stance); a 2000 × 2000 CSV used to be read and planned for minutes with no output.
+pub const MAX_HEIGHT_CSV_BYTES: u64 = 16 << 20;
+
+/// Reads a height-map CSV (at most [`MAX_HEIGHT_CSV_BYTES`]): rows of comma-separated numbers, `#` comment lines and blank
 /// lines ignored. Every row must have the same number of columns (at least 2), and there
 /// must be at least 2 rows.
 pub fn read_height_csv(path: &Path) -> Result<Vec<Vec<f64>>, ScenarioError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+    let io = |source| ScenarioError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
     let bad = |message: String| ScenarioError::Syntax {
         path: path.to_path_buf(),
         message,
     };
+    let size = std::fs::metadata(path).map_err(io)?.len();
+    if size > MAX_HEIGHT_CSV_BYTES {
+        return Err(bad(format!(
+            "the file is {size} bytes, more than the {} MiB a height map may have (about a million nodes; \
+             the planner's memory grows with the grid's nodes times n_step, see docs/gap-crossing.md, \"Size limit\"): use a coarser grid",
+            MAX_HEIGHT_CSV_BYTES >> 20
+        )));
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
     let mut rows: Vec<Vec<f64>> = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let line = line.trim();

@@ -38,6 +38,7 @@ fn tiny() -> SolutionFile {
         scenario: s,
         solver: info(),
         stances: vec![st; 2],
+        replanned: None,
     }
 }
 

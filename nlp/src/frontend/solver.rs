@@ -2,19 +2,16 @@
 //! (`&dyn Solver`) instead of matching on the back end; [`SolverOptions`]: the same for
 //! their options (set by name, the common part, the solver they configure).
 
-use std::ops::ControlFlow;
+use std::ops::{ControlFlow, Deref, DerefMut};
 
 use super::CommonOptions;
 use crate::callback::{IterationCallback, IterationView};
 use crate::error::SolveError;
-use crate::ipm::Ipm;
 use crate::numeric::NumericNlp;
-use crate::option_names::{NamedOptions, OptionError};
-use crate::options::IpmOptions;
+use crate::option_names::OptionError;
 use crate::solution::Solution;
-use crate::sqp::{Sqp, SqpOptions};
 
-/// A solver of [`NumericNlp`]s: [`Ipm`] or [`Sqp`].
+/// A solver of [`NumericNlp`]s: [`Ipm`](crate::Ipm) or [`Sqp`](crate::Sqp).
 ///
 /// Implementors provide [`Solver::solve_dyn`]; the other methods are provided.
 /// ```
@@ -81,9 +78,67 @@ pub trait Solver: Send + Sync {
     }
 }
 
-/// The options of one back end ([`IpmOptions`] or [`SqpOptions`]) behind a `&dyn`, so
-/// that a driver holding either sets them by name, reads their common part and builds
-/// their solver without matching on the back end.
+/// The [`Solver`] entry points as inherent methods of a back end, each one call of
+/// [`Solver::solve_dyn`]: callers need no `use nlp::Solver` and pass callbacks by value.
+/// `$warm` documents what the back end's `solve_warm` reuses.
+macro_rules! solver_entry_points {
+    ($solver:ident, $warm:literal) => {
+        impl $solver {
+            /// Solves from the problem's initial point.
+            pub fn solve(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, None, None)
+            }
+
+            #[doc = $warm]
+            pub fn solve_warm(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+                previous: &$crate::solution::Solution,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, Some(previous), None)
+            }
+
+            /// `solve` with a per-iteration callback (IPOPT's `intermediate_callback`):
+            /// `callback` sees every iteration, restoration iterations and iteration 0
+            /// included, once per row of `Solution::stats.records`, before the
+            /// convergence test; returning [`ControlFlow::Break`](std::ops::ControlFlow::Break)
+            /// ends the solve with [`Status::UserRequestedStop`](crate::Status::UserRequestedStop)
+            /// at that point. See [`crate::callback`].
+            pub fn solve_with_callback(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+                mut callback: impl FnMut(
+                    &$crate::callback::IterationView<'_>,
+                ) -> std::ops::ControlFlow<()>,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, None, Some(&mut callback))
+            }
+
+            /// `solve_warm` with a per-iteration callback (see `solve_with_callback`).
+            pub fn solve_warm_with_callback(
+                &self,
+                nlp: &mut dyn $crate::numeric::NumericNlp,
+                previous: &$crate::solution::Solution,
+                mut callback: impl FnMut(
+                    &$crate::callback::IterationView<'_>,
+                ) -> std::ops::ControlFlow<()>,
+            ) -> Result<$crate::solution::Solution, $crate::error::SolveError> {
+                $crate::frontend::Solver::solve_dyn(self, nlp, Some(previous), Some(&mut callback))
+            }
+        }
+    };
+}
+
+pub(crate) use solver_entry_points;
+
+/// The options of one back end ([`IpmOptions`](crate::IpmOptions) or
+/// [`SqpOptions`](crate::SqpOptions)) behind a `&dyn`, so
+/// that a driver holding either sets them by name, reads and writes their common part
+/// (through `Deref`/`DerefMut` to [`CommonOptions`], the one way to it, as on the
+/// concrete options) and builds their solver without matching on the back end.
 /// ```
 /// use nlp::{IpmOptions, SolverOptions, SqpOptions};
 ///
@@ -91,7 +146,8 @@ pub trait Solver: Send + Sync {
 /// let mut sqp = SqpOptions::default();
 /// for o in [&mut ipm as &mut dyn SolverOptions, &mut sqp] {
 ///     o.set_options_by_name(&["tol=1e-10", "max_iter=50"]).unwrap();
-///     assert_eq!((o.common().tol, o.common().max_iter), (1e-10, 50));
+///     // The common part through `Deref`, as on the concrete options (`ipm.tol`).
+///     assert_eq!((o.tol, o.max_iter), (1e-10, 50));
 ///     // An option of the other back end only is refused, named.
 ///     let err = o.set_options_by_name(&["mu_init=1e-3", "penalty_init=5"]).unwrap_err();
 ///     assert!(err.to_string().contains("unknown option"), "{err}");
@@ -99,44 +155,37 @@ pub trait Solver: Send + Sync {
 /// assert_eq!(ipm.solver().name(), "ipm");
 /// assert_eq!(sqp.solver().name(), "sqp");
 /// ```
-pub trait SolverOptions: Send + Sync + std::fmt::Debug {
-    /// Applies `KEY=VALUE` assignments in order (the names of [`NamedOptions`]: the
+pub trait SolverOptions:
+    Deref<Target = CommonOptions> + DerefMut + Send + Sync + std::fmt::Debug
+{
+    /// Applies `KEY=VALUE` assignments in order (the names of
+    /// [`NamedOptions`](crate::option_names::NamedOptions): the
     /// fields of the options struct); on any error nothing changes and the error names
     /// the option.
     fn set_options_by_name(&mut self, assignments: &[&str]) -> Result<(), OptionError>;
-
-    /// The options both back ends share (termination, output, scaling bounds).
-    fn common(&self) -> &CommonOptions;
-
-    /// The shared options, mutably.
-    fn common_mut(&mut self) -> &mut CommonOptions;
 
     /// The solver with a copy of these options.
     fn solver(&self) -> Box<dyn Solver>;
 }
 
-/// `SolverOptions` for an options struct with a `common` field, whose solver is built
-/// by `$solver::new`.
+/// `SolverOptions` for an options struct (with the `Deref` to [`CommonOptions`] of
+/// `strict_options_serde!`), whose solver is built by `$solver::new`; invoked by each
+/// back end, so that the front end does not import them.
 macro_rules! impl_solver_options {
     ($($options:ty => $solver:ident),*) => {$(
-        impl SolverOptions for $options {
-            fn set_options_by_name(&mut self, assignments: &[&str]) -> Result<(), OptionError> {
-                self.set_by_name(assignments)
+        impl $crate::frontend::SolverOptions for $options {
+            fn set_options_by_name(
+                &mut self,
+                assignments: &[&str],
+            ) -> Result<(), $crate::option_names::OptionError> {
+                $crate::option_names::NamedOptions::set_by_name(self, assignments)
             }
 
-            fn common(&self) -> &CommonOptions {
-                &self.common
-            }
-
-            fn common_mut(&mut self) -> &mut CommonOptions {
-                &mut self.common
-            }
-
-            fn solver(&self) -> Box<dyn Solver> {
+            fn solver(&self) -> Box<dyn $crate::frontend::Solver> {
                 Box::new($solver::new(self.clone()))
             }
         }
     )*};
 }
 
-impl_solver_options!(IpmOptions => Ipm, SqpOptions => Sqp);
+pub(crate) use impl_solver_options;

@@ -27,6 +27,30 @@ pub(crate) struct ConeDuals<'c> {
     pub z_cone: &'c [f64],
 }
 
+/// The end of every solve, after [`user_solution`]: the evaluation counters and times of
+/// `sc` written into `stats` (whose back-end parts are filled), the total and other times
+/// from `start`, `stats` moved into `sol`, and at `print_level` ≥ 3 the summary and the
+/// solution's message printed.
+pub(crate) fn conclude(
+    sol: &mut Solution,
+    mut stats: Stats,
+    sc: &ScaledNlp<'_>,
+    start: Instant,
+    print_level: u8,
+) {
+    sc.write_stats(&mut stats);
+    stats.total_seconds = start.elapsed().as_secs_f64();
+    stats.other_seconds =
+        (stats.total_seconds - stats.eval_seconds - stats.factor_seconds).max(0.0);
+    sol.stats = stats;
+    if print_level >= 3 {
+        print!("{}", crate::log::format_summary(sol));
+        if !sol.message.is_empty() {
+            println!("{}", sol.message);
+        }
+    }
+}
+
 /// Violation of `lo ≤ v ≤ hi`.
 fn viol(v: f64, lo: f64, hi: f64) -> f64 {
     (lo - v).max(v - hi).max(0.0)
@@ -54,6 +78,7 @@ pub(crate) fn user_solution(
     } = p;
     let (n, m) = (x.len(), lambda.len());
     let nlp = sc.user();
+    let parameters = nlp.parameter_values().to_vec();
     let jp = nlp.jac_g_sparsity().clone();
     let cp = nlp.cone_jac_sparsity().cloned();
     let t = Instant::now();
@@ -149,6 +174,7 @@ pub(crate) fn user_solution(
         compl,
         message,
         stats: Stats::default(),
+        parameters,
     }
 }
 

@@ -5,7 +5,7 @@
 //! scaled problem `frontend/scaled.rs`),
 //! `core` (iteration, KKT step with inertia correction, line search with second-order
 //! corrections), `filter`, `barrier` (μ updates), `restoration` (ℓ1 restoration
-//! phase solved by the same core).
+//! phase solved by the same core), `workspace` (what an `Ipm` keeps between solves).
 
 #![allow(clippy::needless_range_loop)]
 
@@ -16,13 +16,14 @@ pub(crate) mod filter;
 pub(crate) mod quality;
 pub(crate) mod reduced;
 mod restoration;
+mod workspace;
 
-use std::ops::ControlFlow;
 use std::time::Instant;
 
-use crate::callback::{IterationCallback, IterationView, Observer};
+use crate::callback::{IterationCallback, Observer};
 use crate::error::SolveError;
-use crate::frontend::user_solution::{user_solution, UserPoint};
+use crate::frontend::solver::{impl_solver_options, solver_entry_points};
+use crate::frontend::user_solution::{conclude, user_solution, UserPoint};
 use crate::frontend::validate::{validate, Validated};
 use crate::frontend::Solver;
 use crate::numeric::NumericNlp;
@@ -30,61 +31,43 @@ use crate::options::{IpmOptions, ScalingMethod};
 use crate::scaling::{gradient_scale, gradient_scale_up};
 use crate::solution::{Solution, Stats, Status};
 
-use self::core::{Core, Setup, Shared, Start};
+use self::core::{Core, Outcome, Setup, Shared, Start};
 use self::reduced::Reduced;
+use self::workspace::Workspace;
 
-/// The interior-point solver.
+/// The interior-point solver. It keeps the KKT system's symbolic analysis between
+/// solves of problems with the same structure (see [`Ipm::solve_warm`]); a clone starts
+/// without it.
 #[derive(Debug, Clone, Default)]
 pub struct Ipm {
     /// Options (IPOPT names and defaults).
     pub options: IpmOptions,
+    workspace: Workspace,
 }
 
 impl Ipm {
     /// A solver with the given options.
     pub fn new(options: IpmOptions) -> Self {
-        Ipm { options }
+        Ipm {
+            options,
+            workspace: Workspace::default(),
+        }
     }
+}
 
-    /// Solves from the problem's initial point.
-    pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, None, None)
-    }
+solver_entry_points!(
+    Ipm,
+    "Warm start from a previous solution (IPOPT's `warm_start_init_point = yes`): x, λ, \
+     z_L, z_U are reused, pushed into the interior with the `warm_start_*` options, and \
+     μ starts at `warm_start_mu_init`.\n\n\
+     The KKT system's pattern, ordering and symbolic factorisation are kept from the \
+     previous solve with this solver when the problem's structure (after removing fixed \
+     variables) is the same, as in an MPC loop; the iterates are those of a fresh solver."
+);
 
-    /// [`Ipm::solve`] with a per-iteration callback (IPOPT's `intermediate_callback`):
-    /// `callback` sees every iteration, restoration iterations and iteration 0 included,
-    /// once per row of `Solution::stats.records`, before the convergence test; returning
-    /// [`ControlFlow::Break`] ends the solve with [`Status::UserRequestedStop`] at that
-    /// point. See [`crate::callback`].
-    pub fn solve_with_callback(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
-    ) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, None, Some(&mut callback))
-    }
+impl_solver_options!(IpmOptions => Ipm);
 
-    /// [`Ipm::solve_warm`] with a per-iteration callback (see [`Ipm::solve_with_callback`]).
-    pub fn solve_warm_with_callback(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        previous: &Solution,
-        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
-    ) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, Some(previous), Some(&mut callback))
-    }
-
-    /// Warm start from a previous solution (IPOPT's `warm_start_init_point = yes`): x, λ,
-    /// z_L, z_U are reused, pushed into the interior with the `warm_start_*` options, and
-    /// μ starts at `warm_start_mu_init`.
-    pub fn solve_warm(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        previous: &Solution,
-    ) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, Some(previous), None)
-    }
-
+impl Ipm {
     fn run(
         &self,
         nlp: &mut dyn NumericNlp,
@@ -108,109 +91,103 @@ impl Ipm {
             iter: 0,
             observer,
         };
+        scale_at_start(&mut red, opts);
+        let mut out = self.iterate(&mut red, warm, &mut shared);
+        if opts.honor_original_bounds {
+            for (k, &j) in red.free.iter().enumerate() {
+                if let Some(w) = out.w.get_mut(k) {
+                    *w = w.clamp(v.x_l[j], v.x_u[j]);
+                }
+            }
+        }
+        let all_fixed = red.free.is_empty();
+        let mut sol = finish(&mut red, &v, out);
+        if all_fixed && sol.constr_viol > opts.constr_viol_tol {
+            sol.status = Status::InfeasibleProblemDetected;
+        }
+        shared.stats.iterations = shared.iter;
+        conclude(
+            &mut sol,
+            shared.stats,
+            &red.sc,
+            start_time,
+            opts.print_level,
+        );
+        Ok(sol)
+    }
+
+    /// The iterations on the reduced, scaled problem (none when every variable is fixed
+    /// or the equality rows outnumber the free variables), with the KKT system kept by
+    /// the workspace when the structure is the one it was analysed for.
+    fn iterate(
+        &self,
+        red: &mut Reduced<'_>,
+        warm: Option<&Solution>,
+        shared: &mut Shared<'_>,
+    ) -> Outcome {
+        let opts = &self.options;
         let n = red.free.len();
         let m = red.rows.len();
         let n_eq = red.g_l.iter().zip(&red.g_u).filter(|(l, u)| l == u).count();
-        scale_at_start(&mut red, opts);
-        let (status, w, y, zl, zu, message) = if n == 0 {
-            // Everything fixed: nothing to optimise; feasibility is checked below.
-            (
-                Status::SolveSucceeded,
-                vec![],
-                vec![0.0; m],
-                vec![],
-                vec![],
-                String::from("all variables are fixed"),
-            )
-        } else if n_eq > n {
-            (
+        if n == 0 {
+            // Everything fixed: nothing to optimise; feasibility is checked by the caller.
+            return Outcome::at_start(Status::SolveSucceeded, vec![], m, "all variables are fixed");
+        }
+        if n_eq > n {
+            return Outcome::at_start(
                 Status::NotEnoughDegreesOfFreedom,
                 red.x0.clone(),
-                vec![0.0; m],
-                vec![0.0; n],
-                vec![0.0; n],
+                m,
                 format!("{n_eq} equality constraints but only {n} free variables"),
-            )
-        } else {
-            let start = match warm {
-                None => Start::Cold,
-                Some(prev) => Start::Warm {
-                    y: red
-                        .rows
-                        .iter()
-                        .map(|&i| red.sc.scaling.lambda_from_user(i, prev.lambda[i]))
-                        .collect(),
-                    zl: red
-                        .free
-                        .iter()
-                        .map(|&j| red.sc.scaling.z_from_user(prev.z_l[j]))
-                        .collect(),
-                    zu: red
-                        .free
-                        .iter()
-                        .map(|&j| red.sc.scaling.z_from_user(prev.z_u[j]))
-                        .collect(),
-                },
-            };
-            let setup = Setup {
-                mu_init: if warm.is_some() {
-                    opts.warm_start_mu_init
-                } else {
-                    opts.mu_init
-                },
-                bound_relax_factor: opts.bound_relax_factor,
-                in_resto: false,
-                scaling: red.scaling(),
-                mu_strategy: opts.effective_mu_strategy(),
-            };
-            match Core::new(&mut red, opts, &setup) {
-                Err(e) => (
-                    Status::InternalError,
-                    red.x0.clone(),
-                    vec![0.0; m],
-                    vec![0.0; n],
-                    vec![0.0; n],
-                    e.to_string(),
-                ),
-                Ok(mut core) => {
-                    let out = core.run(&mut shared, start);
-                    (
-                        out.status,
-                        out.w[..n].to_vec(),
-                        out.y,
-                        out.zl[..n].to_vec(),
-                        out.zu[..n].to_vec(),
-                        out.message,
-                    )
-                }
-            }
+            );
+        }
+        let start = match warm {
+            None => Start::Cold,
+            Some(prev) => warm_start(red, prev),
         };
-        let mut w = w;
-        if opts.honor_original_bounds {
-            for (k, &j) in red.free.iter().enumerate() {
-                if k < w.len() {
-                    w[k] = w[k].clamp(v.x_l[j], v.x_u[j]);
-                }
+        let setup = Setup {
+            mu_init: if warm.is_some() {
+                opts.warm_start_mu_init
+            } else {
+                opts.mu_init
+            },
+            bound_relax_factor: opts.bound_relax_factor,
+            in_resto: false,
+            scaling: red.scaling(),
+            mu_strategy: opts.effective_mu_strategy(),
+        };
+        let kept = (self.workspace).take(n, m, red.hess_l_sparsity(), red.jac_g_sparsity());
+        match Core::new(red, opts, &setup, kept) {
+            Err(e) => Outcome::at_start(Status::InternalError, red.x0.clone(), m, e.to_string()),
+            Ok(mut core) => {
+                let out = core.run(shared, start);
+                let kkt = core.into_kkt();
+                (self.workspace).keep(kkt, red.hess_l_sparsity(), red.jac_g_sparsity());
+                out
             }
         }
-        let mut sol = finish(&mut red, &v, status, &w, &y, &zl, &zu, message);
-        if n == 0 && sol.constr_viol > opts.constr_viol_tol {
-            sol.status = Status::InfeasibleProblemDetected;
-        }
-        let mut stats = shared.stats;
-        stats.iterations = shared.iter;
-        red.sc.write_stats(&mut stats);
-        stats.total_seconds = start_time.elapsed().as_secs_f64();
-        stats.other_seconds =
-            (stats.total_seconds - stats.eval_seconds - stats.factor_seconds).max(0.0);
-        sol.stats = stats;
-        if opts.print_level >= 3 {
-            print!("{}", crate::log::format_summary(&sol));
-            if !sol.message.is_empty() {
-                println!("{}", sol.message);
-            }
-        }
-        Ok(sol)
+    }
+}
+
+/// The warm start's multipliers in the reduced problem's numbering and scaling.
+fn warm_start(red: &Reduced<'_>, prev: &Solution) -> Start {
+    let scaling = &red.sc.scaling;
+    Start::Warm {
+        y: red
+            .rows
+            .iter()
+            .map(|&i| scaling.lambda_from_user(i, prev.lambda[i]))
+            .collect(),
+        zl: red
+            .free
+            .iter()
+            .map(|&j| scaling.z_from_user(prev.z_l[j]))
+            .collect(),
+        zu: red
+            .free
+            .iter()
+            .map(|&j| scaling.z_from_user(prev.z_u[j]))
+            .collect(),
     }
 }
 
@@ -229,21 +206,21 @@ impl Solver for Ipm {
     }
 }
 
-/// Builds the user-level solution from the reduced, scaled iterate: fixed variables at
-/// their values, multipliers unscaled (rows without bounds: λ = 0), then the front end's
+/// Builds the user-level solution from the reduced, scaled iterate `out` (w = [x; s] or
+/// shorter: only its first `free.len()` entries are read): fixed variables at their
+/// values, multipliers unscaled (rows without bounds: λ = 0), then the front end's
 /// [`user_solution`].
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    red: &mut Reduced<'_>,
-    v: &Validated,
-    status: Status,
-    w: &[f64],
-    y: &[f64],
-    zl: &[f64],
-    zu: &[f64],
-    message: String,
-) -> Solution {
+fn finish(red: &mut Reduced<'_>, v: &Validated, out: Outcome) -> Solution {
     let (n_user, m_user) = (v.x_l.len(), v.g_l.len());
+    let Outcome {
+        status,
+        w,
+        y,
+        zl,
+        zu,
+        message,
+        ..
+    } = out;
     let mut point = UserPoint {
         x: red.x_full.clone(),
         lambda: vec![0.0; m_user],

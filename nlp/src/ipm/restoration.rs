@@ -323,7 +323,7 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         let mut inner_opts = opts.clone();
         inner_opts.acceptable_iter = 0;
         inner_opts.start_with_resto = false;
-        let mut inner = match Core::new(&mut resto, &inner_opts, &setup) {
+        let mut inner = match Core::new(&mut resto, &inner_opts, &setup, None) {
             Ok(c) => c,
             Err(e) => return Err(core.outcome(Status::RestorationFailed, e.to_string(), false)),
         };

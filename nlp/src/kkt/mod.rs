@@ -223,6 +223,13 @@ impl Kkt {
         self.n + self.m
     }
 
+    /// Forgets the numeric factor (keeps the pattern, the symbolic analysis and the work
+    /// space): the state of a new [`Kkt`], for reuse on a problem of the same structure.
+    pub(crate) fn reset(&mut self) {
+        self.factored = false;
+        self.last_residual_ratio = 0.0;
+    }
+
     /// True if faer chose the supernodal factorisation.
     #[cfg_attr(not(test), allow(dead_code))]
     pub fn is_supernodal(&self) -> bool {

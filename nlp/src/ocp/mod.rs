@@ -15,6 +15,7 @@
 //! it once per interval ([`Method::multiple_shooting_with_calls`]).
 mod butcher;
 mod collocation;
+mod grid;
 mod shift;
 mod simulator;
 mod trajectory;
@@ -22,6 +23,7 @@ mod transcription;
 
 pub use butcher::ButcherTableau;
 pub use collocation::{Collocation, CollocationPoints};
+pub use grid::{ControlInterpolation, Grid};
 pub use shift::Shift;
 pub use simulator::Simulator;
 pub use trajectory::{CollocationStates, Trajectory};
@@ -62,6 +64,9 @@ pub enum OcpError {
     /// No dynamics was given.
     #[error("the problem has no dynamics: call Ocp::set_dynamics")]
     NoDynamics,
+    /// No final time was given.
+    #[error("the problem has no final time: call Ocp::set_horizon (Horizon::Fixed(T) or Horizon::Free {{ .. }})")]
+    NoHorizon,
     /// An error of the underlying problem.
     #[error(transparent)]
     Build(#[from] BuildError),
@@ -174,6 +179,16 @@ pub enum Horizon {
 }
 
 impl Horizon {
+    /// A free final time `lower ≤ T ≤ upper` with an initial guess, i.e.
+    /// `Horizon::Free { lower, upper, guess }` (checked by [`Ocp::set_horizon`]).
+    pub const fn free(lower: f64, upper: f64, guess: f64) -> Horizon {
+        Horizon::Free {
+            lower,
+            upper,
+            guess,
+        }
+    }
+
     /// The fixed value or the guess.
     pub fn guess(&self) -> f64 {
         match *self {
@@ -192,13 +207,15 @@ impl Horizon {
 /// ```
 ///
 /// with `p` parameters (values fixed in a solve, changeable afterwards, and the variables
-/// of [`crate::sensitivity`]). Controls are piecewise constant on the transcription grid.
+/// of [`crate::sensitivity`]). Controls are piecewise constant on the transcription grid,
+/// or piecewise linear with values at the nodes ([`Ocp::set_control_interpolation`]).
 pub struct Ocp {
     pub(crate) states: Vec<String>,
     pub(crate) controls: Vec<String>,
     pub(crate) parameters: Vec<(String, Vec<f64>)>,
     pub(crate) dynamics: Option<Dynamics>,
-    pub(crate) horizon: Horizon,
+    pub(crate) horizon: Option<Horizon>,
+    pub(crate) control_interpolation: ControlInterpolation,
     pub(crate) stage_cost: Option<StageScalar>,
     pub(crate) terminal_cost: Option<TerminalFn>,
     pub(crate) path: Vec<(String, PathFn)>,
@@ -215,7 +232,21 @@ pub struct Ocp {
 
 impl Ocp {
     /// A problem with the named states and controls (their number is the size of `x` and
-    /// `u`), final time fixed at 1 until [`Ocp::set_horizon`], no costs and no bounds.
+    /// `u`), no costs and no bounds. The final time must be given with
+    /// [`Ocp::set_horizon`] before transcribing ([`OcpError::NoHorizon`] otherwise).
+    ///
+    /// Closures given to an `Ocp` (dynamics, costs, constraints, guesses) are stored in it,
+    /// so they must be `'static`: one that uses a local variable must own it — write
+    /// `move |x, u, p| …` (without `move` the compiler reports E0373, "closure may outlive
+    /// the current function"). Copy or clone what the closure needs before it:
+    ///
+    /// ```
+    /// use nlp::ocp::Ocp;
+    /// use symx::Matrix;
+    /// let mass = 2.0; // a local captured by the closure: `move` copies it in
+    /// let mut ocp = Ocp::new(&["x", "v"], &["f"]);
+    /// ocp.set_dynamics(move |x, u, _p| Matrix::from_vec(vec![x[1], u[0] / mass]));
+    /// ```
     pub fn new(states: &[&str], controls: &[&str]) -> Ocp {
         let (nx, nu) = (states.len(), controls.len());
         Ocp {
@@ -223,7 +254,8 @@ impl Ocp {
             controls: controls.iter().map(|s| s.to_string()).collect(),
             parameters: Vec::new(),
             dynamics: None,
-            horizon: Horizon::Fixed(1.0),
+            horizon: None,
+            control_interpolation: ControlInterpolation::PiecewiseConstant,
             stage_cost: None,
             terminal_cost: None,
             path: Vec::new(),
@@ -314,6 +346,7 @@ impl Ocp {
     /// ocp.set_dynamics_function(f).unwrap();
     /// ocp.set_stage_cost(|x, u, _| x[0].sq() + u[0].sq());
     /// ocp.set_initial_state(&[1.0]).unwrap();
+    /// ocp.set_horizon(nlp::ocp::Horizon::Fixed(1.0)).unwrap();
     /// let tr = ocp.transcribe(&Method::collocation(nlp::ocp::CollocationPoints::Radau, 3).unwrap(), 50).unwrap();
     /// // 50 intervals × 3 collocation points = 150 calls of the one function f.
     /// assert!(tr.problem().constraint_expressions()[0].to_string().contains("f("));
@@ -361,10 +394,18 @@ impl Ocp {
                 bad("need 0 ≤ lower ≤ guess ≤ upper and a finite guess > 0")
             }
             _ => {
-                self.horizon = horizon;
+                self.horizon = Some(horizon);
                 Ok(())
             }
         }
+    }
+
+    /// Sets how the controls vary on the transcription grid: piecewise constant (the
+    /// default, one value per interval) or piecewise linear (one value per node, `U` is
+    /// `nu × (N+1)`). Every method supports both; with multiple shooting a linear control
+    /// is integrated exactly as a function of time within each Runge–Kutta step.
+    pub fn set_control_interpolation(&mut self, interpolation: ControlInterpolation) {
+        self.control_interpolation = interpolation;
     }
 
     /// Sets the Lagrange integrand `l(x, u, p)` of the cost `∫₀ᵀ l dt`.
@@ -436,6 +477,7 @@ impl Ocp {
     /// ocp.set_dynamics(|x, u, _p| Matrix::from_vec(vec![-x[0] + u[0]]));
     /// ocp.set_stage_cost(|x, u, _p| x[0].sq() + u[0].sq());
     /// ocp.set_initial_state_parameter("x0", &[1.0]).unwrap();
+    /// ocp.set_horizon(nlp::ocp::Horizon::Fixed(1.0)).unwrap();
     /// let tr = ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 10).unwrap();
     /// assert_eq!(tr.initial_state_parameter(), Some("x0"));
     /// let mut compiled = tr.compile().unwrap();
@@ -468,13 +510,29 @@ impl Ocp {
         Ok(())
     }
 
-    /// Guesses the states as a function of time `t ∈ [0, T]` (`T` the fixed value or the
-    /// horizon's guess); it must return `nx` finite values.
+    /// Guesses the states as a function of the absolute time `t ∈ [0, T]` (`T` the fixed
+    /// final time or, for a free one, the horizon's `guess`; `t` is not normalised to
+    /// `[0, 1]`); it must return `nx` finite values. It is called at every grid node (and
+    /// collocation or midpoint state) when transcribing.
+    ///
+    /// ```
+    /// use nlp::ocp::{Horizon, Method, Ocp};
+    /// use symx::Matrix;
+    /// let mut ocp = Ocp::new(&["x"], &[]);
+    /// ocp.set_dynamics(|_x, _u, _p| Matrix::from_vec(vec![1.0.into()]));
+    /// ocp.set_horizon(Horizon::Fixed(4.0)).unwrap();
+    /// ocp.set_state_guess(|t| vec![t]); // t runs over 0 … 4
+    /// let tr = ocp.transcribe(&Method::trapezoidal(), 2).unwrap();
+    /// let x0 = tr.problem().initial_point();
+    /// assert_eq!(&x0[..3], [0.0, 2.0, 4.0]);
+    /// ```
     pub fn set_state_guess(&mut self, x: impl Fn(f64) -> Vec<f64> + 'static) {
         self.state_guess = Some(Box::new(move |t, _| x(t)));
     }
 
-    /// Guesses the controls as a function of time (`nu` finite values).
+    /// Guesses the controls as a function of the absolute time `t` (as
+    /// [`Ocp::set_state_guess`]; `nu` finite values), at the interval starts for
+    /// piecewise-constant controls and at every node for piecewise-linear ones.
     pub fn set_control_guess(&mut self, u: impl Fn(f64) -> Vec<f64> + 'static) {
         self.control_guess = Some(Box::new(move |t, _| u(t)));
     }

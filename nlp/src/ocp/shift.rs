@@ -25,6 +25,7 @@ use symx::Matrix;
 /// let mut ocp = Ocp::new(&["x"], &["u"]);
 /// ocp.set_dynamics(|x, u, _p| Matrix::from_vec(vec![u[0] - x[0]]));
 /// ocp.set_initial_state_parameter("x0", &[1.0]).unwrap();
+/// ocp.set_horizon(nlp::ocp::Horizon::Fixed(1.0)).unwrap();
 /// let tr = ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 3).unwrap();
 /// let shift = tr.shift_plan().unwrap();
 /// // x = (X0, X1, X2, X3, U0, U1, U2): each stage takes the next one's value.
@@ -35,7 +36,7 @@ use symx::Matrix;
 ///     lambda: vec![5.0, 20.0, 21.0, 22.0],
 ///     z_l: vec![0.0; 7], z_u: vec![0.0; 7], g: vec![0.0; 4],
 ///     objective: 0.0, constr_viol: 0.0, dual_inf: 0.0, compl: 0.0,
-///     message: String::new(), stats: Default::default(),
+///     message: String::new(), stats: Default::default(), parameters: vec![1.0],
 /// };
 /// shift.apply(&mut sol).unwrap();
 /// assert_eq!(sol.lambda, [5.0, 21.0, 22.0, 22.0]); // the initial state's row stays
@@ -104,8 +105,17 @@ impl Shift {
 impl Transcription {
     /// The plan of [`Shift`] for this transcription (computed once; apply it every MPC
     /// step). Call it after any [`Transcription::problem_mut`] additions. An error names a
-    /// per-stage constraint group whose rows are simple bounds at some stages only.
+    /// per-stage constraint group whose rows are simple bounds at some stages only, or a
+    /// grid that is not uniform.
     pub fn shift_plan(&self) -> Result<Shift, OcpError> {
+        if !self.grid().is_uniform() {
+            // One stage is one sampling period only when every interval has the same length.
+            return Err(OcpError::Invalid {
+                what: "shift".into(),
+                why: "needs a uniform grid (Grid::uniform): one stage must be one sampling period"
+                    .into(),
+            });
+        }
         let pb = self.problem();
         let n = self.intervals();
         let mut variable_moves = Vec::new();
@@ -121,7 +131,7 @@ impl Transcription {
         };
         columns(self.states(), n + 1, 1)?;
         if self.controls().nrows() > 0 {
-            columns(self.controls(), n, 1)?;
+            columns(self.controls(), self.controls().ncols(), 1)?;
         }
         if let Some(xc) = self.collocation_states() {
             columns(xc, n, xc.ncols() / n)?;

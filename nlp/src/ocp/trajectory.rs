@@ -1,4 +1,5 @@
 //! [`Trajectory`]: a solved optimal control problem as time series, ready to plot or save.
+use super::ControlInterpolation;
 use crate::solution::Status;
 use std::fmt::Write;
 
@@ -12,10 +13,11 @@ pub struct CollocationStates {
 }
 
 /// A solution as trajectories: one series per state on the time grid `t₀ = 0 … t_N = T`
-/// and one per control (piecewise constant, its value on `[t_k, t_{k+1})` stored at `t_k`).
+/// and one per control (piecewise constant, its value on `[t_k, t_{k+1})` stored at `t_k`;
+/// or piecewise linear, its values at the nodes).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Trajectory {
-    /// The grid `t_k = k T / N`, `k = 0…N`.
+    /// The grid nodes `t_k = s_k T`, `k = 0…N` (`t_k = k T / N` on a uniform grid).
     pub time: Vec<f64>,
     /// State names, in the order of `states`.
     pub state_names: Vec<String>,
@@ -23,10 +25,15 @@ pub struct Trajectory {
     pub states: Vec<Vec<f64>>,
     /// Control names, in the order of `controls`.
     pub control_names: Vec<String>,
-    /// Start of each interval, `t_k`, `k = 0…N−1`.
+    /// Start of each interval, `t_k`, `k = 0…N−1`; every node `k = 0…N` for
+    /// piecewise-linear controls.
     pub control_time: Vec<f64>,
-    /// `controls[j][k]`: control `j` on interval `k`.
+    /// `controls[j][k]`: control `j` on interval `k` (at node `k` for piecewise-linear
+    /// controls).
     pub controls: Vec<Vec<f64>>,
+    /// How the controls vary between `control_time`s (files without it: piecewise constant).
+    #[serde(default)]
+    pub control_interpolation: ControlInterpolation,
     /// The final time T.
     pub final_time: f64,
     /// The optimal objective.
@@ -68,22 +75,32 @@ impl Trajectory {
             .collect()
     }
 
-    /// The controls at time `t` (piecewise constant; clamped to `[0, T]`).
+    /// The controls at time `t` (piecewise constant or linear, as solved; clamped to
+    /// `[0, T]`).
     pub fn controls_at(&self, t: f64) -> Vec<f64> {
-        let (k, _) = self.locate(t);
+        let (k, s) = self.locate(t);
         let k = k.min(self.control_time.len().saturating_sub(1));
-        self.controls.iter().map(|u| u[k]).collect()
+        let linear = self.control_interpolation == ControlInterpolation::PiecewiseLinear;
+        self.controls
+            .iter()
+            .map(|u| match (linear, u.get(k + 1)) {
+                (true, Some(&next)) => u[k] + s * (next - u[k]),
+                _ => u[k],
+            })
+            .collect()
     }
 
-    /// Interval index k and fraction s ∈ [0, 1] of time t.
+    /// Interval index k and fraction s ∈ [0, 1] of time t on the grid `time`.
     fn locate(&self, t: f64) -> (usize, f64) {
         let n = self.time.len() - 1;
         if n == 0 || self.final_time <= 0.0 {
             return (0, 0.0);
         }
-        let r = (t / self.final_time).clamp(0.0, 1.0) * n as f64;
-        let k = (r.floor() as usize).min(n - 1);
-        (k, r - k as f64)
+        let t = t.clamp(0.0, self.final_time);
+        // The last node at or before t, at most N − 1.
+        let k = self.time[1..n].partition_point(|&tk| tk <= t);
+        let (a, b) = (self.time[k], self.time[k + 1]);
+        (k, ((t - a) / (b - a)).clamp(0.0, 1.0))
     }
 
     /// The grid as CSV: a header `t,<states>,<controls>` and one line per grid point (the

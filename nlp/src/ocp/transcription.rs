@@ -1,6 +1,10 @@
-//! Transcription of an [`Ocp`] into a [`Problem`]: direct multiple shooting or direct
-//! collocation on a uniform grid of `N` intervals with piecewise-constant controls.
-use super::{ButcherTableau, Collocation, CollocationPoints, Ocp, OcpError, Trajectory};
+//! Transcription of an [`Ocp`] into a [`Problem`]: direct multiple shooting, direct
+//! collocation, trapezoidal or Hermite–Simpson collocation on a uniform or user-given
+//! [`Grid`] of `N` intervals, with controls piecewise constant or linear between nodes.
+use super::{
+    ButcherTableau, Collocation, CollocationPoints, ControlInterpolation, Grid, Ocp, OcpError,
+    Trajectory,
+};
 use crate::compiled::Compiled;
 use crate::constraint::{Constraint, Relation};
 use crate::problem::Problem;
@@ -29,6 +33,22 @@ pub enum Method {
     /// collocation points are variables (named `Xc`), and the dynamics hold at those
     /// points; the Lagrange cost uses the collocation quadrature.
     Collocation(Collocation),
+    /// Trapezoidal collocation (Betts 2010, §4.5; COPS 3.0's Goddard rocket): on interval
+    /// `k`, `x_{k+1} = x_k + h_k/2 (f(x_k, u) + f(x_{k+1}, u))`; the Lagrange cost by the
+    /// trapezoidal rule. Second order; no variables beyond `X` and `U`.
+    Trapezoidal,
+    /// Hermite–Simpson collocation (Betts 2010, §4.5; Kelly 2017, SIAM Rev. 59): the state
+    /// is a Hermite cubic on each interval, its midpoint
+    /// `x_m = (x_k + x_{k+1})/2 + h_k/8 (f_k − f_{k+1})`, and Simpson's rule
+    /// `x_{k+1} = x_k + h_k/6 (f_k + 4 f_m + f_{k+1})` with `f_m = f(x_m, u_m)`; the Lagrange
+    /// cost by Simpson's rule. Fourth order in the state. The midpoint control `u_m` is the
+    /// interval's control, or the mean of the node controls when they are linear.
+    HermiteSimpson {
+        /// Separated form: the midpoint states are variables (`Xm`, `nx × N`, with the state
+        /// bounds) tied to the cubic by the constraint group `midpoint`; sparser and larger.
+        /// Compressed form (`false`): `x_m` is an expression of `X`, fewer variables.
+        separated: bool,
+    },
 }
 
 impl Method {
@@ -56,16 +76,35 @@ impl Method {
     pub fn collocation(points: CollocationPoints, degree: usize) -> Result<Method, OcpError> {
         Ok(Method::Collocation(Collocation::new(points, degree)?))
     }
+
+    /// Trapezoidal collocation ([`Method::Trapezoidal`]).
+    pub fn trapezoidal() -> Method {
+        Method::Trapezoidal
+    }
+
+    /// Hermite–Simpson collocation, compressed ([`Method::HermiteSimpson`]).
+    pub fn hermite_simpson() -> Method {
+        Method::HermiteSimpson { separated: false }
+    }
+
+    /// Hermite–Simpson collocation, separated: midpoint states as variables
+    /// ([`Method::HermiteSimpson`]).
+    pub fn hermite_simpson_separated() -> Method {
+        Method::HermiteSimpson { separated: true }
+    }
 }
 
 /// An [`Ocp`] written as a [`Problem`], with what is needed to read solutions back.
 ///
-/// The problem's variables are `X` (`nx × (N+1)`, the grid states), `U` (`nu × N`), `T`
-/// for a free final time and `Xc` (`nx × N·d`) for collocation; its parameters are the
-/// OCP's. [`Transcription::problem_mut`] allows adding anything else before compiling.
+/// The problem's variables are `X` (`nx × (N+1)`, the grid states), `U` (`nu × N`, or
+/// `nu × (N+1)` for controls at the nodes), `T` for a free final time, `Xc` (`nx × N·d`)
+/// for direct collocation and `Xm` (`nx × N`) for separated Hermite–Simpson; its
+/// parameters are the OCP's. [`Transcription::problem_mut`] allows adding anything else before compiling.
 pub struct Transcription {
     problem: Problem,
     intervals: usize,
+    grid: Grid,
+    control_interpolation: ControlInterpolation,
     states: Matrix,
     controls: Matrix,
     collocation_states: Option<Matrix>,
@@ -126,17 +165,35 @@ impl RowLog {
     }
 }
 
-const RESERVED: [&str; 4] = ["X", "U", "T", "Xc"];
+const RESERVED: [&str; 5] = ["X", "U", "T", "Xc", "Xm"];
 
 impl Ocp {
-    /// Writes the problem on `intervals` (N ≥ 1) uniform intervals with `method`.
+    /// Writes the problem on `intervals` (N ≥ 1) uniform intervals with `method`
+    /// ([`Ocp::transcribe_on`] with [`Grid::uniform`]).
     pub fn transcribe(&self, method: &Method, intervals: usize) -> Result<Transcription, OcpError> {
-        let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
-        let (nx, nu, n) = (self.nx(), self.nu(), intervals);
-        if n == 0 || nx == 0 {
+        if intervals == 0 || self.nx() == 0 {
             return Err(OcpError::Invalid {
                 what: "transcription".into(),
-                why: format!("needs at least one interval and one state (N = {n}, nx = {nx})"),
+                why: format!(
+                    "needs at least one interval and one state (N = {intervals}, nx = {})",
+                    self.nx()
+                ),
+            });
+        }
+        self.transcribe_on(method, &Grid::uniform(intervals)?)
+    }
+
+    /// Writes the problem with `method` on `grid` (uniform or user-given, see [`Grid`]).
+    /// Errors: no dynamics, no horizon ([`OcpError::NoHorizon`]), closures returning the
+    /// wrong sizes, and what the [`Problem`] builder reports.
+    pub fn transcribe_on(&self, method: &Method, grid: &Grid) -> Result<Transcription, OcpError> {
+        let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
+        let horizon = self.horizon.ok_or(OcpError::NoHorizon)?;
+        let (nx, nu, n) = (self.nx(), self.nu(), grid.intervals());
+        if nx == 0 {
+            return Err(OcpError::Invalid {
+                what: "transcription".into(),
+                why: "needs at least one state".into(),
             });
         }
         if let Method::MultipleShooting { steps: 0, .. } = method {
@@ -145,14 +202,16 @@ impl Ocp {
                 why: "steps per interval must be ≥ 1".into(),
             });
         }
+        let linear = self.control_interpolation == ControlInterpolation::PiecewiseLinear;
+        let n_u = if linear { n + 1 } else { n };
         let mut pb = Problem::new();
         let x = pb.variable_matrix("X", nx, n + 1)?;
         let u = if nu > 0 {
-            pb.variable_matrix("U", nu, n)?
+            pb.variable_matrix("U", nu, n_u)?
         } else {
-            Matrix::zeros(0, n)
+            Matrix::zeros(0, n_u)
         };
-        let t_f = match self.horizon {
+        let t_f = match horizon {
             super::Horizon::Fixed(t) => Expr::constant(t),
             super::Horizon::Free {
                 lower,
@@ -212,13 +271,21 @@ impl Ocp {
             let c = col(&x, n)?.eq(&Matrix::from_f64(xf));
             log.add(&mut pb, "final state", c, None)?;
         }
-        let h = t_f / n as f64;
+        // Interval lengths: T/N on a uniform grid (one expression), (s_{k+1} − s_k)·T otherwise.
+        let s = grid.fractions();
+        let h: Vec<Expr> = (0..n)
+            .map(|k| match grid.is_uniform() {
+                true => t_f / n as f64,
+                false => t_f * (s[k + 1] - s[k]),
+            })
+            .collect();
         let stage = Stage {
             ocp: self,
             x: &x,
             u: &u,
             p: &p,
-            h,
+            h: &h,
+            linear,
         };
         let (mut cost, xc, tau) = match method {
             Method::MultipleShooting {
@@ -234,10 +301,20 @@ impl Ocp {
                 let (cost, xc) = stage.collocation(&mut pb, &mut log, c)?;
                 (cost, Some(xc), c.tau.clone())
             }
+            Method::Trapezoidal => (stage.trapezoidal(&mut pb, &mut log)?, None, vec![0.0]),
+            Method::HermiteSimpson { separated } => {
+                let (cost, xm) = stage.hermite_simpson(&mut pb, &mut log, *separated)?;
+                let tau = if xm.is_some() {
+                    vec![0.0, 0.5]
+                } else {
+                    vec![0.0]
+                };
+                (cost, xm, tau)
+            }
         };
         for (name, c) in &self.path {
             let rows = (0..=n)
-                .map(|k| Ok(c(&col(&x, k)?, &col(&u, k.min(n - 1))?, &p)))
+                .map(|k| Ok(c(&col(&x, k)?, &stage.node_control(k)?, &p)))
                 .collect::<Result<Vec<_>, OcpError>>()?;
             log.add(&mut pb, name, Constraint::all(rows), Some(n + 1))?;
         }
@@ -251,6 +328,8 @@ impl Ocp {
         let tr = Transcription {
             problem: pb,
             intervals: n,
+            grid: grid.clone(),
+            control_interpolation: self.control_interpolation,
             states: x,
             controls: u,
             collocation_states: xc,
@@ -261,13 +340,12 @@ impl Ocp {
             initial_state_parameter: self.initial_state_parameter.clone(),
             staged_rows: log.staged,
         };
-        self.apply_guess(tr)
+        self.apply_guess(tr, horizon.guess())
     }
 
-    fn apply_guess(&self, mut tr: Transcription) -> Result<Transcription, OcpError> {
+    fn apply_guess(&self, mut tr: Transcription, t_f: f64) -> Result<Transcription, OcpError> {
         let n = tr.intervals;
-        let t_f = self.horizon.guess();
-        let times = |k: usize, tau: f64| (k as f64 + tau) * t_f / n as f64;
+        let grid = tr.grid.clone();
         if let Some(g) = &self.state_guess {
             let mut set = |m: &Matrix, col: usize, t: f64| -> Result<(), OcpError> {
                 let v = g(t, t_f);
@@ -283,20 +361,20 @@ impl Ocp {
                     })
             };
             for k in 0..=n {
-                set(&tr.states, k, times(k, 0.0))?;
+                set(&tr.states, k, grid.time(k, t_f))?;
             }
             if let Some(xc) = &tr.collocation_states {
                 let d = tr.tau.len() - 1;
                 for k in 0..n {
                     for j in 1..=d {
-                        set(xc, k * d + j - 1, times(k, tr.tau[j]))?;
+                        set(xc, k * d + j - 1, grid.time_in(k, tr.tau[j], t_f))?;
                     }
                 }
             }
         }
         if let (Some(g), true) = (&self.control_guess, self.nu() > 0) {
-            for k in 0..n {
-                let t = times(k, 0.0);
+            for k in 0..tr.controls.ncols() {
+                let t = grid.time(k, t_f);
                 let v = g(t, t_f);
                 if v.len() != self.nu() {
                     return Err(OcpError::Size {
@@ -318,12 +396,151 @@ struct Stage<'a> {
     x: &'a Matrix,
     u: &'a Matrix,
     p: &'a Matrix,
-    h: Expr,
+    /// Interval lengths `h_k`.
+    h: &'a [Expr],
+    /// Controls at the nodes, linear in between (else one per interval).
+    linear: bool,
 }
+
+/// `ẋ` and the Lagrange integrand at one point.
+type PointValues = (Matrix, Option<Expr>);
 
 impl Stage<'_> {
     fn dynamics(&self) -> &super::Dynamics {
         self.ocp.dynamics.as_ref().expect("checked by transcribe")
+    }
+
+    /// The control at the fraction `tau ∈ [0, 1]` of interval `k`.
+    fn control(&self, k: usize, tau: f64) -> Result<Matrix, OcpError> {
+        if !self.linear || tau == 0.0 {
+            return Ok(self.u.column(k)?);
+        }
+        if tau == 1.0 {
+            return Ok(self.u.column(k + 1)?);
+        }
+        let (a, b) = (self.u.column(k)?, self.u.column(k + 1)?);
+        Ok(Matrix::from_vec(
+            a.iter()
+                .zip(b.iter())
+                .map(|(&a, &b)| (1.0 - tau) * a + tau * b)
+                .collect(),
+        ))
+    }
+
+    /// The control at node `k` (for piecewise-constant controls, the last interval's at `t_N`).
+    fn node_control(&self, k: usize) -> Result<Matrix, OcpError> {
+        let last = self.u.ncols() - 1;
+        Ok(self.u.column(k.min(last))?)
+    }
+
+    /// `ẋ` and the Lagrange integrand at `(x, u)`.
+    fn point(&self, x: &Matrix, u: &Matrix) -> Result<PointValues, OcpError> {
+        let f = self.dynamics().eval(x, u, self.p)?;
+        let l = self.ocp.stage_cost.as_ref().map(|l| l(x, u, self.p));
+        Ok((f, l))
+    }
+
+    /// The values at both ends of every interval: with controls at the nodes each node is
+    /// evaluated once and shared by its two intervals.
+    fn interval_ends(&self) -> Result<Vec<(PointValues, PointValues)>, OcpError> {
+        let n = self.h.len();
+        if self.linear {
+            let nodes = (0..=n)
+                .map(|k| self.point(&self.x.column(k)?, &self.u.column(k)?))
+                .collect::<Result<Vec<_>, OcpError>>()?;
+            return Ok((0..n)
+                .map(|k| (nodes[k].clone(), nodes[k + 1].clone()))
+                .collect());
+        }
+        (0..n)
+            .map(|k| {
+                let uk = self.u.column(k)?;
+                Ok((
+                    self.point(&self.x.column(k)?, &uk)?,
+                    self.point(&self.x.column(k + 1)?, &uk)?,
+                ))
+            })
+            .collect()
+    }
+
+    /// Trapezoidal collocation: `x_{k+1} = x_k + h_k/2 (f_k + f_{k+1})` (group
+    /// `continuity`), the cost by the trapezoidal rule.
+    fn trapezoidal(&self, pb: &mut Problem, log: &mut RowLog) -> Result<Expr, OcpError> {
+        let mut cost = Expr::zero();
+        let mut defects = Vec::with_capacity(self.h.len());
+        for (k, ((fa, la), (fb, lb))) in self.interval_ends()?.into_iter().enumerate() {
+            let h = self.h[k];
+            let (xa, xb) = (self.x.column(k)?, self.x.column(k + 1)?);
+            let d: Vec<Expr> = (0..xa.len())
+                .map(|i| xb[i] - xa[i] - 0.5 * h * (fa[i] + fb[i]))
+                .collect();
+            defects.push(Matrix::from_vec(d).eq(0.0));
+            if let (Some(la), Some(lb)) = (la, lb) {
+                cost += 0.5 * h * (la + lb);
+            }
+        }
+        log.add(
+            pb,
+            "continuity",
+            Constraint::all(defects),
+            Some(self.h.len()),
+        )?;
+        Ok(cost)
+    }
+
+    /// Hermite–Simpson collocation: the Hermite cubic's midpoint
+    /// `x_m = (x_k + x_{k+1})/2 + h_k/8 (f_k − f_{k+1})` and Simpson's rule
+    /// `x_{k+1} = x_k + h_k/6 (f_k + 4 f_m + f_{k+1})` (group `continuity`); the cost by
+    /// Simpson's rule. Separated: `x_m` is a variable (`Xm`, `nx × N`) tied to the cubic by
+    /// the group `midpoint`; compressed: `x_m` is the expression. Returns the cost and `Xm`.
+    fn hermite_simpson(
+        &self,
+        pb: &mut Problem,
+        log: &mut RowLog,
+        separated: bool,
+    ) -> Result<(Expr, Option<Matrix>), OcpError> {
+        let (nx, n) = (self.ocp.nx(), self.h.len());
+        let xm_var = if separated {
+            let xm = pb.variable_matrix("Xm", nx, n)?;
+            for i in 0..nx {
+                let (lo, hi) = (self.ocp.state_bounds.0[i], self.ocp.state_bounds.1[i]);
+                pb.set_bounds(&xm.row(i)?, lo, hi)?;
+            }
+            Some(xm)
+        } else {
+            None
+        };
+        let mut cost = Expr::zero();
+        let (mut midpoints, mut defects) = (Vec::new(), Vec::with_capacity(n));
+        for (k, ((fa, la), (fb, lb))) in self.interval_ends()?.into_iter().enumerate() {
+            let h = self.h[k];
+            let (xa, xb) = (self.x.column(k)?, self.x.column(k + 1)?);
+            let cubic: Vec<Expr> = (0..nx)
+                .map(|i| 0.5 * (xa[i] + xb[i]) + h / 8.0 * (fa[i] - fb[i]))
+                .collect();
+            let xm = match &xm_var {
+                Some(v) => {
+                    let xm = v.column(k)?;
+                    let gap: Vec<Expr> = (0..nx).map(|i| xm[i] - cubic[i]).collect();
+                    midpoints.push(Matrix::from_vec(gap).eq(0.0));
+                    xm
+                }
+                None => Matrix::from_vec(cubic),
+            };
+            let (fm, lm) = self.point(&xm, &self.control(k, 0.5)?)?;
+            let d: Vec<Expr> = (0..nx)
+                .map(|i| xb[i] - xa[i] - h / 6.0 * (fa[i] + 4.0 * fm[i] + fb[i]))
+                .collect();
+            defects.push(Matrix::from_vec(d).eq(0.0));
+            if let (Some(la), Some(lm), Some(lb)) = (la, lm, lb) {
+                cost += h / 6.0 * (la + 4.0 * lm + lb);
+            }
+        }
+        if separated {
+            log.add(pb, "midpoint", Constraint::all(midpoints), Some(n))?;
+        }
+        log.add(pb, "continuity", Constraint::all(defects), Some(n))?;
+        Ok((cost, xm_var))
     }
 
     /// Continuity constraints of multiple shooting; returns the integrated Lagrange cost.
@@ -335,7 +552,7 @@ impl Stage<'_> {
         steps: usize,
         step_calls: bool,
     ) -> Result<Expr, OcpError> {
-        let n = self.u.ncols();
+        let n = self.h.len();
         let step = if step_calls {
             Some(self.step_function(tableau, steps)?)
         } else {
@@ -344,14 +561,20 @@ impl Stage<'_> {
         let mut cost = Expr::zero();
         let mut gaps = Vec::with_capacity(n);
         for k in 0..n {
-            let (xk, uk) = (self.x.column(k)?, self.u.column(k)?);
+            let xk = self.x.column(k)?;
+            // The interval's control: U_k, or (U_k, U_{k+1}) stacked for linear controls.
+            let mut uk = self.u.column(k)?.to_vec();
+            if self.linear {
+                uk.extend(self.u.column(k + 1)?.iter());
+            }
+            let uk = Matrix::from_vec(uk);
             let (x_end, q) = match &step {
                 Some(f) => {
-                    let mut out = f.apply(&[&xk, &uk, self.p, &[self.h]])?.into_iter();
+                    let mut out = f.apply(&[&xk, &uk, self.p, &[self.h[k]]])?.into_iter();
                     let x_end = Matrix::from_vec(out.next().unwrap_or_default());
                     (x_end, out.next().map(|q| q[0]))
                 }
-                None => self.integrate(tableau, steps, &xk, &uk, self.p, self.h)?,
+                None => self.integrate(tableau, steps, &xk, &uk, self.p, self.h[k])?,
             };
             if let Some(q) = q {
                 cost += q;
@@ -363,14 +586,16 @@ impl Stage<'_> {
     }
 
     /// One interval's integration compiled as `F(x, u, p, h) = (x(h), q(h))`, `q` the
-    /// Lagrange cost's quadrature state (only with a stage cost).
+    /// Lagrange cost's quadrature state (only with a stage cost); for linear controls `u`
+    /// stacks the controls at both ends.
     fn step_function(
         &self,
         tableau: &ButcherTableau,
         steps: usize,
     ) -> Result<symx::Function, OcpError> {
         let x = Matrix::sym_vec("x", self.ocp.nx());
-        let u = Matrix::sym_vec("u", self.ocp.nu());
+        let nu = self.ocp.nu() * if self.linear { 2 } else { 1 };
+        let u = Matrix::sym_vec("u", nu);
         let p = Matrix::sym_vec("p", self.ocp.np());
         let h = Expr::sym("h");
         let (x_end, q) = self.integrate(tableau, steps, &x, &u, &p, h)?;
@@ -385,7 +610,9 @@ impl Stage<'_> {
     }
 
     /// `steps` steps of `tableau` over `h` from `x` with control `u`: the end state and,
-    /// with a stage cost, its integral (a quadrature state started at 0).
+    /// with a stage cost, its integral (a quadrature state started at 0). For linear
+    /// controls `u` stacks the controls at both ends and a clock state `s` (`ṡ = 1/h`,
+    /// integrated exactly by any Runge–Kutta method) interpolates between them.
     fn integrate(
         &self,
         tableau: &ButcherTableau,
@@ -395,12 +622,22 @@ impl Stage<'_> {
         p: &Matrix,
         h: Expr,
     ) -> Result<(Matrix, Option<Expr>), OcpError> {
-        let nx = self.ocp.nx();
+        let (nx, nu) = (self.ocp.nx(), self.ocp.nu());
+        let cost = self.ocp.stage_cost.is_some();
+        let clock = nx + usize::from(cost);
         // The tableau takes an infallible right-hand side: a failure is kept and returned.
         let failure = std::cell::RefCell::new(None);
         let rhs = |z: &Matrix| -> Matrix {
             let xs = Matrix::from_vec(z[..nx].to_vec());
-            let mut dz: Vec<Expr> = match self.dynamics().eval(&xs, u, p) {
+            let us = match self.linear {
+                false => u.clone(),
+                true => Matrix::from_vec(
+                    (0..nu)
+                        .map(|j| u[j] + z[clock] * (u[nu + j] - u[j]))
+                        .collect(),
+                ),
+            };
+            let mut dz: Vec<Expr> = match self.dynamics().eval(&xs, &us, p) {
                 Ok(f) => f.to_vec(),
                 Err(e) => {
                     failure.borrow_mut().get_or_insert(e);
@@ -408,19 +645,25 @@ impl Stage<'_> {
                 }
             };
             if let Some(l) = &self.ocp.stage_cost {
-                dz.push(l(&xs, u, p));
+                dz.push(l(&xs, &us, p));
+            }
+            if self.linear {
+                dz.push(Expr::constant(1.0) / h);
             }
             Matrix::from_vec(dz)
         };
         let mut z0: Vec<Expr> = x.to_vec();
-        if self.ocp.stage_cost.is_some() {
+        if cost {
+            z0.push(Expr::zero());
+        }
+        if self.linear {
             z0.push(Expr::zero());
         }
         let z_end = tableau.integrate(&rhs, &Matrix::from_vec(z0), h, steps);
         if let Some(e) = failure.into_inner() {
             return Err(e);
         }
-        let q = self.ocp.stage_cost.as_ref().map(|_| z_end[nx]);
+        let q = cost.then(|| z_end[nx]);
         Ok((Matrix::from_vec(z_end[..nx].to_vec()), q))
     }
 
@@ -432,7 +675,7 @@ impl Stage<'_> {
         log: &mut RowLog,
         c: &Collocation,
     ) -> Result<(Expr, Matrix), OcpError> {
-        let (nx, n, d) = (self.ocp.nx(), self.u.ncols(), c.degree());
+        let (nx, n, d) = (self.ocp.nx(), self.h.len(), c.degree());
         let xc = pb.variable_matrix("Xc", nx, n * d)?;
         for i in 0..nx {
             let (lo, hi) = (self.ocp.state_bounds.0[i], self.ocp.state_bounds.1[i]);
@@ -441,7 +684,7 @@ impl Stage<'_> {
         let mut cost = Expr::zero();
         let (mut colloc, mut gaps) = (Vec::new(), Vec::new());
         for k in 0..n {
-            let uk = self.u.column(k)?;
+            let h = self.h[k];
             let xk = self.x.column(k)?;
             let pts: Vec<Matrix> = (0..d)
                 .map(|j| xc.column(k * d + j))
@@ -452,10 +695,11 @@ impl Stage<'_> {
                 for r in 1..=d {
                     xp = xp + c.c[r][j] * &pts[r - 1];
                 }
-                let fj = self.dynamics().eval(&pts[j - 1], &uk, self.p)?;
-                colloc.push((&(self.h * &fj - xp)).eq(0.0));
+                let uj = self.control(k, c.tau[j])?;
+                let fj = self.dynamics().eval(&pts[j - 1], &uj, self.p)?;
+                colloc.push((&(h * &fj - xp)).eq(0.0));
                 if let Some(l) = &self.ocp.stage_cost {
-                    cost += c.b[j] * l(&pts[j - 1], &uk, self.p) * self.h;
+                    cost += c.b[j] * l(&pts[j - 1], &uj, self.p) * h;
                 }
             }
             let mut x_end = c.d[0] * &xk;
@@ -496,9 +740,19 @@ impl Transcription {
         &self.states
     }
 
-    /// The controls `U` (`nu × N`).
+    /// The controls `U` (`nu × N`; `nu × (N+1)` for piecewise-linear controls).
     pub fn controls(&self) -> &Matrix {
         &self.controls
+    }
+
+    /// The time grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// How the controls vary between nodes.
+    pub fn control_interpolation(&self) -> ControlInterpolation {
+        self.control_interpolation
     }
 
     /// The final time: the variable `T` or the fixed value as a constant.
@@ -513,7 +767,8 @@ impl Transcription {
     }
 
     /// The collocation states `Xc` (`nx × N·d`, stage `k`'s `d` columns from `k·d`), for
-    /// collocation methods.
+    /// direct collocation, or the midpoint states `Xm` (`nx × N`) for separated
+    /// Hermite–Simpson.
     pub fn collocation_states(&self) -> Option<&Matrix> {
         self.collocation_states.as_ref()
     }
@@ -544,13 +799,13 @@ impl Transcription {
             None => sol.x[self.problem.variable_indices(&[self.final_time])?[0]],
         };
         let n = self.intervals;
-        let grid = |k: usize, tau: f64| (k as f64 + tau) * t_f / n as f64;
+        let grid = &self.grid;
         let collocation = match &self.collocation_states {
             Some(xc) => {
                 let d = self.tau.len() - 1;
                 Some(super::CollocationStates {
                     time: (0..n * d)
-                        .map(|i| grid(i / d, self.tau[i % d + 1]))
+                        .map(|i| grid.time_in(i / d, self.tau[i % d + 1], t_f))
                         .collect(),
                     states: values(xc)?,
                 })
@@ -562,14 +817,14 @@ impl Transcription {
         } else {
             Vec::new()
         };
-        let mut time: Vec<f64> = (0..=n).map(|k| grid(k, 0.0)).collect();
-        time[n] = t_f; // exactly T, not (N·T)/N
+        let time: Vec<f64> = (0..=n).map(|k| grid.time(k, t_f)).collect(); // t_N exactly T
         Ok(Trajectory {
-            time,
             state_names: self.state_names.clone(),
             states: values(&self.states)?,
             control_names: self.control_names.clone(),
-            control_time: (0..n).map(|k| grid(k, 0.0)).collect(),
+            control_time: time[..self.controls.ncols()].to_vec(),
+            control_interpolation: self.control_interpolation,
+            time,
             controls,
             final_time: t_f,
             objective: sol.objective,

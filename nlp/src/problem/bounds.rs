@@ -72,14 +72,103 @@ pub(crate) struct Layout {
     pub row_of: Vec<Option<usize>>,
 }
 
+/// A constraint row `lo ≤ a·xⱼ + b ≤ hi` on a single variable, as a bound of `xⱼ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SimpleBound {
+    /// The variable's index j.
+    pub var: usize,
+    /// The coefficient a (finite, nonzero).
+    pub scale: f64,
+    /// The constant b.
+    pub offset: f64,
+}
+
+impl SimpleBound {
+    /// The bounds of xⱼ that `lo ≤ a·xⱼ + b ≤ hi` means.
+    fn variable_bounds(&self, lo: f64, hi: f64) -> (f64, f64) {
+        let (l, u) = (
+            (lo - self.offset) / self.scale,
+            (hi - self.offset) / self.scale,
+        );
+        if self.scale > 0.0 {
+            (l, u)
+        } else {
+            (u, l)
+        }
+    }
+}
+
+/// How deep [`Problem::affine_in_one_variable`] looks into a row's expression: enough for
+/// `a·(x − c)/d + e` as users write boundary values, without walking large graphs.
+const AFFINE_DEPTH: usize = 8;
+
 impl Problem {
-    /// The variable written row `i` is on, when detection is on and the row is a single
-    /// variable (`lo ≤ xⱼ ≤ hi`).
+    /// The variable written row `i` is on, when detection is on and the row is affine in a
+    /// single variable (`lo ≤ a·xⱼ + b ≤ hi`, `a ≠ 0`, constants only).
     pub(crate) fn simple_bound_of(&self, i: usize) -> Option<usize> {
+        self.simple_bound(i).map(|b| b.var)
+    }
+
+    /// Row `i` as a bound of one variable, when detection is on and the row is affine in
+    /// a single variable with constant coefficients (as CasADi's `detect_simple_bounds`
+    /// treats `x − 1`, `2·x − 1` or `3 − x`).
+    pub(crate) fn simple_bound(&self, i: usize) -> Option<SimpleBound> {
         if !self.detect_simple_bounds {
             return None;
         }
-        self.variable_index.get(&self.rows[i].expr.id()).copied()
+        let (var, scale, offset) = self.affine_in_one_variable(self.rows[i].expr, AFFINE_DEPTH)?;
+        let var = var?;
+        (scale != 0.0 && scale.is_finite() && offset.is_finite()).then_some(SimpleBound {
+            var,
+            scale,
+            offset,
+        })
+    }
+
+    /// `e` as `a·xⱼ + b` with constant a, b (`None` for j when `e` is a constant), looking
+    /// at most `depth` operations deep; `None` when it is not of that form.
+    fn affine_in_one_variable(
+        &self,
+        e: symx::Expr,
+        depth: usize,
+    ) -> Option<(Option<usize>, f64, f64)> {
+        use symx::Op;
+        if let Some(c) = e.value() {
+            return Some((None, 0.0, c));
+        }
+        if e.is_symbol() {
+            // A parameter is not a variable: a row on it stays a row.
+            return self
+                .variable_index
+                .get(&e.id())
+                .map(|&j| (Some(j), 1.0, 0.0));
+        }
+        if depth == 0 {
+            return None;
+        }
+        let args = e.operands();
+        let sub = |k: usize| self.affine_in_one_variable(args[k], depth - 1);
+        let same = |u: Option<usize>, v: Option<usize>| match (u, v) {
+            (Some(a), Some(b)) if a != b => None,
+            _ => Some(u.or(v)),
+        };
+        match e.op() {
+            Op::Neg => sub(0).map(|(j, a, b)| (j, -a, -b)),
+            Op::Add | Op::Sub => {
+                let ((j, a, b), (k, c, d)) = (sub(0)?, sub(1)?);
+                let sign = if e.op() == Op::Add { 1.0 } else { -1.0 };
+                Some((same(j, k)?, a + sign * c, b + sign * d))
+            }
+            Op::Mul => match (sub(0)?, sub(1)?) {
+                ((None, _, c), (j, a, b)) | ((j, a, b), (None, _, c)) => Some((j, c * a, c * b)),
+                _ => None,
+            },
+            Op::Div => match (sub(0)?, sub(1)?) {
+                ((j, a, b), (None, _, c)) if c != 0.0 => Some((j, a / c, b / c)),
+                _ => None,
+            },
+            _ => None,
+        }
     }
 
     /// Applies simple bound detection: each row on a single variable intersects that
@@ -89,9 +178,11 @@ impl Problem {
         let mut rows = Vec::with_capacity(self.rows.len());
         let mut row_of = Vec::with_capacity(self.rows.len());
         for (i, row) in self.rows.iter().enumerate() {
-            match self.simple_bound_of(i) {
-                Some(j) => {
-                    let (lo, hi) = (lower[j].max(row.lower), upper[j].min(row.upper));
+            match self.simple_bound(i) {
+                Some(bound) => {
+                    let j = bound.var;
+                    let (row_lo, row_hi) = bound.variable_bounds(row.lower, row.upper);
+                    let (lo, hi) = (lower[j].max(row_lo), upper[j].min(row_hi));
                     check_bound(
                         || {
                             format!(

@@ -7,11 +7,13 @@ pub mod bounds;
 pub mod complementarity;
 pub mod cone;
 pub mod error;
+pub mod to_function;
 
 pub use bounds::PerEntry;
 pub use complementarity::ComplementarityReport;
 pub use cone::{Cone, CONE_SMOOTHING};
 pub use error::BuildError;
+pub use to_function::{SolverFunction, ToFunctionError};
 
 use crate::compiled::{CompileOptions, Compiled};
 use crate::constraint::{Constraint, Row};
@@ -270,6 +272,11 @@ impl Problem {
         Ok(())
     }
 
+    /// The initial guess of every variable, in variable order (0 where none was set).
+    pub fn initial_point(&self) -> &[f64] {
+        &self.initial
+    }
+
     /// Sets the initial guess of the entries of `x` (one finite value each).
     pub fn set_initial(&mut self, x: &[Expr], values: &[f64]) -> Result<(), BuildError> {
         let idx = self.variable_positions(x, "set_initial")?;
@@ -327,6 +334,25 @@ impl Problem {
     /// measurements). Turn it off to solve the problem exactly as written, e.g. to compare
     /// iteration counts with IPOPT under CasADi's defaults. The setting applies at
     /// [`Problem::compile`], whenever it is made.
+    ///
+    /// Only rows whose expression is a single variable with constant limits become bounds:
+    /// a row on one variable that involves a **parameter** (`x.ge(p)`, `x.eq(p)`, written as
+    /// `x − p` against constant limits) **stays a row** of g, so that the parameter can
+    /// change between solves without recompiling; its multiplier is in `λ`, not in
+    /// `z_L`/`z_U`.
+    ///
+    /// ```
+    /// let mut pb = nlp::Problem::new();
+    /// let x = pb.scalar_variable("x")?;
+    /// let p = pb.scalar_parameter("p")?;
+    /// pb.set_value(p, &[1.0])?;
+    /// pb.minimize(x.sq());
+    /// use nlp::{NumericNlp, Relation};
+    /// pb.subject_to(x.ge(p))?; // one variable, but a parameter: a row
+    /// pb.subject_to(x.le(5.0))?; // one variable, a constant: a bound
+    /// assert_eq!(pb.compile()?.m(), 1);
+    /// # Ok::<(), nlp::BuildError>(())
+    /// ```
     pub fn set_detect_simple_bounds(&mut self, detect: bool) {
         self.detect_simple_bounds = detect;
     }
@@ -427,13 +453,15 @@ impl Problem {
     /// Evaluates expressions of the variables and parameters at a primal point `x`
     /// (parameters at their current values), e.g. to read a solution.
     pub fn evaluate(&self, exprs: &[Expr], x: &[f64]) -> Result<Vec<f64>, BuildError> {
-        self.evaluate_named(exprs, x, "evaluate")
+        self.evaluate_named(exprs, x, None, "evaluate")
     }
 
+    /// Evaluates `exprs` at `x` with the parameter values `p` (this problem's when `None`).
     fn evaluate_named(
         &self,
         exprs: &[Expr],
         x: &[f64],
+        p: Option<&[f64]>,
         what: &str,
     ) -> Result<Vec<f64>, BuildError> {
         if x.len() != self.variables.len() {
@@ -443,26 +471,66 @@ impl Problem {
                 got: x.len(),
             });
         }
-        let p = self.parameter_vector()?;
+        let p = match p {
+            Some(p) if p.len() != self.parameters.len() => {
+                return Err(BuildError::Size {
+                    what: format!("{what}: solution parameters"),
+                    expected: self.parameters.len(),
+                    got: p.len(),
+                })
+            }
+            Some(p) => p.to_vec(),
+            None => self.parameter_vector()?,
+        };
         let f = self.function(exprs, what)?;
         Ok(f.call(&[x, &p])?.swap_remove(0))
     }
 
+    /// Evaluates `exprs` at a solution, with the parameter values it was solved with.
+    fn evaluate_solution(
+        &self,
+        exprs: &[Expr],
+        solution: &Solution,
+        what: &str,
+    ) -> Result<Vec<f64>, BuildError> {
+        // A solution without parameter values (hand-built, or from an older file) falls
+        // back to this problem's.
+        let p = (!solution.parameters.is_empty()).then_some(solution.parameters.as_slice());
+        self.evaluate_named(exprs, &solution.x, p, what)
+    }
+
     /// The value of `e`, an expression of this problem's variables and parameters, at a
-    /// solution — Opti's `sol.value(e)`. Parameters take the values set on this problem
-    /// (after changing them on a [`Compiled`] only, set them here too before reading).
+    /// solution — Opti's `sol.value(e)`. Parameters take the values the solution was
+    /// solved with ([`Solution::parameters`]), whatever was set since on this problem or
+    /// on a [`Compiled`]; a solution that does not carry them (built by hand, or read from
+    /// a file written before that field existed) uses the values set on this problem.
+    ///
+    /// ```
+    /// use nlp::{Ipm, Problem};
+    /// let mut pb = Problem::new();
+    /// let x = pb.scalar_variable("x")?;
+    /// let p = pb.scalar_parameter("p")?;
+    /// pb.set_value(p, &[2.0])?;
+    /// pb.minimize((x - p).sq());
+    /// let mut compiled = pb.compile()?;
+    /// compiled.set_value("p", &[4.0])?; // changed on the compiled problem only
+    /// let sol = Ipm::default().solve(&mut compiled)?;
+    /// assert_eq!(sol.parameters, [4.0]);
+    /// assert!((pb.value(x - p, &sol)? - 0.0).abs() < 1e-8); // evaluated with p = 4
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     ///
     /// An expression using a symbol that is neither a variable nor a parameter of this
     /// problem is an error ([`BuildError::FreeSymbol`]), as is a solution whose `x` does
     /// not have one entry per variable.
     pub fn value(&self, e: Expr, solution: &Solution) -> Result<f64, BuildError> {
-        Ok(self.evaluate_named(&[e], &solution.x, "value")?[0])
+        Ok(self.evaluate_solution(&[e], solution, "value")?[0])
     }
 
     /// The values of the entries of `e` at a solution (see [`Problem::value`]); for a
     /// [`Matrix`], its entries in column-major order.
     pub fn values(&self, e: &[Expr], solution: &Solution) -> Result<Vec<f64>, BuildError> {
-        self.evaluate_named(e, &solution.x, "values")
+        self.evaluate_solution(e, solution, "values")
     }
 
     /// The values of the matrix `m` at a solution as rows: `v[i][j]` is entry (i, j) (see
@@ -472,7 +540,7 @@ impl Problem {
         m: &Matrix,
         solution: &Solution,
     ) -> Result<Vec<Vec<f64>>, BuildError> {
-        let flat = self.evaluate_named(m, &solution.x, "value_matrix")?;
+        let flat = self.evaluate_solution(m, solution, "value_matrix")?;
         let (rows, cols) = m.shape();
         Ok((0..rows)
             .map(|i| (0..cols).map(|j| flat[i + j * rows]).collect())

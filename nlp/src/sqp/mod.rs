@@ -26,7 +26,8 @@
 //! (tol 1e-8, s_max, dual_inf_tol, constr_viol_tol, compl_inf_tol, acceptable_*), on
 //! the problem scaled by the same gradient-based factors.
 //!
-//! In the iteration table, `lg(mu)` is log10 of the augmented weight ρ_a ("-" when 0),
+//! In the iteration table, `lg(mu)` is log10 of the augmented weight ρ_a (the record's
+//! `augmented_weight`; "-" when 0),
 //! `lg(rg)` is the Hessian shift δ,
 //! the 'r' mark after the iteration number flags elastic mode, and the step character
 //! is 'S' for an accepted second-order correction, 'f' otherwise.
@@ -55,11 +56,12 @@ mod state;
 mod stop;
 mod subproblem;
 
-use std::ops::ControlFlow;
 use std::time::Instant;
 
-use crate::callback::{IterationCallback, IterationView, Observer};
+use crate::callback::{IterationCallback, Observer};
 use crate::error::SolveError;
+use crate::frontend::solver::{impl_solver_options, solver_entry_points};
+use crate::frontend::user_solution::conclude;
 use crate::frontend::validate::validate;
 use crate::frontend::{Solver, Termination};
 use crate::numeric::NumericNlp;
@@ -97,44 +99,17 @@ impl Sqp {
     pub fn new(options: SqpOptions) -> Self {
         Sqp { options }
     }
+}
 
-    /// Solves from the problem's initial point.
-    pub fn solve(&self, nlp: &mut dyn NumericNlp) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, None, None)
-    }
+solver_entry_points!(
+    Sqp,
+    "Starts from a previous solution's x and multipliers (λ, z_L, z_U): with a good \
+     guess the first QPs already have the right active set."
+);
 
-    /// [`Sqp::solve`] with a per-iteration callback, as
-    /// [`Ipm::solve_with_callback`](crate::Ipm::solve_with_callback): called once per row
-    /// of `Solution::stats.records` (iteration 0 included) before the convergence test;
-    /// [`ControlFlow::Break`] ends the solve with [`Status::UserRequestedStop`](crate::Status::UserRequestedStop).
-    pub fn solve_with_callback(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
-    ) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, None, Some(&mut callback))
-    }
+impl_solver_options!(SqpOptions => Sqp);
 
-    /// [`Sqp::solve_warm`] with a per-iteration callback (see [`Sqp::solve_with_callback`]).
-    pub fn solve_warm_with_callback(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        previous: &Solution,
-        mut callback: impl FnMut(&IterationView<'_>) -> ControlFlow<()>,
-    ) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, Some(previous), Some(&mut callback))
-    }
-
-    /// Starts from a previous solution's x and multipliers (λ, z_L, z_U): with a good
-    /// guess the first QPs already have the right active set.
-    pub fn solve_warm(
-        &self,
-        nlp: &mut dyn NumericNlp,
-        previous: &Solution,
-    ) -> Result<Solution, SolveError> {
-        self.solve_dyn(nlp, Some(previous), None)
-    }
-
+impl Sqp {
     fn run(
         &self,
         nlp: &mut dyn NumericNlp,
@@ -161,13 +136,14 @@ impl Sqp {
         s.stats.qp_iterations = w.qp_iterations as usize;
         s.stats.qp_seconds = w.qp_seconds;
         let mut sol = s.user_solution(stop);
-        s.stats.total_seconds = start.elapsed().as_secs_f64();
-        s.sc.write_stats(&mut s.stats);
-        let st = &mut s.stats;
-        st.other_seconds = (st.total_seconds - st.eval_seconds - st.factor_seconds).max(0.0);
-        sol.stats = std::mem::take(&mut s.stats);
+        conclude(
+            &mut sol,
+            std::mem::take(&mut s.stats),
+            &s.sc,
+            start,
+            o.print_level,
+        );
         if o.print_level >= 3 {
-            print!("{}", crate::log::format_summary(&sol));
             println!(
                 "Polished QP solutions: {} of {}",
                 s.work.n_polished, s.work.n_qp
@@ -206,10 +182,11 @@ fn iterate(
             objective: 0.0,
             inf_pr: 0.0,
             inf_du: 0.0,
-            mu: s.curv.rho_a_last,
+            mu: 0.0,
             d_norm: ls.d_norm,
             regularization: delta,
             jacobian_regularization: 0.0,
+            augmented_weight: s.curv.rho_a_last,
             alpha_du: ls.alpha,
             alpha_pr: ls.alpha,
             alpha_pr_char: if ls.soc_used {

@@ -241,6 +241,7 @@ impl<'a> SqpState<'a> {
             d_norm: 0.0,
             regularization: 0.0,
             jacobian_regularization: 0.0,
+            augmented_weight: 0.0,
             alpha_du: 0.0,
             alpha_pr: 0.0,
             alpha_pr_char: ' ',

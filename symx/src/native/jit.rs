@@ -1,14 +1,17 @@
 //! The tape compiled to machine code by Cranelift.
 //!
 //! Each function's tape is cut into chunks of [`CHUNK`] instructions, each compiled as one
-//! machine-code function `fn(w: *mut f64)`, so that compile time stays linear in the tape's
-//! length (register allocation of one huge straight-line function is not). Inside a chunk,
-//! registers live in SSA values: a register is loaded from the work vector at its first read
-//! in the chunk, and a result is stored back only if a later chunk, a call of a lookup table
-//! or the caller (an output slot) reads it (a backward liveness pass decides). Constants are
-//! immediates. A call of another function gathers its arguments into the scratch block and
+//! machine-code function `fn(w, args, res)` ([`Entry`]), so that compile time stays linear
+//! in the tape's length (register allocation of one huge straight-line function is not).
+//! Inputs are read where the caller keeps them (`args[k]`) and outputs written where it
+//! wants them (`res[k]`): no copy in or out. Inside a chunk, registers live in SSA values:
+//! a register is loaded at its first read in the chunk, and a result is stored to the work
+//! vector only if a later chunk or a lookup table reads it, or if it is read again more
+//! than [`WINDOW`] instructions later (then reloaded, so that no value lives long enough
+//! to be spilled); a backward liveness pass decides. Constants are immediates, and only
+//! the constant outputs of the template are written. A call of another function gathers its arguments into the scratch block and
 //! calls that function's machine code, compiled once in the same module.
-use super::SymxError;
+use super::{Entry, SymxError};
 use crate::function::{Function, Instr};
 use crate::op::{self, Op};
 use crate::table::Table;
@@ -28,8 +31,16 @@ use std::sync::Arc;
 /// 2.6× faster than 4096, and evaluated it no slower).
 const CHUNK: usize = 1024;
 
-/// Templates up to this length are written by immediate stores, longer ones by a copy.
-const INLINE_TEMPLATE: usize = 64;
+/// A value accessed again more than this many instructions later is reloaded from the
+/// work vector (or its constant re-materialised) rather than kept in a machine register
+/// (see [`stores`]): on the gap model's Jacobian this cut the register allocator's spills
+/// from 10 417 to 1 253 and the instructions executed by 7.5 %; 24 removed every spill
+/// but executed more loads.
+const WINDOW: usize = 48;
+
+/// Runs of template entries shorter than this are written by immediate stores, longer
+/// ones by a copy.
+const INLINE_TEMPLATE: usize = 16;
 
 /// What the machine code needs alive: the code memory, the templates it copies and the
 /// tables it reads (through raw pointers).
@@ -63,9 +74,7 @@ fn err(e: impl std::fmt::Display) -> SymxError {
 
 /// Compiles `f`: its entry point, the owner of the code, the number of machine-code
 /// functions and of tape instructions compiled.
-pub(crate) fn compile(
-    f: &Function,
-) -> Result<(unsafe extern "C" fn(*mut f64), Owner, usize, usize), SymxError> {
+pub(crate) fn compile(f: &Function) -> Result<(Entry, Owner, usize, usize), SymxError> {
     let mut flags = settings::builder();
     let set = |flags: &mut settings::Builder, k: &str, v: &str| flags.set(k, v).map_err(err);
     // Cranelift's optimiser (opt_level "speed") made compilation slower and evaluation no
@@ -104,7 +113,7 @@ pub(crate) fn compile(
     jit.module.finalize_definitions().map_err(err)?;
     let code = jit.module.get_finalized_function(id);
     // SAFETY: `id` was defined with the signature `fn(*mut f64)` (C calling convention).
-    let entry = unsafe { std::mem::transmute::<*const u8, unsafe extern "C" fn(*mut f64)>(code) };
+    let entry = unsafe { std::mem::transmute::<*const u8, Entry>(code) };
     let owner = Owner {
         module: Some(jit.module),
         _templates: jit.templates,
@@ -132,6 +141,11 @@ struct Layout<'a> {
     store: Vec<bool>,
     /// Registers holding a constant (never written, in the template): their values.
     constant: Vec<Option<f64>>,
+    /// Which template entries the machine code must write (see [`template_stores`]).
+    template_stores: Vec<bool>,
+    /// For each register, the input or output entry `(k, i)` it holds, if any.
+    input_of: Vec<Option<(u32, u32)>>,
+    output_of: Vec<Option<(u32, u32)>>,
     /// Entry points of the called functions, by call index.
     callees: Vec<FuncId>,
     /// Addresses of the tables, by table index.
@@ -150,10 +164,23 @@ impl Jit {
             callees.push(self.function(&c.function)?);
         }
         let template = f.template.clone();
+        let constant = constants(f);
+        let entries = |sizes: &[usize], offsets: &[usize]| {
+            let mut of = vec![None; f.work_size];
+            for (k, (&n, &at)) in sizes.iter().zip(offsets).enumerate() {
+                for i in 0..n {
+                    of[at + i] = Some((k as u32, i as u32));
+                }
+            }
+            of
+        };
         let layout = Layout {
             f,
+            input_of: entries(&f.input_sizes, &f.input_offsets),
+            output_of: entries(&f.output_sizes, &f.output_offsets),
             store: stores(f),
-            constant: constants(f),
+            template_stores: template_stores(f, &constant),
+            constant,
             callees,
             tables: f.tables.iter().map(|t| Arc::as_ptr(t) as i64).collect(),
             template: template.as_ptr(),
@@ -183,10 +210,11 @@ impl Jit {
         Ok(id)
     }
 
+    /// `fn(w, args, res)`: see [`Entry`].
     fn signature(&self) -> Signature {
         let mut sig = self.module.make_signature();
-        sig.params
-            .push(AbiParam::new(self.module.target_config().pointer_type()));
+        let p = AbiParam::new(self.module.target_config().pointer_type());
+        sig.params.extend([p, p, p]);
         sig
     }
 
@@ -207,16 +235,13 @@ impl Jit {
     ) -> Result<(), SymxError> {
         self.ctx.func.signature = self.signature();
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let block = b.create_block();
-        b.append_block_params_for_function_params(block);
-        b.switch_to_block(block);
-        b.seal_block(block);
-        let w = b.block_params(block)[0];
-        let mut e = Emitter::new(&mut b, &mut self.module, w, layout);
+        let params = prologue(&mut b, layout, true);
+        let entry = params.entry;
+        let mut e = Emitter::new(&mut b, &mut self.module, params, layout);
         e.template();
         for &c in chunk_ids {
             let r = e.module.declare_func_in_func(c, e.b.func);
-            e.b.ins().call(r, &[w]);
+            e.b.ins().call(r, &entry);
         }
         b.ins().return_(&[]);
         b.finalize();
@@ -238,12 +263,8 @@ impl Jit {
     ) -> Result<(), SymxError> {
         self.ctx.func.signature = self.signature();
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let block = b.create_block();
-        b.append_block_params_for_function_params(block);
-        b.switch_to_block(block);
-        b.seal_block(block);
-        let w = b.block_params(block)[0];
-        let mut e = Emitter::new(&mut b, &mut self.module, w, layout);
+        let params = prologue(&mut b, layout, true);
+        let mut e = Emitter::new(&mut b, &mut self.module, params, layout);
         if with_template {
             e.template();
         }
@@ -260,6 +281,71 @@ impl Jit {
         self.module.clear_context(&mut self.ctx);
         Ok(())
     }
+}
+
+/// The arguments of a machine-code function and the addresses of the function's inputs
+/// and outputs (`args[k]`/`res[k]`, or their registers in `w` when `args` is null).
+#[derive(Clone)]
+struct Params {
+    w: Value,
+    /// The function's own parameters `(w, args, res)`, passed on to the chunks.
+    entry: [Value; 3],
+    inputs: Vec<Value>,
+    outputs: Vec<Value>,
+}
+
+/// The entry block of a machine-code function: with `with_bases` (always, today), the address of each
+/// input and output (from `args` and `res`, or in `w` when `args` is null), computed once.
+fn prologue(b: &mut FunctionBuilder, layout: &Layout, with_bases: bool) -> Params {
+    let f = layout.f;
+    let entry_block = b.create_block();
+    b.append_block_params_for_function_params(entry_block);
+    b.switch_to_block(entry_block);
+    b.seal_block(entry_block);
+    let ps = b.block_params(entry_block);
+    let (w, args, res) = (ps[0], ps[1], ps[2]);
+    let mut params = Params {
+        w,
+        entry: [w, args, res],
+        inputs: Vec::new(),
+        outputs: Vec::new(),
+    };
+    if !with_bases {
+        return params;
+    }
+    let ptr = types::I64;
+    let flags = MemFlags::trusted();
+    let (n_in, n_out) = (f.input_offsets.len(), f.output_offsets.len());
+    let direct = b.create_block();
+    let in_w = b.create_block();
+    let body = b.create_block();
+    for _ in 0..n_in + n_out {
+        b.append_block_param(body, ptr);
+    }
+    b.ins().brif(args, direct, &[], in_w, &[]);
+    b.switch_to_block(direct);
+    b.seal_block(direct);
+    let mut bases = Vec::new();
+    for k in 0..n_in {
+        bases.push(b.ins().load(ptr, flags, args, 8 * k as i32).into());
+    }
+    for k in 0..n_out {
+        bases.push(b.ins().load(ptr, flags, res, 8 * k as i32).into());
+    }
+    b.ins().jump(body, &bases);
+    b.switch_to_block(in_w);
+    b.seal_block(in_w);
+    let offsets = f.input_offsets.iter().chain(&f.output_offsets);
+    let bases: Vec<_> = offsets
+        .map(|&at| b.ins().iadd_imm(w, 8 * at as i64).into())
+        .collect();
+    b.ins().jump(body, &bases);
+    b.switch_to_block(body);
+    b.seal_block(body);
+    let ps = b.block_params(body).to_vec();
+    params.inputs = ps[..n_in].to_vec();
+    params.outputs = ps[n_in..].to_vec();
+    params
 }
 
 /// The registers an instruction reads from the work vector by value.
@@ -282,17 +368,23 @@ fn reads(f: &Function, ins: &Instr, mut visit: impl FnMut(u32)) {
 }
 
 /// Which instructions' results must be stored to the work vector: those read by a later
-/// chunk, through a pointer (lookup tables of any dimension) or after the tape (outputs).
+/// chunk or through a pointer (lookup tables of any dimension; outputs are stored to the
+/// caller's output by the emitter), and those with two consecutive accesses (write or read) more than [`WINDOW`]
+/// instructions apart, which the emitter reloads instead of keeping them live.
 fn stores(f: &Function) -> Vec<bool> {
     const NONE: u32 = 0;
     const ALWAYS: u32 = u32::MAX;
     // Per register: 1 + the last chunk reading its current value (going backwards), or
     // NONE / ALWAYS.
     let mut reader = vec![NONE; f.work_size];
-    for (&n, &at) in f.output_sizes.iter().zip(&f.output_offsets) {
-        reader[at..at + n].iter_mut().for_each(|r| *r = ALWAYS);
-    }
+    // Per register: the next read of its current value (going backwards), and whether
+    // two accesses of it lie more than `WINDOW` apart in one chunk.
+    let mut next = vec![usize::MAX; f.work_size];
+    let mut far = vec![false; f.work_size];
     let mut store = vec![false; f.tape.len()];
+    let gap = |next: usize, i: usize| {
+        next != usize::MAX && next / CHUNK == i / CHUNK && next - i > WINDOW
+    };
     for (i, ins) in f.tape.iter().enumerate().rev() {
         let chunk = (i / CHUNK) as u32 + 1;
         if ins.op == Op::Call {
@@ -300,18 +392,24 @@ fn stores(f: &Function) -> Vec<bool> {
             let n: usize = call.function.output_sizes.iter().sum();
             let out = call.out as usize;
             reader[out..out + n].iter_mut().for_each(|r| *r = NONE);
+            next[out..out + n].iter_mut().for_each(|r| *r = usize::MAX);
+            far[out..out + n].iter_mut().for_each(|r| *r = false);
         } else {
             let d = ins.d as usize;
-            store[i] = reader[d] > chunk;
+            store[i] = reader[d] > chunk || far[d] || gap(next[d], i);
             reader[d] = NONE;
+            next[d] = usize::MAX;
+            far[d] = false;
         }
         if ins.op == Op::InterpolantN {
             let (a, n) = (ins.a as usize, ins.b as usize);
             reader[a..a + n].iter_mut().for_each(|r| *r = ALWAYS);
         }
         reads(f, ins, |r| {
-            let r = &mut reader[r as usize];
-            *r = (*r).max(chunk);
+            let r = r as usize;
+            reader[r] = reader[r].max(chunk);
+            far[r] |= gap(next[r], i);
+            next[r] = i;
         });
     }
     store
@@ -336,14 +434,38 @@ fn constants(f: &Function) -> Vec<Option<f64>> {
     c
 }
 
+/// The template entries read from memory, which the machine code must write: constant
+/// outputs (the caller copies the output slots) and constants a lookup table reads through
+/// a pointer. Constants read by value are immediates, and every other output slot is
+/// written by the tape.
+fn template_stores(f: &Function, constant: &[Option<f64>]) -> Vec<bool> {
+    let mut needed = vec![false; f.template.len()];
+    let mut mark = |r: usize| {
+        if constant[r].is_some() && r >= f.template_start && r < f.template_start + needed.len() {
+            needed[r - f.template_start] = true;
+        }
+    };
+    for (&n, &at) in f.output_sizes.iter().zip(&f.output_offsets) {
+        (at..at + n).for_each(&mut mark);
+    }
+    for ins in f.tape.iter().filter(|i| i.op == Op::InterpolantN) {
+        (ins.a as usize..(ins.a + ins.b) as usize).for_each(&mut mark);
+    }
+    needed
+}
+
 /// Emits the code of one machine-code function.
 struct Emitter<'a, 'b> {
     b: &'a mut FunctionBuilder<'b>,
     module: &'a mut JITModule,
     w: Value,
+    params: Params,
     layout: &'a Layout<'a>,
-    /// The SSA value of each register read or written in this function so far.
-    values: FxHashMap<u32, Value>,
+    /// The SSA value of each register read or written in this function so far, and the
+    /// instruction of its last access.
+    values: FxHashMap<u32, (Value, usize)>,
+    /// The instruction being emitted.
+    at: usize,
     flags: MemFlags,
     unary: Option<SigRef>,
     binary: Option<SigRef>,
@@ -359,15 +481,17 @@ impl<'a, 'b> Emitter<'a, 'b> {
     fn new(
         b: &'a mut FunctionBuilder<'b>,
         module: &'a mut JITModule,
-        w: Value,
+        params: Params,
         layout: &'a Layout<'a>,
     ) -> Self {
         Emitter {
             b,
             module,
-            w,
+            w: params.w,
+            params,
             layout,
             values: FxHashMap::default(),
+            at: 0,
             flags: MemFlags::trusted(),
             unary: None,
             binary: None,
@@ -385,40 +509,104 @@ impl<'a, 'b> Emitter<'a, 'b> {
         self.b.ins().f64const(Ieee64::with_bits(v.to_bits()))
     }
 
-    /// The value of register `r`.
+    /// The value of register `r`: its SSA value if it was accessed at most [`WINDOW`]
+    /// instructions ago, else reloaded (or the constant re-materialised) so that no value
+    /// lives long enough to be spilled.
     fn get(&mut self, r: u32) -> Value {
-        if let Some(&v) = self.values.get(&r) {
-            return v;
+        self.operand(r, false)
+    }
+
+    /// [`Emitter::get`]; with `first`, for the first operand of a commutative operation: a
+    /// value loaded here is loaded as bits and moved to a float register, because
+    /// Cranelift folds a single-use load into the instruction by swapping the operands of
+    /// `fadd`/`fmul`, and x86 returns the first operand's NaN when both are NaN: the swap
+    /// would change a NaN's sign or payload.
+    fn operand(&mut self, r: u32, first: bool) -> Value {
+        if let Some((v, last)) = self.values.get_mut(&r) {
+            if self.at - *last <= WINDOW {
+                *last = self.at;
+                return *v;
+            }
         }
-        let v = match self.layout.constant[r as usize] {
-            Some(c) => self.constant(c),
-            None => self
-                .b
-                .ins()
-                .load(types::F64, self.flags, self.w, 8 * r as i32),
+        let (base, offset) = match (
+            self.layout.constant[r as usize],
+            self.layout.input_of[r as usize],
+        ) {
+            (Some(c), _) => {
+                let v = self.constant(c);
+                self.values.insert(r, (v, self.at));
+                return v;
+            }
+            // Inputs are never written by the tape: read from the caller's input.
+            (None, Some((k, i))) => (self.params.inputs[k as usize], 8 * i as i32),
+            (None, None) => (self.w, 8 * r as i32),
         };
-        self.values.insert(r, v);
+        let v = if first {
+            let bits = self.b.ins().load(types::I64, self.flags, base, offset);
+            self.b.ins().bitcast(types::F64, MemFlags::new(), bits)
+        } else {
+            self.b.ins().load(types::F64, self.flags, base, offset)
+        };
+        self.values.insert(r, (v, self.at));
         v
     }
 
+    /// Sets register `r` to `v`: stored to the work vector if `store`, and to the caller's
+    /// output if `r` is an output slot (written once by the tape).
     fn put(&mut self, r: u32, v: Value, store: bool) {
-        self.values.insert(r, v);
+        self.values.insert(r, (v, self.at));
         if store {
             self.b.ins().store(self.flags, v, self.w, 8 * r as i32);
         }
+        if let Some((k, i)) = self.layout.output_of[r as usize] {
+            let base = self.params.outputs[k as usize];
+            self.b.ins().store(self.flags, v, base, 8 * i as i32);
+        }
     }
 
-    /// Writes the template into the work vector (the tape's first step).
+    /// Writes the template entries someone reads from memory into the work vector (the
+    /// tape copies the whole template; here the other constants are immediates and the
+    /// other output slots are written by the tape): runs of [`INLINE_TEMPLATE`] entries or
+    /// more by a copy, shorter ones by immediate stores.
     fn template(&mut self) {
         let f = self.layout.f;
-        if f.template.len() <= INLINE_TEMPLATE {
-            for (k, &v) in f.template.iter().enumerate() {
-                let c = self.constant(v);
-                let at = 8 * (f.template_start + k) as i32;
-                self.b.ins().store(self.flags, c, self.w, at);
+        let needed = &self.layout.template_stores;
+        // Where template entry `j` goes: the caller's output, or the work vector.
+        let dest = |j: usize| {
+            let r = f.template_start + j;
+            match self.layout.output_of[r] {
+                Some((k, i)) => (Some(k), 8 * i as i32),
+                None => (None, 8 * r as i32),
             }
-            return;
+        };
+        let mut k = 0;
+        while k < needed.len() {
+            if !needed[k] {
+                k += 1;
+                continue;
+            }
+            let group = dest(k).0;
+            let end = (k..needed.len())
+                .find(|&e| !needed[e] || dest(e).0 != group)
+                .unwrap_or(needed.len());
+            let base = group.map_or(self.w, |o| self.params.outputs[o as usize]);
+            let offset = dest(k).1;
+            if end - k < INLINE_TEMPLATE {
+                for (j, &v) in f.template[k..end].iter().enumerate() {
+                    let c = self.constant(v);
+                    self.b
+                        .ins()
+                        .store(self.flags, c, base, offset + 8 * j as i32);
+                }
+            } else {
+                self.copy_template(k, end, base, offset);
+            }
+            k = end;
         }
+    }
+
+    /// Copies template entries `k..end` to `base + offset`.
+    fn copy_template(&mut self, k: usize, end: usize, base: Value, offset: i32) {
         let sig = *self.copy.get_or_insert_with(|| {
             let p = AbiParam::new(self.module.target_config().pointer_type());
             let mut s = self.module.make_signature();
@@ -426,9 +614,11 @@ impl<'a, 'b> Emitter<'a, 'b> {
             self.b.import_signature(s)
         });
         let ptr = self.ptr();
-        let dst = self.b.ins().iadd_imm(self.w, 8 * f.template_start as i64);
-        let src = self.b.ins().iconst(ptr, self.layout.template as i64);
-        let n = self.b.ins().iconst(ptr, f.template.len() as i64);
+        let dst = self.b.ins().iadd_imm(base, offset as i64);
+        // SAFETY (of the address): `k < template.len()`.
+        let src_addr = unsafe { self.layout.template.add(k) } as i64;
+        let src = self.b.ins().iconst(ptr, src_addr);
+        let n = self.b.ins().iconst(ptr, (end - k) as i64);
         let callee = self.b.ins().iconst(ptr, copy_helper as *const () as i64);
         self.b.ins().call_indirect(sig, callee, &[dst, src, n]);
     }
@@ -496,6 +686,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
     }
 
     fn instruction(&mut self, i: usize) {
+        self.at = i;
         let f = self.layout.f;
         let ins = f.tape[i];
         let store = self.layout.store[i];
@@ -504,12 +695,20 @@ impl<'a, 'b> Emitter<'a, 'b> {
             return;
         }
         if ins.op == Op::InterpolantN {
+            // The table reads its operands from the work vector: inputs copied there.
+            for r in ins.a..ins.a + ins.b {
+                if self.layout.input_of[r as usize].is_some() {
+                    let v = self.get(r);
+                    self.b.ins().store(self.flags, v, self.w, 8 * r as i32);
+                }
+            }
             let x = self.b.ins().iadd_imm(self.w, 8 * ins.a as i64);
             let v = self.lookup(self.layout.tables[ins.c as usize], x, ins.b as usize);
             self.put(ins.d, v, store);
             return;
         }
-        let a = self.get(ins.a);
+        let commutative = matches!(ins.op, Op::Add | Op::Mul | Op::StrongMul);
+        let a = self.operand(ins.a, commutative);
         let b = if ins.op.arity() >= 2 {
             self.get(ins.b)
         } else {
@@ -608,7 +807,9 @@ impl<'a, 'b> Emitter<'a, 'b> {
         let r = self
             .module
             .declare_func_in_func(self.layout.callees[k], self.b.func);
-        self.b.ins().call(r, &[s]);
+        let ptr = self.ptr();
+        let null = self.b.ins().iconst(ptr, 0);
+        self.b.ins().call(r, &[s, null, null]);
         let mut q = 0;
         for (&n, &at) in g.output_sizes.iter().zip(&g.output_offsets) {
             for i in 0..n {

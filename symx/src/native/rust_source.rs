@@ -1,6 +1,7 @@
 //! [`Function::to_rust`]: a function as a self-contained Rust module for deployment
 //! (`no_std`, no allocation, no dependency: the math functions are the C library's, which
 //! Rust's `std` calls too).
+use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
 use crate::function::Function;
 use crate::op::Op;
@@ -9,39 +10,6 @@ use std::fmt::Write;
 
 /// Tape instructions per generated function (keeps rustc's compile time linear).
 const CHUNK: usize = 1024;
-
-/// The C library function computing a unary operation exactly as Rust's `std` does.
-fn libm_unary(op: Op) -> Option<&'static str> {
-    Some(match op {
-        Op::Exp => "exp",
-        Op::Log => "log",
-        Op::Sin => "sin",
-        Op::Cos => "cos",
-        Op::Tan => "tan",
-        Op::Asin => "asin",
-        Op::Acos => "acos",
-        Op::Atan => "atan",
-        Op::Sinh => "sinh",
-        Op::Cosh => "cosh",
-        Op::Tanh => "tanh",
-        Op::Log1p => "log1p",
-        Op::Expm1 => "expm1",
-        Op::Sqrt => "sqrt",
-        Op::Floor => "floor",
-        Op::Ceil => "ceil",
-        _ => return None,
-    })
-}
-
-/// The C library function computing a binary operation exactly as Rust's `std` does.
-fn libm_binary(op: Op) -> Option<&'static str> {
-    Some(match op {
-        Op::Atan2 => "atan2",
-        Op::Hypot => "hypot",
-        Op::Fmod => "fmod",
-        _ => return None,
-    })
-}
 
 struct Writer {
     out: String,
@@ -111,17 +79,10 @@ impl Writer {
                         }
                         continue;
                     }
-                    op => match (libm_unary(op), libm_binary(op)) {
+                    op => match (library_unary(op), library_binary(op)) {
                         (Some(h), _) => format!("{h}({a})"),
                         (_, Some(h)) => format!("{h}({a}, {b})"),
-                        _ => {
-                            return Err(SymxError::Jit {
-                                message: format!(
-                                    "source generation does not support the operation '{}'",
-                                    op.name()
-                                ),
-                            })
-                        }
+                        _ => return Err(unsupported("Rust", op)),
                     },
                 };
                 writeln!(o, "    *w.add({}) = {v};", ins.d).unwrap();
@@ -222,6 +183,25 @@ impl Function {
     /// `Err` for operations the module cannot compute exactly without a dependency:
     /// lookup tables, `erf`, `asinh`, `acosh`, `atanh`.
     pub fn to_rust(&self) -> Result<String, SymxError> {
+        self.to_rust_with(&SourceOptions::default())
+    }
+
+    /// [`Function::to_rust`], with each output's sparsity pattern from `options` in the
+    /// constant `OUTPUT_SPARSITY: [Pattern; n_outputs]` (a `Pattern` holds `nrows`, `ncols`,
+    /// `col_ptr` and `row_idx`, compressed columns; a dense column where none is given).
+    ///
+    /// ```
+    /// use symx::{jacobian, Function, Matrix, SourceOptions};
+    /// let x = Matrix::sym_vec("x", 2);
+    /// let j = jacobian(&[x[0] * x[1], x[1].sin()], &x).unwrap();
+    /// let f = Function::new(&[&x], &[j.values()]).unwrap();
+    /// let options = SourceOptions { output_sparsity: vec![Some(j.sparsity().clone())] };
+    /// let module = f.to_rust_with(&options).unwrap();
+    /// assert!(module.contains("pub const OUTPUT_SPARSITY: [Pattern; 1]"));
+    /// ```
+    pub fn to_rust_with(&self, options: &SourceOptions) -> Result<String, SymxError> {
+        self.refuse_external("to_rust")?;
+        let patterns = options.output_patterns(self)?;
         let mut w = Writer {
             out: String::new(),
             names: FxHashMap::default(),
@@ -264,6 +244,30 @@ impl Function {
             self.work_size
         )
         .unwrap();
+        writeln!(
+            o,
+            "/// A sparsity pattern in compressed columns: the nonzeros of column `j` are in rows\n/// `row_idx[col_ptr[j]..col_ptr[j + 1]]`.\n#[derive(Clone, Copy, Debug)]\npub struct Pattern {{\n    pub nrows: usize,\n    pub ncols: usize,\n    pub col_ptr: &'static [usize],\n    pub row_idx: &'static [usize],\n}}"
+        )
+        .unwrap();
+        let patterns: Vec<String> = patterns
+            .iter()
+            .map(|p| {
+                format!(
+                    "Pattern {{ nrows: {}, ncols: {}, col_ptr: &[{}], row_idx: &[{}] }}",
+                    p.nrows(),
+                    p.ncols(),
+                    list(p.col_ptr()),
+                    list(p.row_idx())
+                )
+            })
+            .collect();
+        writeln!(
+            o,
+            "/// The sparsity pattern of each output (its entries are the nonzeros, column by column).\npub const OUTPUT_SPARSITY: [Pattern; {}] = [{}];",
+            patterns.len(),
+            patterns.join(", ")
+        )
+        .unwrap();
         let ins = list(&self.input_offsets);
         let outs = list(&self.output_offsets);
         write!(
@@ -292,7 +296,7 @@ pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> 
 }}
 }}
 #[allow(unused_imports)]
-pub use generated::{{eval, INPUT_SIZES, OUTPUT_SIZES, WORK_SIZE}};
+pub use generated::{{eval, Pattern, INPUT_SIZES, OUTPUT_SIZES, OUTPUT_SPARSITY, WORK_SIZE}};
 "#,
             ni = self.input_offsets.len(),
             no = self.output_offsets.len(),

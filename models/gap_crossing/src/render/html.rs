@@ -3,16 +3,20 @@
 //!
 //! Nothing is loaded from the network: the plan's numbers are embedded as JSON in an
 //! inline script, which draws both views as inline SVG. Each view shows every stance's
-//! CoMs faintly (the path), the widened gap (top view) or the terrain profile (side
-//! view), the goals, and the current stance in full: feet, support polygon, CoMs, legs
+//! CoMs faintly (the path), the terrain as `plan.svg` draws it ([`terrain_view`]: the
+//! keep-out, allowed regions, gaps, stones, a step's edge, a height map's cells in the
+//! top view; the profile, keep-out bands and stones in the side view), the goals, and the current stance in full: feet, support polygon, CoMs, legs
 //! and contact forces (side view, scaled). Feet that moved into this stance are ringed.
-use super::esc;
+use super::{esc, terrain_view};
 use crate::plan::SolutionFile;
 use crate::scenario::{Biped, Foot};
 use serde_json::json;
 
 /// Lowest terrain drawn in the side view, relative to the floor (m): a deep gap is cut.
 const PROFILE_FLOOR: f64 = -1.0;
+
+/// Where an unbounded edge of a terrain rectangle is put in the page's data (m).
+const FAR: f64 = 1e6;
 
 /// The page for `file`, with `title` as its heading.
 pub fn plan_html(file: &SolutionFile, title: &str) -> String {
@@ -28,30 +32,48 @@ pub fn plan_html(file: &SolutionFile, title: &str) -> String {
             })
         })
         .collect();
-    let (lo, hi) = s.gap.keep_out();
+    let terrain = crate::terrain::of(s);
     let xs = file
         .stances
         .iter()
         .flat_map(|st| Foot::ALL.map(|i| st.feet.get(i)[0]))
-        .chain([s.goal.b[0], s.goal.f[0], lo, hi]);
+        .chain([s.goal.b[0], s.goal.f[0]]);
     let (xmin, xmax) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
         (a.min(x), b.max(x))
     });
     let (x0, x1) = (xmin - 0.6, xmax + 0.6);
-    let profile: Vec<[f64; 2]> = (0..=800)
-        .map(|k| {
-            let x = x0 + (x1 - x0) * k as f64 / 800.0;
-            [x, s.gap.height(x).max(PROFILE_FLOOR)]
+    let profile: Vec<[f64; 2]> =
+        terrain_view::profile(s, &*terrain, &terrain_view::profile_xs(s, x0, x1))
+            .into_iter()
+            .map(|[x, h]| [x, h.max(PROFILE_FLOOR)])
+            .collect();
+    // JSON has no infinity: unbounded edges become far-away finite ones, clipped to the
+    // view by the script.
+    let finite = |v: [f64; 2]| v.map(|e| e.clamp(-FAR, FAR));
+    let rects: Vec<serde_json::Value> = terrain_view::top_rects(s, &*terrain)
+        .into_iter()
+        .map(|r| {
+            json!({
+                "x": finite(r.x),
+                "y": finite(r.y),
+                "fill": r.fill,
+                "opacity": r.opacity.unwrap_or(1.0),
+                "stroke": r.stroke.map(|(c, _)| c),
+                "strokeWidth": r.stroke.map_or(0.0, |(_, w)| w),
+            })
         })
         .collect();
     let data = json!({
         "stances": stances,
         "feet": Foot::ALL.map(|i| i.name()),
         "goal": [s.goal.b, s.goal.f],
-        "keepOut": [lo, hi],
-        "gap": [s.gap.min, s.gap.max],
         "xRange": [x0, x1],
+        "sideY": terrain_view::side_y(s),
+        "topRects": rects,
+        "stepEdge": terrain_view::step_edge(s),
         "profile": profile,
+        "keepOutBands": terrain_view::keep_out_bands(s, &*terrain, &terrain_view::profile_xs(s, x0, x1)),
+        "stones": terrain_view::stone_blocks(s),
         "objective": file.solver.objective,
         "status": file.solver.status,
     });
@@ -86,7 +108,7 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
   <span id="label"></span>
 </div>
 <svg id="top" width="1000" height="330"></svg>
-<div class="caption">Top view (x–y): feet (circles: back feet BR, BL; squares: front feet FR, FL, as in plan.svg), support polygon, CoMs (B blue, F orange) of the current stance; dots: the CoM path of every stance; red band: the widened gap; rings: goals. A ringed foot has just moved.</div>
+<div class="caption">Top view (x–y): feet (circles: back feet BR, BL; squares: front feet FR, FL, as in plan.svg), support polygon, CoMs (B blue, F orange) of the current stance; dots: the CoM path of every stance; terrain as in plan.svg (pale red: keep-out; white: where feet may stand; dark red: gaps; sand: stones; brown shading: a height map, darker is higher); rings: goals. A ringed foot has just moved.</div>
 <svg id="side" width="1000" height="300"></svg>
 <div class="caption">Side view (x–z): terrain, feet, legs (CoM to its feet) and CoMs of the current stance; green arrows: contact forces (1 m per 1000 N).</div>
 <script id="plan-data" type="application/json">__DATA__</script>
@@ -139,16 +161,39 @@ svg { display: block; background: white; border: 1px solid #ccc; margin-bottom: 
   }
   var top = view(document.getElementById("top"), range(1, [D.goal[0][1], D.goal[1][1]]));
   var side = view(document.getElementById("side"), range(2, D.profile.map(function (p) { return p[1]; })));
-  // Static layers: gap band, terrain, goals, CoM paths.
+  // Static layers: terrain, goals, CoM paths.
   var topStatic = el(top.svg, "g", {});
   top.svg.insertBefore(topStatic, top.dyn);
   var yr = range(1, [D.goal[0][1], D.goal[1][1]]);
-  el(topStatic, "rect", { x: top.px(D.keepOut[0]), y: top.py(yr[1]), width: top.px(D.keepOut[1]) - top.px(D.keepOut[0]),
-    height: top.py(yr[0]) - top.py(yr[1]), fill: "#f4c7c3" });
-  el(topStatic, "rect", { x: top.px(D.gap[0]), y: top.py(yr[1]), width: Math.max(1, top.px(D.gap[1]) - top.px(D.gap[0])),
-    height: top.py(yr[0]) - top.py(yr[1]), fill: "#b03a2e" });
+  var zr = range(2, D.profile.map(function (p) { return p[1]; }));
+  // A data rectangle clipped to the view's ranges.
+  function rect(g, v, x, y, xr2, yr2, attrs) {
+    var a = Math.max(x[0], xr2[0]), b = Math.min(x[1], xr2[1]);
+    var c = Math.max(y[0], yr2[0]), d = Math.min(y[1], yr2[1]);
+    if (!(a < b && c < d)) return;
+    attrs.x = v.px(a); attrs.y = v.py(d);
+    attrs.width = Math.max(0.5, v.px(b) - v.px(a)); attrs.height = Math.max(0.5, v.py(c) - v.py(d));
+    el(g, "rect", attrs);
+  }
+  D.topRects.forEach(function (r) {
+    var attrs = { fill: r.fill, "fill-opacity": r.opacity, "class": "terrain" };
+    if (r.stroke) { attrs.stroke = r.stroke; attrs["stroke-width"] = r.strokeWidth; }
+    rect(topStatic, top, r.x, r.y, D.xRange, yr, attrs);
+  });
+  if (D.stepEdge) {
+    el(topStatic, "line", { x1: top.px(D.stepEdge[0]), x2: top.px(D.stepEdge[0]), y1: top.py(yr[0]), y2: top.py(yr[1]),
+      stroke: "#6b4f2a", "stroke-width": 2 });
+    el(topStatic, "text", { x: top.px(D.stepEdge[0]) + 4, y: top.py(yr[1]) + 14, "font-size": 11 },
+      "step " + (D.stepEdge[1] >= 0 ? "+" : "") + D.stepEdge[1] + " m");
+  }
   var sideStatic = el(side.svg, "g", {});
   side.svg.insertBefore(sideStatic, side.dyn);
+  D.keepOutBands.forEach(function (b) {
+    rect(sideStatic, side, b, [-1e6, 1e6], D.xRange, zr, { fill: "#d62728", "fill-opacity": 0.12 });
+  });
+  D.stones.forEach(function (b) {
+    rect(sideStatic, side, b, [-0.03, 0], D.xRange, zr, { fill: "#8c7a55" });
+  });
   el(sideStatic, "polyline", { points: D.profile.map(function (p) { return side.px(p[0]) + "," + side.py(p[1]); }).join(" "),
     fill: "none", stroke: "#7b5a3c", "stroke-width": 2 });
   [0, 1].forEach(function (j) {

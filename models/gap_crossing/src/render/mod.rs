@@ -11,12 +11,16 @@
 //! - [`html`] ([`plan_html`]): the plan animated, one stance at a time, with a slider and
 //!   a play button (a self-contained HTML page with inline SVG and script).
 //!
+//! - [`terrain_view`]: the terrain as drawn (data coordinates), shared by `plan.svg`
+//!   and `plan.html`.
+//!
 //! This module holds what they share: sizes, fonts, the colour ramp, escaping and ticks.
 
 pub mod convergence;
 pub mod html;
 pub mod plan;
 pub mod sweep;
+pub mod terrain_view;
 
 pub use convergence::convergence_svg;
 pub use html::plan_html;

@@ -1,8 +1,9 @@
 //! The plan figure: top view (x–y) above side view (x–z) of every stance.
 
+use super::terrain_view;
 use super::{esc, fmt_tick, nice_step, ramp, svg_open, ticks, FONT, MARGIN_L, MARGIN_R, WIDTH};
 use crate::plan::SolutionFile;
-use crate::scenario::{Biped, Foot, Gap, Scenario, TerrainSpec, Vec3};
+use crate::scenario::{Biped, Foot, Scenario, TerrainSpec, Vec3};
 use crate::terrain::{self, Terrain};
 use std::fmt::Write;
 
@@ -146,40 +147,6 @@ fn goal_marker(svg: &mut String, x: f64, y: f64, label: &str) {
     );
 }
 
-/// Steep edges of the terrain: `(x, width)` with width ≈ the edge's 1/k scale.
-fn edges(s: &Scenario) -> Vec<(f64, f64)> {
-    let gap = |g: &Gap| {
-        let w = 5.0 / g.steepness.max(1e-9);
-        [(g.min, w), (g.max, w)]
-    };
-    match &s.terrain {
-        TerrainSpec::Gap => gap(&s.gap).to_vec(),
-        TerrainSpec::Gaps { gaps } => gaps.iter().flat_map(gap).collect(),
-        TerrainSpec::Step {
-            edge, steepness, ..
-        } => vec![(*edge, 5.0 / steepness.max(1e-9))],
-        _ => Vec::new(),
-    }
-}
-
-/// Terrain sample points: uniform, plus points hugging each steep edge so the atan
-/// edges are drawn as edges.
-fn terrain_xs(s: &Scenario, lo: f64, hi: f64) -> Vec<f64> {
-    let mut xs: Vec<f64> = (0..=400)
-        .map(|i| lo + (hi - lo) * i as f64 / 400.0)
-        .collect();
-    for (e, w) in edges(s) {
-        for d in [-20.0, -5.0, -1.0, 0.0, 1.0, 5.0, 20.0] {
-            let x = e + d * w;
-            if x > lo && x < hi {
-                xs.push(x);
-            }
-        }
-    }
-    xs.sort_by(f64::total_cmp);
-    xs
-}
-
 /// A data rectangle clipped to the panel, as an SVG rect.
 fn rect(svg: &mut String, p: &Panel, x: [f64; 2], y: [f64; 2], style: &str) {
     let (x0, x1) = (x[0].max(p.xr.0), x[1].min(p.xr.1));
@@ -197,72 +164,38 @@ fn rect(svg: &mut String, p: &Panel, x: [f64; 2], y: [f64; 2], style: &str) {
     );
 }
 
-/// Top view of the terrain: the keep-out pale red, allowed regions white (stones
-/// sand-coloured), gaps dark red, a step's edge as a line, a height map as shaded cells.
+/// Top view of the terrain ([`terrain_view::top_rects`], [`terrain_view::step_edge`]).
 fn terrain_top(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain) {
-    let all = [f64::NEG_INFINITY, f64::INFINITY];
-    rect(svg, p, all, all, r##"fill="#d62728" fill-opacity="0.15""##);
-    let stones = matches!(s.terrain, TerrainSpec::Stones { .. });
-    for r in t.regions() {
-        let style = if stones {
-            r##"fill="#e8dcc0" stroke="#8c7a55" stroke-width="0.8""##
-        } else {
-            r#"fill="white""#
-        };
-        rect(svg, p, r.x, r.y, style);
+    for r in terrain_view::top_rects(s, t) {
+        let mut style = format!(r#"fill="{}""#, r.fill);
+        if let Some(o) = r.opacity {
+            let _ = write!(style, r#" fill-opacity="{o}""#);
+        }
+        if let Some((c, w)) = r.stroke {
+            let _ = write!(style, r#" stroke="{c}" stroke-width="{w}""#);
+        }
+        rect(svg, p, r.x, r.y, &style);
     }
-    let dark = r##"fill="#7f1d1d" fill-opacity="0.45""##;
-    match &s.terrain {
-        TerrainSpec::Gap => rect(svg, p, [s.gap.min, s.gap.max], all, dark),
-        TerrainSpec::Gaps { gaps } => {
-            for g in gaps {
-                rect(svg, p, [g.min, g.max], all, dark);
-            }
-        }
-        TerrainSpec::Step { edge, rise, .. } => {
-            let _ = writeln!(
-                svg,
-                r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#6b4f2a" stroke-width="2"/><text x="{:.1}" y="{:.1}" font-size="11" {FONT}>step {rise:+} m</text>"##,
-                p.y0,
-                p.y0 + p.h(),
-                p.px(*edge) + 4.0,
-                p.y0 + 14.0,
-                x = p.px(*edge)
-            );
-        }
-        TerrainSpec::HeightMap { .. } => {
-            // Cells shaded by height (light = low, brown = high) over the grid.
-            let r = t.regions()[0];
-            let (nx, ny) = (60, 24);
-            let (lo, hi) = (terrain_range(s, t).0, terrain_range(s, t).1.max(1e-9));
-            for a in 0..nx {
-                for b in 0..ny {
-                    let x = [
-                        r.x[0] + (r.x[1] - r.x[0]) * a as f64 / nx as f64,
-                        r.x[0] + (r.x[1] - r.x[0]) * (a + 1) as f64 / nx as f64,
-                    ];
-                    let y = [
-                        r.y[0] + (r.y[1] - r.y[0]) * b as f64 / ny as f64,
-                        r.y[0] + (r.y[1] - r.y[0]) * (b + 1) as f64 / ny as f64,
-                    ];
-                    let h = t.height_at((x[0] + x[1]) / 2.0, (y[0] + y[1]) / 2.0);
-                    let u = ((h - lo) / (hi - lo).max(1e-9)).clamp(0.0, 1.0);
-                    let style = format!(
-                        r##"fill="#8c6d3f" fill-opacity="{:.2}" stroke="none""##,
-                        0.05 + 0.5 * u
-                    );
-                    rect(svg, p, x, y, &style);
-                }
-            }
-        }
-        TerrainSpec::Stones { .. } => {}
+    if let Some((edge, rise)) = terrain_view::step_edge(s) {
+        let _ = writeln!(
+            svg,
+            r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#6b4f2a" stroke-width="2"/><text x="{:.1}" y="{:.1}" font-size="11" {FONT}>step {rise:+} m</text>"##,
+            p.y0,
+            p.y0 + p.h(),
+            p.px(edge) + 4.0,
+            p.y0 + 14.0,
+            x = p.px(edge)
+        );
     }
 }
 
 /// Side view of the keep-out: pale red where no allowed region holds (x, y) along the
 /// profile's line (stones: each stone as a block at z = 0 instead).
 fn terrain_side(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain, tx: &[f64]) {
-    let band = |svg: &mut String, a: f64, b: f64| {
+    for b in terrain_view::stone_blocks(s) {
+        rect(svg, p, b, [-0.03, 0.0], r##"fill="#8c7a55""##);
+    }
+    for [a, b] in terrain_view::keep_out_bands(s, t, tx) {
         let _ = writeln!(
             svg,
             r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#d62728" fill-opacity="0.12"/>"##,
@@ -271,56 +204,7 @@ fn terrain_side(svg: &mut String, p: &Panel, s: &Scenario, t: &dyn Terrain, tx: 
             (p.px(b) - p.px(a)).max(0.5),
             p.h()
         );
-    };
-    if let TerrainSpec::Stones { stones } = &s.terrain {
-        for b in stones {
-            rect(svg, p, [b[0], b[1]], [-0.03, 0.0], r##"fill="#8c7a55""##);
-        }
-        return;
     }
-    let (y, regions) = (side_y(s), t.regions());
-    let mut out_from: Option<f64> = None;
-    for &x in tx {
-        let out = !regions.iter().any(|r| r.contains(x, y, 0.0));
-        match (out, out_from) {
-            (true, None) => out_from = Some(x),
-            (false, Some(a)) => {
-                band(svg, a, x);
-                out_from = None;
-            }
-            _ => {}
-        }
-    }
-    if let (Some(a), Some(&b)) = (out_from, tx.last()) {
-        band(svg, a, b);
-    }
-}
-
-/// Lowest and highest terrain height along the side view's line (m), for height maps
-/// sampled over the grid.
-fn terrain_range(s: &Scenario, t: &dyn Terrain) -> (f64, f64) {
-    let r = t.regions();
-    let (x0, x1) = (
-        r.iter()
-            .map(|r| r.x[0])
-            .fold(f64::INFINITY, f64::min)
-            .max(-50.0),
-        r.iter()
-            .map(|r| r.x[1])
-            .fold(f64::NEG_INFINITY, f64::max)
-            .min(50.0),
-    );
-    let y = side_y(s);
-    (0..=200)
-        .map(|k| t.height_at(x0 + (x1 - x0) * k as f64 / 200.0, y))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), h| {
-            (a.min(h), b.max(h))
-        })
-}
-
-/// The y of the side view's terrain profile: the mean y of the start feet.
-fn side_y(s: &Scenario) -> f64 {
-    s.start.feet.to_array().iter().map(|p| p[1]).sum::<f64>() / 4.0
 }
 
 /// The colour of stance `k` of `n`: the ramp from first to last.
@@ -371,7 +255,7 @@ impl Layout {
         let xr = (min(&xs) - 0.4, max(&xs) + 0.4);
         let yr = (min(&ys) - 0.3, max(&ys) + 0.3);
         let shown_depth = depth.min(1.0);
-        let (t_lo, t_hi) = terrain_range(s, terrain);
+        let (t_lo, t_hi) = terrain_view::height_range(s, terrain);
         let zr = (
             min(&zs)
                 .min(t_lo.max(-1.0))
@@ -523,8 +407,8 @@ fn side_view(svg: &mut String, file: &SolutionFile, l: &Layout, terrain: &dyn Te
     let (xr, zr) = (side.xr, side.yr);
     side.axes(svg, "x (m)", "z (m)", "Side view (x–z)");
     let _ = writeln!(svg, r##"<g clip-path="url(#clip-side)">"##);
-    let y_side = side_y(s);
-    let tx = terrain_xs(s, xr.0, xr.1);
+    let y_side = terrain_view::side_y(s);
+    let tx = terrain_view::profile_xs(s, xr.0, xr.1);
     terrain_side(svg, side, s, terrain, &tx);
     let mut d = format!("M{:.1},{:.1}", side.px(xr.0), side.py(zr.0));
     for &x in &tx {
@@ -560,7 +444,7 @@ fn side_view(svg: &mut String, file: &SolutionFile, l: &Layout, terrain: &dyn Te
         let _ = writeln!(
             svg,
             r#"<text x="{:.1}" y="{:.1}" font-size="11" text-anchor="middle" {FONT}>depth {} m (cut)</text>"#,
-            side.px(edges(s).first().map_or(xr.0, |e| e.0)),
+            side.px(terrain_view::edges(s).first().map_or(xr.0, |e| e.0)),
             side.py(zr.0) - 4.0,
             l.depth
         );

@@ -90,6 +90,28 @@ pub(crate) struct Outcome {
     /// by the acceptance hook.
     pub resto_converged: bool,
 }
+
+impl Outcome {
+    /// A solve that ends before iterating: at `w` with zero multipliers for `m` rows and
+    /// `w`'s entries.
+    pub(crate) fn at_start(
+        status: Status,
+        w: Vec<f64>,
+        m: usize,
+        message: impl Into<String>,
+    ) -> Outcome {
+        let nw = w.len();
+        Outcome {
+            status,
+            w,
+            y: vec![0.0; m],
+            zl: vec![0.0; nw],
+            zu: vec![0.0; nw],
+            message: message.into(),
+            resto_converged: false,
+        }
+    }
+}
 /// How the primal vector w = [x; s] is laid out and bounded: fixed for a run.
 #[derive(Clone)]
 pub(crate) struct Layout {
@@ -219,10 +241,13 @@ pub(crate) fn barrier_value(
 }
 
 impl<'p> Core<'p> {
+    /// The iteration on `nlp`, with `kkt` (a KKT system analysed for `nlp`'s Hessian and
+    /// Jacobian patterns, kept from an earlier solve) or a new one.
     pub(crate) fn new(
         nlp: &'p mut dyn IpmProblem,
         opts: &IpmOptions,
         setup: &Setup,
+        kkt: Option<Kkt>,
     ) -> Result<Self, CoreError> {
         let n = nlp.n();
         let m = nlp.m();
@@ -263,10 +288,15 @@ impl<'p> Core<'p> {
         }
         let has_l: Vec<bool> = wl.iter().map(|v| v.is_finite()).collect();
         let has_u: Vec<bool> = wu.iter().map(|v| v.is_finite()).collect();
-        let kkt = Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())?;
+        let mut kkt = match kkt {
+            Some(mut kkt) => {
+                kkt.reset();
+                kkt
+            }
+            None => Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())?,
+        };
         let nnz_j = nlp.jac_g_sparsity().row_idx().len();
         let nnz_h = nlp.hess_l_sparsity().row_idx().len();
-        let mut kkt = kkt;
         kkt.min_refinement_steps = opts.min_refinement_steps;
         kkt.max_refinement_steps = opts.max_refinement_steps;
         kkt.residual_ratio_max = opts.residual_ratio_max;
@@ -397,6 +427,7 @@ impl<'p> Core<'p> {
             d_norm,
             regularization: self.pert.delta_w,
             jacobian_regularization: self.pert.delta_c,
+            augmented_weight: 0.0,
             alpha_du,
             alpha_pr,
             alpha_pr_char: ch,
@@ -431,6 +462,7 @@ impl<'p> Core<'p> {
                         d_norm: 0.0,
                         regularization: 0.0,
                         jacobian_regularization: 0.0,
+                        augmented_weight: 0.0,
                         alpha_du: 0.0,
                         alpha_pr: 0.0,
                         alpha_pr_char: ' ',
@@ -670,6 +702,12 @@ impl<'p> Core<'p> {
             return true;
         }
         false
+    }
+
+    /// The KKT system (its symbolic analysis), to keep for the next solve of a problem
+    /// with the same structure.
+    pub(crate) fn into_kkt(self) -> Kkt {
+        self.kw.kkt
     }
 
     // ------------------------------------------------------------------ for restoration
