@@ -175,7 +175,7 @@ impl SqpState<'_> {
         // Rounding allowance of the merit: of f, and of every weighted row value (a row
         // at its bound shows violations at the rounding level of g_i, which the weights
         // up to ρ magnify; near a solution these decided the line search, see
-        // docs/performance.md, "SQP on the flagship").
+        // benches/reference/results/performance-notebook.md, "SQP on the flagship").
         let g_noise: f64 = (0..self.shape.m)
             .filter(|&i| !self.geo.cone_row[i])
             .map(|i| self.merit_w[i] * self.it.g[i].abs().max(1.0))

@@ -82,7 +82,7 @@ pub struct SqpOptions {
     /// the faer LDLᵀ and keep it when it is a KKT point of the QP (not with cones or
     /// elastic variables in use). Clarabel's own accuracy is relative to its scaled
     /// problem; on reduced Hessians with curvatures far apart its step error stalled the
-    /// SQP (docs/performance.md, "SQP on the flagship"). Default true.
+    /// SQP (benches/reference/results/performance-notebook.md, "SQP on the flagship"). Default true.
     pub qp_polish: bool,
     /// Solve each QP first with the warm-started primal-dual active-set method over the
     /// faer LDLᵀ (from the previous QP's working set), and with clarabel only when that
