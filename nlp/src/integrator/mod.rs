@@ -603,7 +603,6 @@ impl<'a> Dopri<'a> {
 
     /// Steps from `t` to exactly `target`.
     fn advance(&mut self, t: &mut f64, z: &mut [f64], target: f64) -> Result<(), IntegratorError> {
-        let nz = z.len();
         if !self.fresh {
             self.eval(false, z, 0);
             self.fresh = true;
@@ -611,7 +610,6 @@ impl<'a> Dopri<'a> {
         if self.h <= 0.0 && target > *t {
             self.h = self.initial_step(z, target - *t);
         }
-        let mut znew = vec![0.0; nz];
         while *t < target {
             if self.stats.accepted + self.stats.rejected >= self.options.max_steps {
                 return Err(IntegratorError::MaxSteps {
@@ -635,7 +633,7 @@ impl<'a> Dopri<'a> {
                 self.eval(true, z, s);
             }
             // The 5th-order solution is the last stage's point (FSAL).
-            znew.copy_from_slice(&self.stage);
+            let znew = &self.stage;
             let mut sum = 0.0;
             let mut finite = true;
             for i in 0..self.controlled {
@@ -651,7 +649,7 @@ impl<'a> Dopri<'a> {
             let finite = finite && znew.iter().all(|v| v.is_finite());
             if finite && err <= 1.0 {
                 *t = if last { target } else { *t + h };
-                z.copy_from_slice(&znew);
+                z.copy_from_slice(&self.stage);
                 self.k.swap(0, 6);
                 self.stats.accepted += 1;
                 let factor = if err == 0.0 {
