@@ -569,6 +569,30 @@ fn expand(m: Matrix, shape: (usize, usize)) -> PyResult<Matrix> {
     }
 }
 
+/// `lower <= expr <= upper` entry by entry (numbers; `None` for no bound): a
+/// `Constraint`, e.g. for `Problem.subject_to` or an `Ocp` path constraint.
+#[pyfunction]
+#[pyo3(signature = (lower, expr, upper))]
+pub fn bounded(
+    lower: Option<f64>,
+    expr: &Bound<'_, PyAny>,
+    upper: Option<f64>,
+) -> PyResult<PyConstraint> {
+    let m = operand(expr)?;
+    let (l, u) = (
+        lower.unwrap_or(f64::NEG_INFINITY),
+        upper.unwrap_or(f64::INFINITY),
+    );
+    if l.is_nan() || u.is_nan() || l > u {
+        return Err(crate::error::BuildError::new_err(format!(
+            "bounded: bounds [{l}, {u}] are not an interval"
+        )));
+    }
+    Ok(PyConstraint {
+        c: nlp::bounded(l, m, u),
+    })
+}
+
 /// Stacks expressions vertically.
 #[pyfunction]
 #[pyo3(signature = (*parts))]
@@ -712,6 +736,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(logic_and, m)?,
         wrap_pyfunction!(logic_or, m)?,
         wrap_pyfunction!(if_else, m)?,
+        wrap_pyfunction!(bounded, m)?,
         wrap_pyfunction!(vertcat, m)?,
         wrap_pyfunction!(horzcat, m)?,
         wrap_pyfunction!(dot, m)?,

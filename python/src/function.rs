@@ -23,6 +23,13 @@ pub struct PyFunction {
     out_shapes: Vec<(usize, usize)>,
 }
 
+impl PyFunction {
+    /// The compiled symx function.
+    pub fn function(&self) -> &symx::Function {
+        &self.f
+    }
+}
+
 #[pymethods]
 impl PyFunction {
     /// Compiles `outputs` as functions of the symbols in `inputs` (each an `Expr` of

@@ -10,9 +10,14 @@ mod error;
 mod expr;
 mod function;
 mod gap;
+mod method;
+mod mpc;
+mod ocp;
 mod problem;
 mod same_thread;
 mod solution;
+mod trajectory;
+mod transcription;
 
 use pyo3::prelude::*;
 
@@ -25,5 +30,10 @@ fn _symnlp(m: &Bound<'_, PyModule>) -> PyResult<()> {
     problem::register(m)?;
     solution::register(m)?;
     gap::register(m)?;
+    method::register(m)?;
+    ocp::register(m)?;
+    transcription::register(m)?;
+    trajectory::register(m)?;
+    mpc::register(m)?;
     Ok(())
 }

@@ -255,23 +255,13 @@ impl PyProblem {
 
     fn ensure_compiled(&mut self, py: Python<'_>) -> PyResult<()> {
         if self.compiled.is_none() {
-            let pb = SameThread(&self.pb);
-            let c = py.allow_threads(move || {
-                let pb = pb;
-                pb.0.compile()
-            });
-            self.compiled = Some(c.map_err(build_err)?);
+            self.compiled = Some(compile_without_gil(py, &self.pb)?);
         }
         Ok(())
     }
 
     fn names(&self) -> Vec<String> {
-        self.pb
-            .variables()
-            .iter()
-            .chain(self.pb.parameters())
-            .map(|e| e.name().unwrap_or_default())
-            .collect()
+        symbol_names(&self.pb)
     }
 
     fn run(
@@ -287,49 +277,80 @@ impl PyProblem {
         self.ensure_compiled(py)?;
         let names = self.names();
         let compiled = self.compiled.as_mut().expect("compiled above");
-        let parameters = compiled.parameter_values().to_vec();
-        let warm = warm.map(|w| &w.inner);
-        let mut raised: Option<PyErr> = None;
-        let result = py.allow_threads(|| match callback {
-            None => backend.solve_dyn(compiled, warm, None),
-            Some(cb) => {
-                let mut call = |view: &nlp::IterationView<'_>| -> ControlFlow<()> {
-                    Python::with_gil(|py| {
-                        let go = iteration_dict(py, view.record()).and_then(|d| {
-                            d.set_item(
-                                "x",
-                                numpy::IntoPyArray::into_pyarray(view.x().to_vec(), py),
-                            )?;
-                            cb.call1(py, (d,))
-                        });
-                        match go {
-                            Ok(r) if r.bind(py).is(&PyBool::new(py, false).to_owned()) => {
-                                ControlFlow::Break(())
-                            }
-                            Ok(_) => ControlFlow::Continue(()),
-                            Err(e) => {
-                                raised = Some(e);
-                                ControlFlow::Break(())
-                            }
-                        }
-                    })
-                };
-                backend.solve_dyn(compiled, warm, Some(&mut call))
-            }
-        });
-        if let Some(e) = raised {
-            return Err(e);
-        }
-        Ok(PySolution {
-            inner: result.map_err(solve_err)?,
-            names,
-            parameters,
-        })
+        solve_compiled(py, compiled, backend.as_ref(), callback, warm, names)
     }
 }
 
+/// `pb` compiled with the GIL released.
+pub fn compile_without_gil(py: Python<'_>, pb: &nlp::Problem) -> PyResult<Compiled> {
+    let pb = SameThread(pb);
+    let c = py.allow_threads(move || {
+        let pb = pb;
+        pb.0.compile()
+    });
+    c.map_err(build_err)
+}
+
+/// The names of `pb`'s variables then parameters, entry by entry (what a [`PySolution`]
+/// resolves symbols by).
+pub fn symbol_names(pb: &nlp::Problem) -> Vec<String> {
+    pb.variables()
+        .iter()
+        .chain(pb.parameters())
+        .map(|e| e.name().unwrap_or_default())
+        .collect()
+}
+
+/// Solves `compiled` with `backend` (warm from `warm` if given) without the GIL;
+/// `callback(info)` is called with the GIL at each iteration (`False` stops the solve, an
+/// exception stops it and propagates). `names`: the problem's [`symbol_names`].
+pub fn solve_compiled(
+    py: Python<'_>,
+    compiled: &mut Compiled,
+    backend: &dyn Solver,
+    callback: Option<Py<PyAny>>,
+    warm: Option<&PySolution>,
+    names: Vec<String>,
+) -> PyResult<PySolution> {
+    let parameters = compiled.parameter_values().to_vec();
+    let warm = warm.map(|w| &w.inner);
+    let mut raised: Option<PyErr> = None;
+    let result = py.allow_threads(|| match callback {
+        None => backend.solve_dyn(compiled, warm, None),
+        Some(cb) => {
+            let mut call = |view: &nlp::IterationView<'_>| -> ControlFlow<()> {
+                Python::with_gil(|py| {
+                    let go = iteration_dict(py, view.record()).and_then(|d| {
+                        d.set_item("x", numpy::IntoPyArray::into_pyarray(view.x().to_vec(), py))?;
+                        cb.call1(py, (d,))
+                    });
+                    match go {
+                        Ok(r) if r.bind(py).is(&PyBool::new(py, false).to_owned()) => {
+                            ControlFlow::Break(())
+                        }
+                        Ok(_) => ControlFlow::Continue(()),
+                        Err(e) => {
+                            raised = Some(e);
+                            ControlFlow::Break(())
+                        }
+                    }
+                })
+            };
+            backend.solve_dyn(compiled, warm, Some(&mut call))
+        }
+    });
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    Ok(PySolution {
+        inner: result.map_err(solve_err)?,
+        names,
+        parameters,
+    })
+}
+
 /// The back end named `solver` with `options` (IPOPT names) applied.
-fn make_solver(solver: &str, options: Option<&Bound<'_, PyDict>>) -> PyResult<Box<dyn Solver>> {
+pub fn make_solver(solver: &str, options: Option<&Bound<'_, PyDict>>) -> PyResult<Box<dyn Solver>> {
     let mut opts: Box<dyn SolverOptions> = match solver {
         "ipm" | "ipopt" => Box::new(nlp::IpmOptions::default()),
         "sqp" => Box::new(nlp::SqpOptions::default()),
@@ -453,19 +474,7 @@ impl PyProblem {
         expr: &Bound<'_, PyAny>,
         upper: Option<f64>,
     ) -> PyResult<PyConstraint> {
-        let m = operand(expr)?;
-        let (l, u) = (
-            lower.unwrap_or(f64::NEG_INFINITY),
-            upper.unwrap_or(f64::INFINITY),
-        );
-        if l.is_nan() || u.is_nan() || l > u {
-            return Err(crate::error::BuildError::new_err(format!(
-                "bounded: bounds [{l}, {u}] are not an interval"
-            )));
-        }
-        Ok(PyConstraint {
-            c: nlp::bounded(l, m, u),
-        })
+        crate::expr::bounded(lower, expr, upper)
     }
 
     /// Second-order cone `‖v‖₂ ≤ t`.
@@ -612,33 +621,8 @@ impl PyProblem {
     ) -> PyResult<Bound<'py, PyDict>> {
         self.bind()?;
         self.ensure_compiled(py)?;
-        let p = self
-            .compiled
-            .as_ref()
-            .expect("compiled above")
-            .parameter_values()
-            .to_vec();
-        if self.sensitivity.is_none() {
-            let pb = SameThread(&self.pb);
-            let ps = py.allow_threads(move || {
-                let pb = pb;
-                nlp::ParametricSensitivity::new(pb.0)
-            });
-            self.sensitivity = Some(ps.map_err(build_err)?);
-        }
-        let ps = self.sensitivity.as_mut().expect("built above");
-        let sol = &solution.inner;
-        let s = py
-            .allow_threads(|| ps.compute(sol, &p))
-            .map_err(solve_err)?;
-        let d = PyDict::new(py);
-        d.set_item("dx_dp", columns(py, &s.dx_dp)?)?;
-        d.set_item("dlam_g_dp", columns(py, &s.dlambda_dp)?)?;
-        d.set_item("active_rows", s.active_rows.clone())?;
-        d.set_item("active_bounds", s.active_bounds.clone())?;
-        d.set_item("weakly_active", s.weakly_active.clone())?;
-        d.set_item("residual", s.residual)?;
-        Ok(d)
+        let compiled = self.compiled.as_ref().expect("compiled above");
+        sensitivity_dict(py, &self.pb, compiled, &mut self.sensitivity, solution)
     }
 
     /// The state pickle uses: the recorded builder calls with printed expressions.
@@ -686,6 +670,40 @@ impl PyProblem {
             self.pb.n_constraints()
         )
     }
+}
+
+/// The parametric sensitivities of `solution` (a solution of `pb` compiled as `compiled`,
+/// at its current parameter values) as the dict `Problem.sensitivity` documents; the
+/// derivatives are compiled into `cache` at the first call. Releases the GIL.
+pub fn sensitivity_dict<'py>(
+    py: Python<'py>,
+    pb: &nlp::Problem,
+    compiled: &Compiled,
+    cache: &mut Option<nlp::ParametricSensitivity>,
+    solution: &PySolution,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = compiled.parameter_values().to_vec();
+    if cache.is_none() {
+        let pb = SameThread(pb);
+        let ps = py.allow_threads(move || {
+            let pb = pb;
+            nlp::ParametricSensitivity::new(pb.0)
+        });
+        *cache = Some(ps.map_err(build_err)?);
+    }
+    let ps = cache.as_mut().expect("built above");
+    let sol = &solution.inner;
+    let s = py
+        .allow_threads(|| ps.compute(sol, &p))
+        .map_err(solve_err)?;
+    let d = PyDict::new(py);
+    d.set_item("dx_dp", columns(py, &s.dx_dp)?)?;
+    d.set_item("dlam_g_dp", columns(py, &s.dlambda_dp)?)?;
+    d.set_item("active_rows", s.active_rows.clone())?;
+    d.set_item("active_bounds", s.active_bounds.clone())?;
+    d.set_item("weakly_active", s.weakly_active.clone())?;
+    d.set_item("residual", s.residual)?;
+    Ok(d)
 }
 
 /// Columns `cols[j]` (each of one length) as a 2-D array with those columns.

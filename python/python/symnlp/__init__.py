@@ -2,21 +2,30 @@
 
 Expressions (``sym``, operators, ``sin``, ``jacobian`` ...), compiled ``Function``\\ s,
 the ``Problem`` builder with ``solve(solver="ipm" | "sqp", options={...})`` and
-``Solution``; ``symnlp.gap_crossing`` plans the quadruped gap crossing. Everything is a
+``Solution``; optimal control with ``Ocp`` (``transcribe`` → ``Transcription`` →
+``Trajectory``) and ``Mpc``; ``symnlp.gap_crossing`` plans the quadruped gap crossing. Everything is a
 thin wrapper over the Rust crates ``symx``, ``nlp`` and ``gap_crossing``; see
 docs/python.md.
 """
 from . import _symnlp
 from ._symnlp import (
     BuildError,
+    ButcherTableau,
     Constraint,
     Expr,
     Function,
+    Grid,
+    Method,
+    Mpc,
+    Ocp,
     OptionError,
     Problem,
+    Simulator,
     Solution,
     SolveError,
     SymnlpError,
+    Trajectory,
+    Transcription,
     acos,
     acosh,
     asin,
@@ -24,6 +33,7 @@ from ._symnlp import (
     atan,
     atan2,
     atanh,
+    bounded,
     ceil,
     cos,
     cosh,
