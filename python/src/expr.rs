@@ -399,6 +399,53 @@ impl PyExpr {
         PyExpr::scalar(self.m.sum())
     }
 
+    /// What pickling stores: the shape, each entry printed (column-major) and the names
+    /// of the symbols (each a distinct name that parses back).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Py<PyAny>, PickledExpr)> {
+        let me = slf.borrow();
+        let symbols = crate::solution::free_symbols(me.m.entries());
+        let mut names: Vec<String> = Vec::with_capacity(symbols.len());
+        for s in &symbols {
+            let name = s.name().unwrap_or_default();
+            if names.contains(&name) {
+                return Err(PyTypeError::new_err(format!(
+                    "cannot pickle this Expr: two different symbols are named '{name}' \
+                     (pickling finds symbols by name)"
+                )));
+            }
+            if !parses_back(&name) {
+                return Err(PyTypeError::new_err(format!(
+                    "cannot pickle this Expr: the symbol name '{name}' does not parse back \
+                     (use letters, digits, '_', '.', '^' and [indices])"
+                )));
+            }
+            names.push(name);
+        }
+        let entries = me.m.iter().map(|e| e.to_string()).collect();
+        let (r, c) = me.m.shape();
+        let f = slf.get_type().getattr("_from_pickle")?;
+        Ok((f.unbind(), (r, c, entries, names)))
+    }
+
+    /// What unpickling calls: the entries parsed against new symbols of the given names
+    /// (in this thread's graph).
+    #[staticmethod]
+    fn _from_pickle(
+        rows: usize,
+        cols: usize,
+        entries: Vec<String>,
+        names: Vec<String>,
+    ) -> PyResult<PyExpr> {
+        let symbols: Vec<Expr> = names.iter().map(|n| Expr::sym(n)).collect();
+        let es = entries
+            .iter()
+            .map(|t| symx::parse(t, &symbols).map_err(build_err))
+            .collect::<PyResult<Vec<Expr>>>()?;
+        Matrix::from_column_major(rows, cols, es)
+            .map(PyExpr::new)
+            .map_err(build_err)
+    }
+
     /// Reshapes to `(rows, cols)` in column-major order (CasADi's `reshape`).
     fn reshape(&self, rows: usize, cols: usize) -> PyResult<PyExpr> {
         if rows * cols != self.m.len() {
@@ -411,6 +458,34 @@ impl PyExpr {
             .map(PyExpr::new)
             .map_err(build_err)
     }
+}
+
+/// An `Expr` as pickling stores it: rows, columns, printed entries, symbol names.
+type PickledExpr = (usize, usize, Vec<String>, Vec<String>);
+
+/// Whether symx's parser reads `name` back as this one symbol name (symx::parse's rule:
+/// a letter or `_`, then letters, digits, `_`, `.`, `^` and bracketed indices).
+fn parses_back(name: &str) -> bool {
+    let b = name.as_bytes();
+    if !matches!(b.first(), Some(c) if c.is_ascii_alphabetic() || *c == b'_')
+        || matches!(name, "inf" | "NaN")
+    {
+        return false;
+    }
+    let mut i = 0;
+    while i < b.len() {
+        if b[i].is_ascii_alphanumeric() || matches!(b[i], b'_' | b'.' | b'^') {
+            i += 1;
+        } else if b[i] == b'[' {
+            match b[i..].iter().position(|&c| c == b']') {
+                Some(close) => i += close + 1,
+                None => return false,
+            }
+        } else {
+            return false;
+        }
+    }
+    true
 }
 
 fn pow_entry(a: Expr, b: Expr) -> Expr {

@@ -158,6 +158,16 @@ impl PyFunction {
         }
     }
 
+    /// A compiled function does not pickle (it holds no expressions to rebuild it from):
+    /// the error says what to do instead.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "cannot pickle Function '{}': pickle the expressions it is built from (an Expr \
+             or a Problem pickles) and build the Function again where it is used",
+            self.f.name()
+        )))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Function('{}', inputs {:?}, outputs {:?})",

@@ -44,7 +44,7 @@ fn array(py: Python<'_>, v: &[f64]) -> Py<PyAny> {
 }
 
 /// The symbols in `roots`' graphs, each once, in order of discovery.
-fn free_symbols(roots: &[Expr]) -> Vec<Expr> {
+pub fn free_symbols(roots: &[Expr]) -> Vec<Expr> {
     let mut seen = std::collections::HashSet::new();
     let mut stack: Vec<Expr> = roots.to_vec();
     let mut out = Vec::new();

@@ -101,3 +101,33 @@ def test_errors_are_exceptions_with_messages():
     with pytest.raises(TypeError):
         bool(x[0] >= 0)
     assert math.isfinite(f([1.0, 2.0]))
+
+
+def test_a_bare_expr_pickles_by_its_printed_form():
+    import pickle
+
+    pb = s.Problem()
+    x = pb.variable("x", 2)
+    e = s.vertcat(s.sin(x[0]) * x[1] ** 2, s.if_else(s.gt(x[0], 0), x[0], -x[1]))
+    pb.minimize((x[0] - 1) ** 2 + (x[1] - 2) ** 2)
+    sol = pb.solve()
+    e2 = pickle.loads(pickle.dumps(e))
+    assert e2.shape == e.shape and str(e2) == str(e)
+    # New symbols of the same names: a Solution finds them by name.
+    assert np.array_equal(sol.value(e2), sol.value(e))
+    m = s.Expr(np.arange(6.0).reshape(2, 3))
+    assert np.array_equal(pickle.loads(pickle.dumps(m)).to_numpy(), m.to_numpy())
+
+
+def test_what_cannot_pickle_says_why():
+    import pickle
+
+    twins = s.sym("x") + s.sym("x")  # two symbols, one name
+    with pytest.raises(TypeError, match="two different symbols are named 'x'"):
+        pickle.dumps(twins)
+    with pytest.raises(TypeError, match="'my var' does not parse back"):
+        pickle.dumps(s.sym("my var") * 2)
+    x = s.sym("x", 2)
+    f = s.Function("f", [x], [x * 2])
+    with pytest.raises(TypeError, match="cannot pickle Function 'f'"):
+        pickle.dumps(f)
