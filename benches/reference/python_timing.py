@@ -8,9 +8,13 @@ Prints three ratios, each from interleaved repetitions (medians), in one process
    hanging chain (the problem is compiled once before timing; every solve starts cold).
 2. Building the 1000-link hanging chain (variables, objective, 999 link constraints, end
    conditions) in symnlp vs casadi.Opti, same formulation, same process.
-3. Two threads each solving a chain at once vs the same two solves one after the other.
+3. Two threads each solving a chain at once vs the same two solves one after the other,
+   then the speed-up in words: met or not, and whether the load average at the time lets
+   it count (it needs two free cores: run it on an idle machine, e.g.
+   `.venv/bin/python benches/reference/python_timing.py --reps 9 --n 1000`).
 """
 import argparse
+import os
 import statistics
 import threading
 import time
@@ -87,8 +91,18 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=7)
     ap.add_argument("--n", type=int, default=200, help="chain masses for ratios 1 and 3")
+    ap.add_argument("--only", choices=["solve", "build", "threads"],
+                    help="measure one ratio only (threads: the two-thread speed-up)")
     a = ap.parse_args()
+    if a.only in (None, "solve"):
+        solve_ratio(a)
+    if a.only in (None, "build"):
+        build_ratios(a)
+    if a.only in (None, "threads"):
+        threads_ratio(a)
 
+
+def solve_ratio(a):
     # 1. Python vs Rust solve time.
     pb = chain_symnlp(a.n)
     pb.compile()
@@ -102,6 +116,8 @@ def main():
     print(f"1. solve, chain n={a.n}: Python wall {statistics.median(py_t)*1e3:.2f} ms, "
           f"Rust total {statistics.median(rs_t)*1e3:.2f} ms, ratio {r1:.3f}")
 
+
+def build_ratios(a):
     # 2. Build the 1000-link chain: symnlp vs CasADi, interleaved.
     sb, cb = [], []
     for _ in range(a.reps):
@@ -120,6 +136,8 @@ def main():
           f"{statistics.median(sv)*1e3:.1f} ms, casadi.Opti {statistics.median(cv)*1e3:.1f} ms, "
           f"ratio {r2v:.3f}")
 
+
+def threads_ratio(a):
     # 3. Two threads vs serial. Problems are bound to the thread that builds them, so
     # each thread builds and compiles its own, waits at a barrier, then solves; only the
     # solves are timed (from the barrier to the last join). Serial: two problems built
@@ -154,7 +172,22 @@ def main():
     r3 = statistics.median(par) / statistics.median(ser)
     print(f"3. two solves: serial {statistics.median(ser)*1e3:.1f} ms, two threads "
           f"{statistics.median(par)*1e3:.1f} ms, ratio {r3:.3f}")
+    two_threads_verdict(r3)
 
+
+def two_threads_verdict(ratio, target=0.6):
+    """States the two-thread result plainly, with the load it was measured under: the
+    ratio only means something with two cores free (an idle machine)."""
+    cores = os.cpu_count() or 1
+    load = os.getloadavg()[0]
+    met = "MET" if ratio <= target else "NOT MET"
+    print(f"   two-thread speed-up: {1 / ratio:.2f}x (time ratio {ratio:.3f}, target <= {target}: {met})")
+    print(f"   measured with load average {load:.1f} on {cores} cores", end="")
+    if load > max(cores - 2, 0) + 0.5:
+        print(": the machine is busy, so this does NOT show what the GIL release gives;"
+              " re-run on an idle machine")
+    else:
+        print(": the machine was idle enough for this to count")
 
 if __name__ == "__main__":
     main()
