@@ -184,6 +184,17 @@ pub fn numbers(obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     if let Ok(v) = obj.extract::<f64>() {
         return Ok(vec![v]);
     }
+    // Fast paths (no numpy call): a contiguous 1-D float64 array, a flat list or tuple.
+    if let Ok(a) = obj.downcast::<numpy::PyArray1<f64>>() {
+        if let Ok(r) = a.readonly().as_slice() {
+            return Ok(r.to_vec());
+        }
+    }
+    if obj.is_instance_of::<pyo3::types::PyList>() || obj.is_instance_of::<PyTuple>() {
+        if let Ok(v) = obj.extract::<Vec<f64>>() {
+            return Ok(v);
+        }
+    }
     let np = obj.py().import("numpy")?;
     let arr = np.call_method1("asarray", (obj, "float64"))?;
     let arr = arr.call_method1("ravel", ("F",))?;

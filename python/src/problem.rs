@@ -192,10 +192,15 @@ impl PyProblem {
             }
             Step::Minimize { f } => self.pb.minimize(*f),
             Step::Constraint { name, rows } => {
-                let c = nlp::Constraint::all(rows.iter().map(|&(e, l, u)| {
+                // Runs of rows with the same bounds as one part each (a vector relation
+                // is one run): one allocation per run, not per row.
+                let runs = rows.chunk_by(|a, b| (a.1, a.2) == (b.1, b.2));
+                let c = nlp::Constraint::all(runs.map(|run| {
+                    let (l, u) = (run[0].1, run[0].2);
+                    let entries: Vec<Expr> = run.iter().map(|r| r.0).collect();
                     nlp::bounded(
                         l.unwrap_or(f64::NEG_INFINITY),
-                        e,
+                        symx::Matrix::from_vec(entries),
                         u.unwrap_or(f64::INFINITY),
                     )
                 }));
