@@ -8,11 +8,6 @@ pub struct Filter {
 }
 
 impl Filter {
-    /// Empty filter.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
     /// Removes all entries (done whenever μ changes).
     pub fn reset(&mut self) {
         self.entries.clear();
@@ -48,7 +43,7 @@ mod tests {
 
     #[test]
     fn filter_dominance() {
-        let mut f = Filter::new();
+        let mut f = Filter::default();
         assert!(f.acceptable(1.0, 1.0));
         f.add(1.0, 1.0);
         assert!(!f.acceptable(1.0, 1.0));

@@ -12,6 +12,7 @@ use std::time::Instant;
 use super::*;
 
 /// A primal-dual direction.
+#[derive(Default)]
 pub(super) struct Direction {
     pub(super) dw: Vec<f64>,
     pub(super) dy: Vec<f64>,
@@ -20,12 +21,15 @@ pub(super) struct Direction {
 }
 
 impl Direction {
-    pub(super) fn new(nw: usize, m: usize) -> Direction {
-        Direction {
-            dw: vec![0.0; nw],
-            dy: vec![0.0; m],
-            dzl: vec![0.0; nw],
-            dzu: vec![0.0; nw],
+    /// Sized for `nw` primal and `m` dual entries, zeroed.
+    pub(super) fn prepare(&mut self, nw: usize, m: usize) {
+        for (v, len) in [
+            (&mut self.dw, nw),
+            (&mut self.dy, m),
+            (&mut self.dzl, nw),
+            (&mut self.dzu, nw),
+        ] {
+            crate::frontend::scaled::refill(v, len, 0.0);
         }
     }
 }

@@ -10,6 +10,7 @@
 use std::time::Instant;
 
 use super::*;
+use crate::frontend::scaled::refill;
 
 /// Lower bound of the lowered equality-row regularisation, relative to `eq_reg` (see
 /// `Core::step_eq_reg`).
@@ -61,6 +62,72 @@ const QUALITY_RETRIES: usize = 3;
 const QUALITY_MU_MAX: f64 = 1e-6;
 
 impl KktWork {
+    /// The KKT system analysed for `nlp`'s Hessian and Jacobian patterns, with empty
+    /// work vectors (see [`KktWork::prepare`]).
+    pub(super) fn new(nlp: &dyn IpmProblem) -> Result<KktWork, CoreError> {
+        let kkt = Kkt::new(
+            nlp.n(),
+            nlp.m(),
+            nlp.hess_l_sparsity(),
+            nlp.jac_g_sparsity(),
+        )?;
+        Ok(KktWork {
+            kkt,
+            kdx: Vec::new(),
+            kdc: Vec::new(),
+            rhs: Vec::new(),
+            rhs_s: Vec::new(),
+            rhs_copy: Vec::new(),
+            ds: Vec::new(),
+            shift: Vec::new(),
+            eq_reg: Vec::new(),
+            eq_reg_step: Vec::new(),
+            hess_diag: Vec::new(),
+            hzero: Vec::new(),
+            work_nw: Vec::new(),
+            lm: None,
+            reg_scale: 1.0,
+        })
+    }
+
+    /// The state of a fresh run: the factor forgotten, the refinement options set, every
+    /// work vector sized for `lay` and zeroed, the Hessian's diagonal positions found.
+    pub(super) fn prepare(&mut self, nlp: &dyn IpmProblem, opts: &IpmOptions, lay: &Layout) {
+        let (n, m, ni, nw) = (lay.n, lay.m, lay.ni, lay.nw);
+        let nnz_h = nlp.hess_l_sparsity().row_idx().len();
+        self.kkt.reset();
+        self.kkt.min_refinement_steps = opts.min_refinement_steps;
+        self.kkt.max_refinement_steps = opts.max_refinement_steps;
+        self.kkt.residual_ratio_max = opts.residual_ratio_max;
+        for (v, len) in [
+            (&mut self.kdx, n),
+            (&mut self.kdc, m),
+            (&mut self.rhs, n + m),
+            (&mut self.rhs_s, ni),
+            (&mut self.rhs_copy, n + m),
+            (&mut self.ds, ni),
+            // Refinement target: K without the static regularisation of equality rows.
+            (&mut self.shift, n + m),
+            (&mut self.eq_reg, m),
+            (&mut self.eq_reg_step, m),
+            (&mut self.hzero, nnz_h),
+            (&mut self.work_nw, nw),
+        ] {
+            refill(v, len, 0.0);
+        }
+        refill(&mut self.hess_diag, n, usize::MAX);
+        let hp = nlp.hess_l_sparsity();
+        for (j, d) in self.hess_diag.iter_mut().enumerate() {
+            for p in hp.col_range(j) {
+                if hp.row_idx()[p] == j {
+                    *d = p;
+                }
+            }
+        }
+        self.lm = crate::lbfgs::LimitedMemoryHessian::from_options(opts, n);
+        self.reg_scale = 1.0;
+    }
+
     /// Solves the factorised system for `rhs` in place (refined against K + diag(shift)).
     pub(super) fn solve_rhs(&mut self) -> Result<f64, crate::kkt::KktError> {
         match self.lm.as_mut() {
@@ -281,9 +348,9 @@ impl Core<'_> {
     /// unchanged when the estimate cannot be computed (IPOPT skips the update when its
     /// calculator fails; there is no size limit).
     pub(super) fn recalc_multipliers(&mut self) {
-        let y = self.it.y.clone();
+        self.y_saved.copy_from_slice(&self.it.y);
         if !self.least_squares_multipliers(f64::INFINITY) {
-            self.it.y = y;
+            self.it.y.copy_from_slice(&self.y_saved);
         }
     }
 
