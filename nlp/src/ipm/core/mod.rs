@@ -361,11 +361,11 @@ impl<'p> Core<'p> {
         }
         if self.opts.print_level >= 5 {
             if shared.stats.records.len() % 10 == 1 {
-                println!("{}", crate::log::header());
+                println!("{}", crate::log::Columns::Ipm.header());
             }
             println!(
                 "{}",
-                crate::log::format_record(shared.stats.records.last().unwrap_or(
+                crate::log::Columns::Ipm.format(shared.stats.records.last().unwrap_or(
                     &IterationRecord {
                         iter: 0,
                         restoration: false,
