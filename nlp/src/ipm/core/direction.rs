@@ -107,13 +107,13 @@ impl Core<'_> {
             }
             self.pert.delta_c = Perturbation::delta_cd(&self.opts, self.mu);
             let dw = self.pert.delta_w;
-            let ok = matches!(self.factor_kkt(shared, dw),
+            let ok = matches!(self.factor_kkt(shared, dw, self.pert.delta_c),
                 Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
             if !ok {
                 // Should not happen (δ_c does not change the inertia); fall back to
                 // the statically regularised system as it is.
                 self.pert.delta_c = 0.0;
-                if self.factor_kkt(shared, dw).is_err() {
+                if self.factor_kkt(shared, dw, self.pert.delta_c).is_err() {
                     return false;
                 }
             }
@@ -128,7 +128,7 @@ impl Core<'_> {
                 if dw > self.opts.max_hessian_perturbation {
                     return false;
                 }
-                match self.factor_kkt(shared, dw) {
+                match self.factor_kkt(shared, dw, self.pert.delta_c) {
                     Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
                     Ok(_) => continue,
                     Err(_) => continue,

@@ -9,6 +9,7 @@
 
 use std::time::Instant;
 
+use super::perturbation::Factored;
 use super::*;
 use crate::frontend::scaled::refill;
 
@@ -170,7 +171,7 @@ impl Core<'_> {
         let (n, m) = (self.lay.n, self.lay.m);
         self.count.quality_retries += 1;
         self.kw.reg_scale = QUALITY_REG_SCALE;
-        let fact = self.factor_kkt(shared, delta_w);
+        let fact = self.factor_kkt(shared, delta_w, self.pert.delta_c);
         self.kw.reg_scale = 1.0;
         if !matches!(fact, Ok(i) if i.positive == n && i.negative == m && i.zero == 0) {
             return None;
@@ -271,13 +272,28 @@ impl Core<'_> {
         self.kw.eq_reg_step = out;
     }
 
+    /// Factorises the KKT matrix with IPOPT's inertia correction (the perturbation
+    /// handler's Algorithm IC, `perturbation.rs`). Returns false if δ_w exceeded its
+    /// maximum.
+    pub(super) fn factorize_with_inertia_correction(&mut self, shared: &mut Shared) -> bool {
+        let (n, m) = (self.lay.n, self.lay.m);
+        self.update_eq_reg();
+        let (mut pert, opts) = (std::mem::take(&mut self.pert), self.opts.clone());
+        let ok = pert.correct_inertia(&opts, self.mu, m > 0, |delta_w, delta_c| {
+            Factored::of(&self.factor_kkt(shared, delta_w, delta_c), n, m)
+        });
+        self.pert = pert;
+        ok
+    }
+
     /// Assembles the KKT matrix for the current iterate with Hessian perturbation
-    /// `delta_w` and Jacobian perturbation `self.pert.delta_c` (the static regularisation
+    /// `delta_w` and Jacobian perturbation `delta_c` (the static regularisation
     /// `kkt_static_regularization` on equality rows when δ_c = 0) and factorises it.
     pub(super) fn factor_kkt(
         &mut self,
         shared: &mut Shared,
         delta_w: f64,
+        delta_c: f64,
     ) -> Result<crate::kkt::Inertia, crate::kkt::KktError> {
         let (n, m) = (self.lay.n, self.lay.m);
         // The static Hessian regularisation only keeps exact zero pivots away while
@@ -300,12 +316,11 @@ impl Core<'_> {
         self.step_eq_reg(delta_w);
         self.kw.shift[..n].fill(-x_reg);
         for i in 0..m {
-            self.kw.shift[n + i] =
-                if self.lay.slack_of_row[i] == usize::MAX && self.pert.delta_c == 0.0 {
-                    self.kw.eq_reg_step[i]
-                } else {
-                    0.0
-                };
+            self.kw.shift[n + i] = if self.lay.slack_of_row[i] == usize::MAX && delta_c == 0.0 {
+                self.kw.eq_reg_step[i]
+            } else {
+                0.0
+            };
         }
         for k in 0..self.lay.ni {
             let j = n + k;
@@ -324,13 +339,13 @@ impl Core<'_> {
             // unpivoted LDLᵀ needs (removed again by iterative refinement); inequality
             // rows already carry 1/(Σ_s + δ_w) > 0 from the eliminated slack, plus δ_c.
             self.kw.kdc[i] = if k == usize::MAX {
-                if self.pert.delta_c > 0.0 {
-                    self.pert.delta_c
+                if delta_c > 0.0 {
+                    delta_c
                 } else {
                     self.kw.eq_reg_step[i]
                 }
             } else {
-                self.pert.delta_c + 1.0 / self.kw.ds[k]
+                delta_c + 1.0 / self.kw.ds[k]
             };
         }
         let t = Instant::now();
