@@ -9,7 +9,10 @@
 
 use std::time::Instant;
 
-use super::*;
+use super::all_finite;
+use super::perturbation::Perturbation;
+use super::Core;
+use super::Shared;
 
 /// A primal-dual direction.
 #[derive(Default)]

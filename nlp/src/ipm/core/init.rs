@@ -7,7 +7,14 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::first_non_finite;
+use super::one_norm;
+use super::Core;
+use super::Start;
+use crate::ipm::barrier::tau;
+use crate::ipm::error::At;
+use crate::ipm::error::CoreError;
+use crate::ipm::filter::Acceptance;
 
 impl Core<'_> {
     // ------------------------------------------------------------------ initialisation
@@ -124,8 +131,7 @@ impl Core<'_> {
             }
         }
         let theta0 = one_norm(&self.it.c);
-        self.theta_max = self.opts.theta_max_fact * theta0.max(1.0);
-        self.theta_min = self.opts.theta_min_fact * theta0.max(1.0);
+        self.accept = Acceptance::new(&self.opts, theta0);
         Ok(())
     }
 

@@ -7,8 +7,13 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::all_finite;
+use super::first_non_finite;
+use super::inf_norm;
+use super::Core;
 use crate::frontend::scaled::refill;
+use crate::ipm::error::At;
+use crate::ipm::error::CoreError;
 
 /// A primal-dual point with the problem's values there.
 #[derive(Clone, Default)]

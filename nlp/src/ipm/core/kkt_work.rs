@@ -9,9 +9,16 @@
 
 use std::time::Instant;
 
+use super::inf_norm;
 use super::perturbation::Factored;
-use super::*;
+use super::Core;
+use super::Layout;
+use super::Shared;
 use crate::frontend::scaled::refill;
+use crate::ipm::error::CoreError;
+use crate::ipm::reduced::IpmProblem;
+use crate::kkt::Kkt;
+use crate::options::IpmOptions;
 
 /// Lower bound of the lowered equality-row regularisation, relative to `eq_reg` (see
 /// `Core::step_eq_reg`).

@@ -13,13 +13,12 @@ use std::time::Instant;
 use crate::callback::Observer;
 use crate::frontend::scaled::Scaling;
 use crate::frontend::{KktResiduals, Termination};
-use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, mu_floor_adaptive, probing_mu, tau};
-use crate::ipm::error::{At, CoreError};
-use crate::ipm::filter::Filter;
+use crate::ipm::barrier::{mu_floor, tau};
+use crate::ipm::error::CoreError;
+use crate::ipm::filter::{Acceptance, Filter};
 use crate::ipm::reduced::IpmProblem;
 use crate::ipm::restoration;
-use crate::kkt::Kkt;
-use crate::options::{IpmOptions, MuOracle, MuStrategy};
+use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::{IterationRecord, Stats, Status};
 
 mod buffers;
@@ -152,8 +151,8 @@ pub(crate) struct Core<'p> {
     mu: f64,
     tau: f64,
     filter: Filter,
-    theta_min: f64,
-    theta_max: f64,
+    /// The line search's acceptance rules (θ_min, θ_max set by `initialize`).
+    accept: Acceptance,
     free_mode: bool,
     kkt_refs: Vec<f64>,
     /// Scratch of the quality-function μ oracle (reused every free-mode iteration).
@@ -267,8 +266,7 @@ impl<'p> Core<'p> {
             mu: setup.mu_init,
             tau: tau(setup.mu_init, opts),
             filter,
-            theta_min: 0.0,
-            theta_max: 0.0,
+            accept: Acceptance::default(),
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
             kkt_refs,
             quality_pairs,
@@ -579,10 +577,7 @@ impl<'p> Core<'p> {
             if !std::mem::take(&mut self.count.filter_has_current) {
                 let theta = one_norm(&self.it.c);
                 let phi = self.barrier(&self.it.w, self.it.f, self.mu);
-                self.filter.add(
-                    (1.0 - self.opts.gamma_theta) * theta,
-                    phi - self.opts.gamma_phi * theta,
-                );
+                self.accept.augment(&mut self.filter, theta, phi);
             }
             match restoration::restore(self, shared) {
                 Ok(()) => {
@@ -668,7 +663,7 @@ impl<'p> Core<'p> {
 
     /// θ_max of the filter (the largest constraint violation accepted).
     pub(crate) fn theta_max(&self) -> f64 {
-        self.theta_max
+        self.accept.theta_max
     }
 
     /// The scaling of the problem (objective and rows), for the user's units.
