@@ -124,6 +124,7 @@ mod warm_into_example {
         let mut pb = Problem::new();
         let x = pb.variable("x", 2).unwrap();
         let p = pb.parameter("p", 1).unwrap();
+        pb.set_value(&p, &[0.0]).unwrap();
         pb.minimize((x[0] - p[0]).sq() + (x[1] - 2.0).sq());
         let mut nlp = pb.compile().unwrap();
         let ipm = Ipm::default();
