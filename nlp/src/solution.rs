@@ -203,6 +203,26 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// A solution of no problem (every vector empty, status `InternalError`): the value
+    /// a solver fills in place.
+    pub(crate) fn empty() -> Solution {
+        Solution {
+            status: Status::InternalError,
+            x: Vec::new(),
+            lambda: Vec::new(),
+            z_l: Vec::new(),
+            z_u: Vec::new(),
+            g: Vec::new(),
+            objective: 0.0,
+            constr_viol: 0.0,
+            dual_inf: 0.0,
+            compl: 0.0,
+            message: String::new(),
+            stats: Stats::default(),
+            parameters: Vec::new(),
+        }
+    }
+
     /// Checks that this solution can warm-start a problem with `n` variables and `m`
     /// constraints (lengths of x, λ, z_L, z_U).
     pub fn check_warm_start(&self, n: usize, m: usize) -> Result<(), crate::SolveError> {

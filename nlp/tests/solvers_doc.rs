@@ -113,3 +113,40 @@ fn solvers_md_example_is_the_one_tested_here() {
         );
     }
 }
+
+/// docs/solvers.md section 5: `solve_warm_into` in a loop (each line of the doc's block
+/// is checked to be here).
+mod warm_into_example {
+    #[test]
+    fn solvers_md_warm_into_example_runs() {
+        use nlp::{Ipm, Problem, Solution};
+
+        let mut pb = Problem::new();
+        let x = pb.variable("x", 2).unwrap();
+        let p = pb.parameter("p", 1).unwrap();
+        pb.set_value(&p, &[0.0]).unwrap();
+        pb.minimize((x[0] - p[0]).sq() + (x[1] - 2.0).sq());
+        let mut nlp = pb.compile().unwrap();
+        let ipm = Ipm::default();
+        let mut last: Solution = ipm.solve(&mut nlp).unwrap();
+        let mut next = last.clone(); // any solution: its vectors are reused
+        for step in 1..5 {
+            nlp.set_value("p", &[0.1 * step as f64]).unwrap();
+            ipm.solve_warm_into(&mut nlp, &last, &mut next).unwrap();
+            std::mem::swap(&mut last, &mut next); // `last` is this step's solution
+        }
+        assert!((last.x[0] - 0.4).abs() < 1e-6);
+        assert!(last.status.is_success() && next.status.is_success());
+    }
+
+    #[test]
+    fn solvers_md_warm_into_example_is_the_one_tested_here() {
+        let this = include_str!("solvers_doc.rs");
+        for line in super::doc_block("## 5. ") {
+            assert!(
+                this.contains(line),
+                "docs/solvers.md section 5 line not in the test: {line}"
+            );
+        }
+    }
+}

@@ -24,6 +24,13 @@ pub(crate) struct Scaling {
     pub rows: Vec<f64>,
 }
 
+impl Default for Scaling {
+    /// No rows, s_f = 1.
+    fn default() -> Self {
+        Scaling::unscaled(0)
+    }
+}
+
 impl Scaling {
     /// All factors 1, for `m` rows.
     pub fn unscaled(m: usize) -> Self {
@@ -33,12 +40,18 @@ impl Scaling {
         }
     }
 
-    /// The factors of the rows `keep` (in that order), with the same s_f.
-    pub fn restrict(&self, keep: &[usize]) -> Self {
-        Scaling {
-            obj: self.obj,
-            rows: keep.iter().map(|&i| self.rows[i]).collect(),
-        }
+    /// The factors of the rows `keep` (in that order), with the same s_f, into `out`
+    /// (keeping its vector's capacity).
+    pub fn restrict_into(&self, keep: &[usize], out: &mut Scaling) {
+        out.obj = self.obj;
+        out.rows.clear();
+        out.rows.extend(keep.iter().map(|&i| self.rows[i]));
+    }
+
+    /// `self` set to `other` (keeping its vector's capacity).
+    pub fn assign(&mut self, other: &Scaling) {
+        self.obj = other.obj;
+        self.rows.clone_from(&other.rows);
     }
 
     /// λ_i in the user's units from the multiplier `y` of scaled row i: y·s_g,i / s_f.
@@ -90,6 +103,29 @@ impl Scaling {
     }
 }
 
+/// Sets `v` to `len` copies of `value`, keeping its capacity (no allocation once `v`
+/// has grown to `len`).
+pub(crate) fn refill<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
+    v.clear();
+    v.resize(len, value);
+}
+
+/// The vectors of a [`ScaledNlp`], kept between solves.
+#[derive(Default)]
+pub(crate) struct ScaledBuffers {
+    rows: Vec<f64>,
+    lam: Vec<f64>,
+}
+
+/// Scratch of [`ScaledNlp::unscaled_gradient_norms_into`]; `rmax` holds its result.
+#[derive(Default)]
+pub(crate) struct NormScratch {
+    grad: Vec<f64>,
+    jv: Vec<f64>,
+    /// The unscaled max-norm of each row of the Jacobian over the kept columns.
+    pub rmax: Vec<f64>,
+}
+
 /// Evaluation counters and time spent in user callbacks.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct EvalCounters {
@@ -115,12 +151,29 @@ pub(crate) struct ScaledNlp<'a> {
 impl<'a> ScaledNlp<'a> {
     /// The unscaled problem (all factors 1).
     pub fn new(user: &'a mut dyn NumericNlp) -> Self {
+        Self::with_buffers(user, ScaledBuffers::default())
+    }
+
+    /// [`ScaledNlp::new`] in the vectors of `buffers` (kept from an earlier solve with
+    /// [`ScaledNlp::into_buffers`]; no allocation once they have grown to the sizes).
+    pub fn with_buffers(user: &'a mut dyn NumericNlp, buffers: ScaledBuffers) -> Self {
         let m = user.m();
+        let ScaledBuffers { mut rows, mut lam } = buffers;
+        refill(&mut rows, m, 1.0);
+        refill(&mut lam, m, 0.0);
         ScaledNlp {
             user,
-            scaling: Scaling::unscaled(m),
+            scaling: Scaling { obj: 1.0, rows },
             counters: EvalCounters::default(),
-            lam: vec![0.0; m],
+            lam,
+        }
+    }
+
+    /// The vectors, for [`ScaledNlp::with_buffers`] in a later solve.
+    pub fn into_buffers(self) -> ScaledBuffers {
+        ScaledBuffers {
+            rows: self.scaling.rows,
+            lam: self.lam,
         }
     }
 
@@ -208,16 +261,30 @@ impl<'a> ScaledNlp<'a> {
     /// columns (the Jacobian is not evaluated when there are no rows). A row with a
     /// non-finite entry reports NaN (the gradient-based rule then leaves it unscaled).
     pub fn unscaled_gradient_norms(&mut self, x: &[f64], cols: Option<&[bool]>) -> (f64, Vec<f64>) {
+        let mut scratch = NormScratch::default();
+        let gmax = self.unscaled_gradient_norms_into(x, cols, &mut scratch);
+        (gmax, scratch.rmax)
+    }
+
+    /// [`ScaledNlp::unscaled_gradient_norms`] in the vectors of `scratch` (no allocation
+    /// once they have grown to the problem's sizes): returns max |∇f|, the row norms are
+    /// left in `scratch.rmax`.
+    pub fn unscaled_gradient_norms_into(
+        &mut self,
+        x: &[f64],
+        cols: Option<&[bool]>,
+        scratch: &mut NormScratch,
+    ) -> f64 {
         let (n, m) = (self.user.n(), self.user.m());
         let keep = |j: usize| cols.is_none_or(|c| c[j]);
         let t = Instant::now();
-        let mut grad = vec![0.0; n];
-        self.user.eval_grad_f(x, &mut grad);
+        let NormScratch { grad, jv, rmax } = scratch;
+        refill(grad, n, 0.0);
+        self.user.eval_grad_f(x, grad);
         self.counters.grad_f += 1;
-        let jp = self.user.jac_g_sparsity().clone();
-        let mut jv = vec![0.0; jp.row_idx().len()];
+        refill(jv, self.user.jac_g_sparsity().row_idx().len(), 0.0);
         if m > 0 {
-            self.user.eval_jac_g(x, &mut jv);
+            self.user.eval_jac_g(x, jv);
             self.counters.jac_g += 1;
         }
         self.counters.seconds += t.elapsed().as_secs_f64();
@@ -225,7 +292,8 @@ impl<'a> ScaledNlp<'a> {
             .filter(|&j| keep(j))
             .map(|j| grad[j].abs())
             .fold(0.0, f64::max);
-        let mut rmax = vec![0.0f64; m];
+        refill(rmax, m, 0.0f64);
+        let jp = self.user.jac_g_sparsity();
         for c in (0..n).filter(|&c| keep(c)) {
             for p in jp.col_range(c) {
                 let (r, v) = (jp.row_idx()[p], jv[p].abs());
@@ -237,7 +305,7 @@ impl<'a> ScaledNlp<'a> {
                 };
             }
         }
-        (gmax, rmax)
+        gmax
     }
 
     /// Writes the evaluation counts, their time and s_f into `stats`.

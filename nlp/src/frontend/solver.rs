@@ -56,6 +56,21 @@ pub trait Solver: Send + Sync {
         self.solve_dyn(nlp, Some(previous), None)
     }
 
+    /// [`Solver::solve_warm`] with the result written into `out` (any solution, e.g. the
+    /// last step's in an MPC loop), reusing its vectors: the IPM's re-solve of a problem
+    /// with an unchanged structure then allocates nothing (see
+    /// [`Ipm::solve_warm_into`](crate::Ipm::solve_warm_into)). This default solves and
+    /// moves the result into `out`. On error `out` is left unspecified.
+    fn solve_warm_into(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        previous: &Solution,
+        out: &mut Solution,
+    ) -> Result<(), SolveError> {
+        *out = self.solve_dyn(nlp, Some(previous), None)?;
+        Ok(())
+    }
+
     /// [`Solver::solve`] with a per-iteration callback (see [`crate::callback`]):
     /// [`ControlFlow::Break`] ends the solve with
     /// [`Status::UserRequestedStop`](crate::Status::UserRequestedStop).

@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use super::scaled::ScaledNlp;
+use super::scaled::{refill, ScaledNlp};
 use super::validate::Validated;
 use crate::numeric::AffineCone;
 use crate::solution::{Solution, Stats, Status};
@@ -72,58 +72,77 @@ pub(crate) fn user_solution(
 ) -> Solution {
     let UserPoint {
         x,
-        mut lambda,
-        mut z_l,
-        mut z_u,
+        lambda,
+        z_l,
+        z_u,
     } = p;
-    let (n, m) = (x.len(), lambda.len());
-    let nlp = sc.user();
-    let parameters = nlp.parameter_values().to_vec();
-    let jp = nlp.jac_g_sparsity().clone();
-    let cp = nlp.cone_jac_sparsity().cloned();
+    let mut sol = Solution {
+        status,
+        x,
+        lambda,
+        z_l,
+        z_u,
+        g: Vec::new(),
+        objective: 0.0,
+        constr_viol: 0.0,
+        dual_inf: 0.0,
+        compl: 0.0,
+        message,
+        stats: Stats::default(),
+        parameters: Vec::new(),
+    };
+    user_solution_into(sc, b, &mut sol, cones, &mut FinalScratch::default());
+    sol
+}
+
+/// The vectors [`user_solution_into`] works in, kept between solves.
+#[derive(Default)]
+pub(crate) struct FinalScratch {
+    /// The gradient of the Lagrangian.
+    r: Vec<f64>,
+    /// The Jacobian's values.
+    jv: Vec<f64>,
+}
+
+/// [`user_solution`] in place: `sol.x`, `sol.lambda`, `sol.z_l` and `sol.z_u` hold the
+/// point (user numbering and units); its values, measures and parameters are written
+/// into `sol` (status, message and stats are left as they are). Allocates nothing once
+/// `sol`'s and `scratch`'s vectors have the problem's sizes and without cones.
+pub(crate) fn user_solution_into(
+    sc: &mut ScaledNlp<'_>,
+    b: &Validated,
+    sol: &mut Solution,
+    cones: Option<ConeDuals<'_>>,
+    scratch: &mut FinalScratch,
+) {
+    let (n, m) = (sol.x.len(), sol.lambda.len());
+    let FinalScratch { r, jv } = scratch;
+    sol.parameters.clear();
+    sol.parameters
+        .extend_from_slice(sc.user().parameter_values());
     let t = Instant::now();
     let u = sc.user_mut();
-    let objective = u.eval_f(&x);
-    let mut r = vec![0.0; n];
-    let mut g = vec![0.0; m];
-    let mut jv = vec![0.0; jp.row_idx().len()];
-    u.eval_grad_f(&x, &mut r);
-    u.eval_g(&x, &mut g);
-    u.eval_jac_g(&x, &mut jv);
-    let cone_row: Vec<bool> = match &cones {
-        Some(c) => c.cone_row.to_vec(),
-        None => vec![false; m],
-    };
+    sol.objective = u.eval_f(&sol.x);
+    refill(r, n, 0.0);
+    refill(&mut sol.g, m, 0.0);
+    refill(jv, u.jac_g_sparsity().row_idx().len(), 0.0);
+    u.eval_grad_f(&sol.x, r);
+    u.eval_g(&sol.x, &mut sol.g);
+    u.eval_jac_g(&sol.x, jv);
+    let is_cone_row = |i: usize| cones.as_ref().is_some_and(|c| c.cone_row[i]);
     // r = ∇f + Jᵀλ − J_coneᵀ z_cone
+    let jp = sc.user().jac_g_sparsity();
     for c in 0..n {
         for q in jp.col_range(c) {
             let i = jp.row_idx()[q];
-            if !cone_row[i] {
-                r[c] += jv[q] * lambda[i];
+            if !is_cone_row(i) {
+                r[c] += jv[q] * sol.lambda[i];
             }
         }
     }
     let mut constr_viol: f64 = 0.0;
-    if let (Some(cd), Some(cp)) = (&cones, &cp) {
-        let n_cone = cd.z_cone.len();
-        let mut entries = vec![0.0; n_cone];
-        let mut cv = vec![0.0; cp.row_idx().len()];
-        if n_cone > 0 {
-            let u = sc.user_mut();
-            u.eval_cone_entries(&x, &mut entries);
-            u.eval_cone_jac(&x, &mut cv);
-        }
-        for c in 0..n {
-            for q in cp.col_range(c) {
-                r[c] -= cv[q] * cd.z_cone[cp.row_idx()[q]];
-            }
-        }
-        for k in cd.cones {
-            let e = &entries[k.offset..k.offset + k.dim];
-            let nv = e[1..].iter().map(|v| v * v).sum::<f64>().sqrt();
-            constr_viol = constr_viol.max(nv - e[0]);
-            lambda[k.row] = cd.z_cone[k.offset];
-        }
+    if let Some(cd) = &cones {
+        constr_viol = cone_terms(sc, cd, &sol.x, r, &mut sol.lambda);
     }
     sc.counters.f += 1;
     sc.counters.grad_f += 1;
@@ -132,6 +151,7 @@ pub(crate) fn user_solution(
     sc.counters.seconds += t.elapsed().as_secs_f64();
     let mut dual_inf: f64 = 0.0;
     let mut compl: f64 = 0.0;
+    let (x, z_l, z_u) = (&sol.x, &mut sol.z_l, &mut sol.z_u);
     for j in 0..n {
         let (lo, hi) = (b.x_l[j], b.x_u[j]);
         if lo == hi {
@@ -149,7 +169,8 @@ pub(crate) fn user_solution(
         dual_inf = dual_inf.max((r[j] - z_l[j] + z_u[j]).abs());
         constr_viol = constr_viol.max(viol(x[j], lo, hi));
     }
-    for i in (0..m).filter(|&i| !cone_row[i]) {
+    let (g, lambda) = (&sol.g, &sol.lambda);
+    for i in (0..m).filter(|&i| !is_cone_row(i)) {
         let (lo, hi) = (b.g_l[i], b.g_u[i]);
         constr_viol = constr_viol.max(viol(g[i], lo, hi));
         if lo != hi {
@@ -161,21 +182,45 @@ pub(crate) fn user_solution(
             }
         }
     }
-    Solution {
-        status,
-        x,
-        lambda,
-        z_l,
-        z_u,
-        g,
-        objective,
-        constr_viol,
-        dual_inf,
-        compl,
-        message,
-        stats: Stats::default(),
-        parameters,
+    sol.constr_viol = constr_viol;
+    sol.dual_inf = dual_inf;
+    sol.compl = compl;
+}
+
+/// The cones' part of the measures: their multipliers' term subtracted from `r`, each
+/// cone's multiplier z_t reported as its smooth row's λ; returns the largest cone
+/// violation.
+fn cone_terms(
+    sc: &mut ScaledNlp<'_>,
+    cd: &ConeDuals<'_>,
+    x: &[f64],
+    r: &mut [f64],
+    lambda: &mut [f64],
+) -> f64 {
+    let mut constr_viol: f64 = 0.0;
+    let Some(cp) = sc.user().cone_jac_sparsity().cloned() else {
+        return constr_viol;
+    };
+    let n_cone = cd.z_cone.len();
+    let mut entries = vec![0.0; n_cone];
+    let mut cv = vec![0.0; cp.row_idx().len()];
+    if n_cone > 0 {
+        let u = sc.user_mut();
+        u.eval_cone_entries(x, &mut entries);
+        u.eval_cone_jac(x, &mut cv);
     }
+    for (c, rc) in r.iter_mut().enumerate() {
+        for q in cp.col_range(c) {
+            *rc -= cv[q] * cd.z_cone[cp.row_idx()[q]];
+        }
+    }
+    for k in cd.cones {
+        let e = &entries[k.offset..k.offset + k.dim];
+        let nv = e[1..].iter().map(|v| v * v).sum::<f64>().sqrt();
+        constr_viol = constr_viol.max(nv - e[0]);
+        lambda[k.row] = cd.z_cone[k.offset];
+    }
+    constr_viol
 }
 
 #[cfg(test)]

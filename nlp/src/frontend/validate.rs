@@ -6,6 +6,7 @@ use crate::numeric::NumericNlp;
 use crate::solution::Solution;
 
 /// Bounds and starting point of a problem that passed [`validate`].
+#[derive(Default)]
 pub(crate) struct Validated {
     pub x_l: Vec<f64>,
     pub x_u: Vec<f64>,
@@ -24,6 +25,18 @@ pub(crate) fn validate(
     nlp: &dyn NumericNlp,
     warm: Option<&Solution>,
 ) -> Result<Validated, SolveError> {
+    let mut v = Validated::default();
+    validate_into(nlp, warm, &mut v)?;
+    Ok(v)
+}
+
+/// [`validate`] into the vectors of `v` (resized; no allocation once they have grown to
+/// the problem's sizes). On error `v` holds no meaningful values.
+pub(crate) fn validate_into(
+    nlp: &dyn NumericNlp,
+    warm: Option<&Solution>,
+    v: &mut Validated,
+) -> Result<(), SolveError> {
     let n = nlp.n();
     let m = nlp.m();
     let jac = nlp.jac_g_sparsity();
@@ -55,13 +68,16 @@ pub(crate) fn validate(
             c.row
         )));
     }
-    let mut v = Validated {
-        x_l: vec![0.0; n],
-        x_u: vec![0.0; n],
-        g_l: vec![0.0; m],
-        g_u: vec![0.0; m],
-        x0: vec![0.0; n],
-    };
+    for (vec, len) in [
+        (&mut v.x_l, n),
+        (&mut v.x_u, n),
+        (&mut v.g_l, m),
+        (&mut v.g_u, m),
+        (&mut v.x0, n),
+    ] {
+        vec.clear();
+        vec.resize(len, 0.0);
+    }
     nlp.bounds(&mut v.x_l, &mut v.x_u, &mut v.g_l, &mut v.g_u);
     check_bounds("variable", &v.x_l, &v.x_u, &|i| nlp.variable_name(i))?;
     check_bounds("constraint", &v.g_l, &v.g_u, &|i| nlp.constraint_name(i))?;
@@ -79,7 +95,7 @@ pub(crate) fn validate(
             value: x,
         });
     }
-    Ok(v)
+    Ok(())
 }
 
 fn check_bounds(

@@ -14,7 +14,7 @@
 use faer::sparse::SymbolicSparseColMat;
 
 use crate::frontend::scaled::Scaling;
-use crate::ipm::core::{barrier_value, Core, Outcome, Setup, Shared, Start};
+use crate::ipm::core::{barrier_value, Buffers, Core, Outcome, Setup, Shared, Start};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::numeric::NumericNlp;
@@ -312,36 +312,40 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         outer: core.problem_mut(),
     };
     let mut resto = resto;
+    let unscaled = Scaling::unscaled(m);
     let setup = Setup {
         mu_init: mu,
         bound_relax_factor: 0.0,
         in_resto: true,
-        scaling: Scaling::unscaled(m),
+        scaling: &unscaled,
         mu_strategy: MuStrategy::Monotone,
     };
-    let outcome = {
+    let (outcome, w_o) = {
         let mut inner_opts = opts.clone();
         inner_opts.acceptable_iter = 0;
         inner_opts.start_with_resto = false;
-        let mut inner = match Core::new(&mut resto, &inner_opts, &setup, None) {
+        let mut inner = match Core::new(&mut resto, &inner_opts, &setup, Buffers::default()) {
             Ok(c) => c,
             Err(e) => return Err(core.outcome(Status::RestorationFailed, e.to_string(), false)),
         };
         inner.set_resto_start(resto_start);
-        inner.run(
+        let y0 = vec![0.0; m];
+        let outcome = inner.run(
             shared,
             Start::Exact {
-                w,
-                y: vec![0.0; m],
-                zl,
-                zu,
+                w: &w,
+                y: &y0,
+                zl: &zl,
+                zu: &zu,
             },
-        )
+        );
+        // Map the inner point back: x = w[..n], s = w[n+2m..].
+        let w_inner = &inner.iterate().w;
+        let mut w_o = w_inner[..n].to_vec();
+        w_o.extend_from_slice(&w_inner[n + 2 * m..]);
+        (outcome, w_o)
     };
     drop(resto);
-    // Map the inner point back: x = w[..n], s = w[n+2m..].
-    let mut w_o = outcome.w[..n].to_vec();
-    w_o.extend_from_slice(&outcome.w[n + 2 * m..]);
     continue_after(core, outcome, &w_o, opts.constr_viol_tol)
 }
 

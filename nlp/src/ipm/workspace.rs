@@ -1,39 +1,53 @@
-//! What an [`Ipm`](crate::Ipm) keeps between solves of problems with the same structure,
-//! as IPOPT's application object does: the KKT system with its pattern, AMD ordering and
-//! symbolic factorisation (`Kkt::new`, 13 % of a warm cart-pole MPC re-solve before it
-//! was kept).
+//! What an [`Ipm`](crate::Ipm) keeps between solves, as IPOPT's application object does:
+//! the validated bounds, the reduced problem's patterns and vectors, and the core's
+//! buffers with the KKT system (its pattern, AMD ordering and symbolic factorisation)
+//! for the reduced structure they were built for. With them a warm re-solve of a problem
+//! with the same structure allocates nothing (`tests/ipm_warm_alloc.rs`).
 //!
 //! The [`Solver`](crate::Solver) trait takes `&self` (drivers hold a `Box<dyn Solver>`
-//! and may share it between threads), so the workspace sits behind a mutex keyed on the
-//! structure: a solve takes it when the reduced problem's Hessian and Jacobian patterns
-//! are those it was analysed for, and puts it back at the end. A solve that finds it
-//! taken (another thread is solving with the same solver) or keyed on another structure
-//! builds its own, so results never depend on what was kept: the numeric state is reset
-//! and the iterates are bit-identical to a fresh solver's (`tests/ipm_warm_alloc.rs`).
+//! and may share it between threads), so the buffers sit behind a mutex: a solve takes
+//! them and puts them back at the end. A solve that finds them taken (another thread is
+//! solving with the same solver) starts from empty ones, and the core's buffers are used
+//! only for the structure they were built for, so results never depend on what was
+//! kept: every vector is refilled and the numeric state reset, and the iterates are
+//! bit-identical to a fresh solver's.
 
 use std::sync::Mutex;
 
 use faer::sparse::SymbolicSparseColMat;
 
-use crate::kkt::Kkt;
+use crate::frontend::user_solution::FinalScratch;
+use crate::frontend::validate::Validated;
+use crate::ipm::core::Buffers;
+use crate::ipm::reduced::{same_pattern, ReducedParts};
 
-/// The structure a KKT system was analysed for: the reduced problem's sizes and its
+/// The structure a core's buffers were built for: the reduced problem's sizes and its
 /// Hessian (lower triangle) and Jacobian patterns.
-struct Structure {
+pub(crate) struct Structure {
     n: usize,
     m: usize,
     hess: SymbolicSparseColMat<usize>,
     jac: SymbolicSparseColMat<usize>,
 }
 
-fn same_pattern(a: &SymbolicSparseColMat<usize>, b: &SymbolicSparseColMat<usize>) -> bool {
-    a.nrows() == b.nrows()
-        && a.ncols() == b.ncols()
-        && (0..a.ncols()).all(|j| a.row_idx()[a.col_range(j)] == b.row_idx()[b.col_range(j)])
-}
-
 impl Structure {
-    fn is(
+    /// The structure of these sizes and patterns (copied).
+    pub(crate) fn new(
+        n: usize,
+        m: usize,
+        hess: &SymbolicSparseColMat<usize>,
+        jac: &SymbolicSparseColMat<usize>,
+    ) -> Structure {
+        Structure {
+            n,
+            m,
+            hess: hess.clone(),
+            jac: jac.clone(),
+        }
+    }
+
+    /// True if the sizes and patterns are these.
+    pub(crate) fn is(
         &self,
         n: usize,
         m: usize,
@@ -44,60 +58,37 @@ impl Structure {
     }
 }
 
-struct Kept {
-    structure: Structure,
-    /// `None` while a solve has it.
-    kkt: Option<Kkt>,
+/// Everything one solve works in (see the module doc).
+#[derive(Default)]
+pub(crate) struct SolveBuffers {
+    pub(crate) validated: Validated,
+    pub(crate) reduced: ReducedParts,
+    /// The core's buffers and the structure they were built for.
+    pub(crate) core: Option<(Structure, Buffers)>,
+    /// The warm start's multipliers y, z_L, z_U in the reduced problem.
+    pub(crate) warm: [Vec<f64>; 3],
+    pub(crate) last: FinalScratch,
 }
 
-/// The kept workspace of one solver (empty when cloned).
+/// The kept buffers of one solver (empty when cloned).
 #[derive(Default)]
-pub(crate) struct Workspace(Mutex<Option<Kept>>);
+pub(crate) struct Workspace(Mutex<Option<Box<SolveBuffers>>>);
 
 impl Workspace {
-    /// The kept KKT system if it was analysed for this structure (and no other solve has
-    /// it), taken out until [`Workspace::keep`].
-    pub(crate) fn take(
-        &self,
-        n: usize,
-        m: usize,
-        hess: &SymbolicSparseColMat<usize>,
-        jac: &SymbolicSparseColMat<usize>,
-    ) -> Option<Kkt> {
-        let mut guard = self.0.try_lock().ok()?;
-        let kept = guard.as_mut()?;
-        if kept.structure.is(n, m, hess, jac) {
-            kept.kkt.take()
-        } else {
-            None
-        }
+    /// The kept buffers, taken out until [`Workspace::keep`] (empty ones if another
+    /// solve has them, or on the first solve).
+    pub(crate) fn take(&self) -> Box<SolveBuffers> {
+        self.0
+            .try_lock()
+            .ok()
+            .and_then(|mut g| g.take())
+            .unwrap_or_default()
     }
 
-    /// Keeps `kkt`, analysed for this structure, for the next solve (replacing what was
-    /// kept for another structure; a concurrent solve's is dropped).
-    pub(crate) fn keep(
-        &self,
-        kkt: Kkt,
-        hess: &SymbolicSparseColMat<usize>,
-        jac: &SymbolicSparseColMat<usize>,
-    ) {
-        let Ok(mut guard) = self.0.try_lock() else {
-            return;
-        };
-        let (n, m) = (kkt.n(), kkt.m());
-        match guard.as_mut() {
-            Some(kept) if kept.structure.is(n, m, hess, jac) => kept.kkt = Some(kkt),
-            _ => {
-                *guard = Some(Kept {
-                    structure: Structure {
-                        n,
-                        m,
-                        hess: hess.clone(),
-                        jac: jac.clone(),
-                    },
-                    kkt: Some(kkt),
-                })
-            }
+    /// Keeps `buffers` for the next solve (a concurrent solve's are dropped).
+    pub(crate) fn keep(&self, buffers: Box<SolveBuffers>) {
+        if let Ok(mut guard) = self.0.try_lock() {
+            *guard = Some(buffers);
         }
     }
 }

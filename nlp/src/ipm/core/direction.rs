@@ -9,9 +9,13 @@
 
 use std::time::Instant;
 
-use super::*;
+use super::all_finite;
+use super::perturbation::Perturbation;
+use super::Core;
+use super::Shared;
 
 /// A primal-dual direction.
+#[derive(Default)]
 pub(super) struct Direction {
     pub(super) dw: Vec<f64>,
     pub(super) dy: Vec<f64>,
@@ -20,12 +24,15 @@ pub(super) struct Direction {
 }
 
 impl Direction {
-    pub(super) fn new(nw: usize, m: usize) -> Direction {
-        Direction {
-            dw: vec![0.0; nw],
-            dy: vec![0.0; m],
-            dzl: vec![0.0; nw],
-            dzu: vec![0.0; nw],
+    /// Sized for `nw` primal and `m` dual entries, zeroed.
+    pub(super) fn prepare(&mut self, nw: usize, m: usize) {
+        for (v, len) in [
+            (&mut self.dw, nw),
+            (&mut self.dy, m),
+            (&mut self.dzl, nw),
+            (&mut self.dzu, nw),
+        ] {
+            crate::frontend::scaled::refill(v, len, 0.0);
         }
     }
 }
@@ -103,13 +110,13 @@ impl Core<'_> {
             }
             self.pert.delta_c = Perturbation::delta_cd(&self.opts, self.mu);
             let dw = self.pert.delta_w;
-            let ok = matches!(self.factor_kkt(shared, dw),
+            let ok = matches!(self.factor_kkt(shared, dw, self.pert.delta_c),
                 Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
             if !ok {
                 // Should not happen (δ_c does not change the inertia); fall back to
                 // the statically regularised system as it is.
                 self.pert.delta_c = 0.0;
-                if self.factor_kkt(shared, dw).is_err() {
+                if self.factor_kkt(shared, dw, self.pert.delta_c).is_err() {
                     return false;
                 }
             }
@@ -124,7 +131,7 @@ impl Core<'_> {
                 if dw > self.opts.max_hessian_perturbation {
                     return false;
                 }
-                match self.factor_kkt(shared, dw) {
+                match self.factor_kkt(shared, dw, self.pert.delta_c) {
                     Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
                     Ok(_) => continue,
                     Err(_) => continue,

@@ -7,7 +7,14 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::first_non_finite;
+use super::one_norm;
+use super::Core;
+use super::Start;
+use crate::ipm::barrier::tau;
+use crate::ipm::error::At;
+use crate::ipm::error::CoreError;
+use crate::ipm::filter::Acceptance;
 
 impl Core<'_> {
     // ------------------------------------------------------------------ initialisation
@@ -44,16 +51,22 @@ impl Core<'_> {
         }
     }
 
-    pub(super) fn initialize(&mut self, start: Start) -> Result<(), CoreError> {
-        let n = self.lay.n;
-        let mut x0 = vec![0.0; n];
+    pub(super) fn initialize(&mut self, start: Start<'_>) -> Result<(), CoreError> {
+        let mut x0 = std::mem::take(&mut self.x_start);
         self.nlp.initial_point(&mut x0);
+        let res = self.initialize_from(start, &x0);
+        self.x_start = x0;
+        res
+    }
+
+    fn initialize_from(&mut self, start: Start<'_>, x0: &[f64]) -> Result<(), CoreError> {
+        let n = self.lay.n;
         match start {
             Start::Exact { w, y, zl, zu } => {
-                self.it.w.copy_from_slice(&w);
-                self.it.y.copy_from_slice(&y);
-                self.it.zl.copy_from_slice(&zl);
-                self.it.zu.copy_from_slice(&zu);
+                self.it.w.copy_from_slice(w);
+                self.it.y.copy_from_slice(y);
+                self.it.zl.copy_from_slice(zl);
+                self.it.zu.copy_from_slice(zu);
                 self.eval_current()?;
             }
             Start::Cold | Start::Warm { .. } => {
@@ -86,7 +99,7 @@ impl Core<'_> {
                 match start {
                     Start::Warm { y, zl, zu } => {
                         let zmin = self.opts.warm_start_mult_bound_push;
-                        self.it.y.copy_from_slice(&y);
+                        self.it.y.copy_from_slice(y);
                         for j in 0..self.lay.nw {
                             let (a, b) = if j < n {
                                 (zl[j], zu[j])
@@ -118,8 +131,7 @@ impl Core<'_> {
             }
         }
         let theta0 = one_norm(&self.it.c);
-        self.theta_max = self.opts.theta_max_fact * theta0.max(1.0);
-        self.theta_min = self.opts.theta_min_fact * theta0.max(1.0);
+        self.accept = Acceptance::new(&self.opts, theta0);
         Ok(())
     }
 

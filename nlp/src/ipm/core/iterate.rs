@@ -7,10 +7,16 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::all_finite;
+use super::first_non_finite;
+use super::inf_norm;
+use super::Core;
+use crate::frontend::scaled::refill;
+use crate::ipm::error::At;
+use crate::ipm::error::CoreError;
 
 /// A primal-dual point with the problem's values there.
-#[derive(Clone)]
+#[derive(Clone, Default)]
 pub(crate) struct Iterate {
     /// w = [x; s].
     pub(crate) w: Vec<f64>,
@@ -30,6 +36,7 @@ pub(crate) struct Iterate {
 }
 
 /// The line search's trial point (bound multipliers are updated in place on acceptance).
+#[derive(Default)]
 pub(super) struct Trial {
     pub(super) w: Vec<f64>,
     pub(super) y: Vec<f64>,
@@ -39,6 +46,45 @@ pub(super) struct Trial {
     pub(super) c: Vec<f64>,
     pub(super) jac: Vec<f64>,
     pub(super) hess: Vec<f64>,
+}
+
+impl Iterate {
+    /// Sized for `n` variables, `m` rows, `nw` entries of w and the Jacobian's and
+    /// Hessian's nonzeros, zeroed.
+    pub(super) fn prepare(&mut self, n: usize, m: usize, nw: usize, nnz_j: usize, nnz_h: usize) {
+        for (v, len) in [
+            (&mut self.w, nw),
+            (&mut self.y, m),
+            (&mut self.zl, nw),
+            (&mut self.zu, nw),
+            (&mut self.grad, n),
+            (&mut self.g, m),
+            (&mut self.c, m),
+            (&mut self.jac, nnz_j),
+            (&mut self.hess, nnz_h),
+        ] {
+            refill(v, len, 0.0);
+        }
+        self.f = 0.0;
+    }
+}
+
+impl Trial {
+    /// As [`Iterate::prepare`].
+    pub(super) fn prepare(&mut self, n: usize, m: usize, nw: usize, nnz_j: usize, nnz_h: usize) {
+        for (v, len) in [
+            (&mut self.w, nw),
+            (&mut self.y, m),
+            (&mut self.grad, n),
+            (&mut self.g, m),
+            (&mut self.c, m),
+            (&mut self.jac, nnz_j),
+            (&mut self.hess, nnz_h),
+        ] {
+            refill(v, len, 0.0);
+        }
+        self.f = 0.0;
+    }
 }
 
 impl Core<'_> {

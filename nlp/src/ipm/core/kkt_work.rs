@@ -9,7 +9,16 @@
 
 use std::time::Instant;
 
-use super::*;
+use super::inf_norm;
+use super::perturbation::Factored;
+use super::Core;
+use super::Layout;
+use super::Shared;
+use crate::frontend::scaled::refill;
+use crate::ipm::error::CoreError;
+use crate::ipm::reduced::IpmProblem;
+use crate::kkt::Kkt;
+use crate::options::IpmOptions;
 
 /// Lower bound of the lowered equality-row regularisation, relative to `eq_reg` (see
 /// `Core::step_eq_reg`).
@@ -61,6 +70,72 @@ const QUALITY_RETRIES: usize = 3;
 const QUALITY_MU_MAX: f64 = 1e-6;
 
 impl KktWork {
+    /// The KKT system analysed for `nlp`'s Hessian and Jacobian patterns, with empty
+    /// work vectors (see [`KktWork::prepare`]).
+    pub(super) fn new(nlp: &dyn IpmProblem) -> Result<KktWork, CoreError> {
+        let kkt = Kkt::new(
+            nlp.n(),
+            nlp.m(),
+            nlp.hess_l_sparsity(),
+            nlp.jac_g_sparsity(),
+        )?;
+        Ok(KktWork {
+            kkt,
+            kdx: Vec::new(),
+            kdc: Vec::new(),
+            rhs: Vec::new(),
+            rhs_s: Vec::new(),
+            rhs_copy: Vec::new(),
+            ds: Vec::new(),
+            shift: Vec::new(),
+            eq_reg: Vec::new(),
+            eq_reg_step: Vec::new(),
+            hess_diag: Vec::new(),
+            hzero: Vec::new(),
+            work_nw: Vec::new(),
+            lm: None,
+            reg_scale: 1.0,
+        })
+    }
+
+    /// The state of a fresh run: the factor forgotten, the refinement options set, every
+    /// work vector sized for `lay` and zeroed, the Hessian's diagonal positions found.
+    pub(super) fn prepare(&mut self, nlp: &dyn IpmProblem, opts: &IpmOptions, lay: &Layout) {
+        let (n, m, ni, nw) = (lay.n, lay.m, lay.ni, lay.nw);
+        let nnz_h = nlp.hess_l_sparsity().row_idx().len();
+        self.kkt.reset();
+        self.kkt.min_refinement_steps = opts.min_refinement_steps;
+        self.kkt.max_refinement_steps = opts.max_refinement_steps;
+        self.kkt.residual_ratio_max = opts.residual_ratio_max;
+        for (v, len) in [
+            (&mut self.kdx, n),
+            (&mut self.kdc, m),
+            (&mut self.rhs, n + m),
+            (&mut self.rhs_s, ni),
+            (&mut self.rhs_copy, n + m),
+            (&mut self.ds, ni),
+            // Refinement target: K without the static regularisation of equality rows.
+            (&mut self.shift, n + m),
+            (&mut self.eq_reg, m),
+            (&mut self.eq_reg_step, m),
+            (&mut self.hzero, nnz_h),
+            (&mut self.work_nw, nw),
+        ] {
+            refill(v, len, 0.0);
+        }
+        refill(&mut self.hess_diag, n, usize::MAX);
+        let hp = nlp.hess_l_sparsity();
+        for (j, d) in self.hess_diag.iter_mut().enumerate() {
+            for p in hp.col_range(j) {
+                if hp.row_idx()[p] == j {
+                    *d = p;
+                }
+            }
+        }
+        self.lm = crate::lbfgs::LimitedMemoryHessian::from_options(opts, n);
+        self.reg_scale = 1.0;
+    }
+
     /// Solves the factorised system for `rhs` in place (refined against K + diag(shift)).
     pub(super) fn solve_rhs(&mut self) -> Result<f64, crate::kkt::KktError> {
         match self.lm.as_mut() {
@@ -103,7 +178,7 @@ impl Core<'_> {
         let (n, m) = (self.lay.n, self.lay.m);
         self.count.quality_retries += 1;
         self.kw.reg_scale = QUALITY_REG_SCALE;
-        let fact = self.factor_kkt(shared, delta_w);
+        let fact = self.factor_kkt(shared, delta_w, self.pert.delta_c);
         self.kw.reg_scale = 1.0;
         if !matches!(fact, Ok(i) if i.positive == n && i.negative == m && i.zero == 0) {
             return None;
@@ -204,13 +279,28 @@ impl Core<'_> {
         self.kw.eq_reg_step = out;
     }
 
+    /// Factorises the KKT matrix with IPOPT's inertia correction (the perturbation
+    /// handler's Algorithm IC, `perturbation.rs`). Returns false if δ_w exceeded its
+    /// maximum.
+    pub(super) fn factorize_with_inertia_correction(&mut self, shared: &mut Shared) -> bool {
+        let (n, m) = (self.lay.n, self.lay.m);
+        self.update_eq_reg();
+        let (mut pert, opts) = (std::mem::take(&mut self.pert), self.opts.clone());
+        let ok = pert.correct_inertia(&opts, self.mu, m > 0, |delta_w, delta_c| {
+            Factored::of(&self.factor_kkt(shared, delta_w, delta_c), n, m)
+        });
+        self.pert = pert;
+        ok
+    }
+
     /// Assembles the KKT matrix for the current iterate with Hessian perturbation
-    /// `delta_w` and Jacobian perturbation `self.pert.delta_c` (the static regularisation
+    /// `delta_w` and Jacobian perturbation `delta_c` (the static regularisation
     /// `kkt_static_regularization` on equality rows when δ_c = 0) and factorises it.
     pub(super) fn factor_kkt(
         &mut self,
         shared: &mut Shared,
         delta_w: f64,
+        delta_c: f64,
     ) -> Result<crate::kkt::Inertia, crate::kkt::KktError> {
         let (n, m) = (self.lay.n, self.lay.m);
         // The static Hessian regularisation only keeps exact zero pivots away while
@@ -233,12 +323,11 @@ impl Core<'_> {
         self.step_eq_reg(delta_w);
         self.kw.shift[..n].fill(-x_reg);
         for i in 0..m {
-            self.kw.shift[n + i] =
-                if self.lay.slack_of_row[i] == usize::MAX && self.pert.delta_c == 0.0 {
-                    self.kw.eq_reg_step[i]
-                } else {
-                    0.0
-                };
+            self.kw.shift[n + i] = if self.lay.slack_of_row[i] == usize::MAX && delta_c == 0.0 {
+                self.kw.eq_reg_step[i]
+            } else {
+                0.0
+            };
         }
         for k in 0..self.lay.ni {
             let j = n + k;
@@ -257,13 +346,13 @@ impl Core<'_> {
             // unpivoted LDLᵀ needs (removed again by iterative refinement); inequality
             // rows already carry 1/(Σ_s + δ_w) > 0 from the eliminated slack, plus δ_c.
             self.kw.kdc[i] = if k == usize::MAX {
-                if self.pert.delta_c > 0.0 {
-                    self.pert.delta_c
+                if delta_c > 0.0 {
+                    delta_c
                 } else {
                     self.kw.eq_reg_step[i]
                 }
             } else {
-                self.pert.delta_c + 1.0 / self.kw.ds[k]
+                delta_c + 1.0 / self.kw.ds[k]
             };
         }
         let t = Instant::now();
@@ -281,9 +370,9 @@ impl Core<'_> {
     /// unchanged when the estimate cannot be computed (IPOPT skips the update when its
     /// calculator fails; there is no size limit).
     pub(super) fn recalc_multipliers(&mut self) {
-        let y = self.it.y.clone();
+        self.y_saved.copy_from_slice(&self.it.y);
         if !self.least_squares_multipliers(f64::INFINITY) {
-            self.it.y = y;
+            self.it.y.copy_from_slice(&self.y_saved);
         }
     }
 

@@ -6,7 +6,9 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::one_norm;
+use super::Core;
+use super::Shared;
 
 /// How the step of an accepted trial point was made (the log's character after
 /// alpha_pr: lower case for the plain step, upper case for a second-order correction).
@@ -59,78 +61,6 @@ pub(super) enum LineSearch {
 impl Core<'_> {
     // ------------------------------------------------------------------ line search
 
-    /// IPOPT's acceptance test of a trial point (FilterLSAcceptor::CheckAcceptabilityOfTrialPoint):
-    /// θ_t ≤ θ_max, then, when θ ≤ θ_min and the switching condition holds, Armijo on φ_μ,
-    /// else sufficient reduction of θ or φ_μ against the current iterate; and the filter.
-    /// `alpha` is the step size used in the switching and Armijo conditions (for a
-    /// second-order correction, the step of the rejected trial point).
-    pub(super) fn is_acceptable(
-        &self,
-        alpha: f64,
-        theta: f64,
-        phi: f64,
-        gpd: f64,
-        theta_t: f64,
-        phi_t: f64,
-    ) -> bool {
-        let o = &self.opts;
-        if !(theta_t <= self.theta_max) || !phi_t.is_finite() {
-            return false;
-        }
-        let tol = 10.0 * f64::EPSILON * phi.abs();
-        let ok = if theta <= self.theta_min && self.switching(alpha, theta, gpd) {
-            phi_t - phi - o.eta_phi * alpha * gpd <= tol
-        } else {
-            theta_t <= (1.0 - o.gamma_theta) * theta || phi_t - (phi - o.gamma_phi * theta) <= tol
-        };
-        ok && self.filter.acceptable(theta_t, phi_t)
-    }
-
-    /// The switching condition α (−∇φ_μᵀd)^s_φ > δ θ^s_θ (with ∇φ_μᵀd < 0).
-    pub(super) fn switching(&self, alpha: f64, theta: f64, gpd: f64) -> bool {
-        let o = &self.opts;
-        gpd < 0.0 && alpha * (-gpd).powf(o.s_phi) > o.delta * theta.powf(o.s_theta)
-    }
-
-    /// Classifies an accepted step as IPOPT does (FilterLSAcceptor::UpdateForNextIteration,
-    /// Wächter & Biegler 2006, Algorithm A step A-8): an f-type step satisfies the switching
-    /// condition and the Armijo condition, whether or not θ ≤ θ_min; any other step
-    /// augments the filter with the current iterate. Returns true for an f-type step.
-    pub(super) fn update_filter_after_step(
-        &mut self,
-        alpha: f64,
-        theta: f64,
-        phi: f64,
-        gpd: f64,
-        phi_t: f64,
-    ) -> bool {
-        let o = &self.opts;
-        let tol = 10.0 * f64::EPSILON * phi.abs();
-        let ftype =
-            self.switching(alpha, theta, gpd) && phi_t - phi - o.eta_phi * alpha * gpd <= tol;
-        if !ftype {
-            self.filter.add(
-                (1.0 - self.opts.gamma_theta) * theta,
-                phi - self.opts.gamma_phi * theta,
-            );
-        }
-        ftype
-    }
-
-    pub(super) fn alpha_min(&self, theta: f64, gpd: f64) -> f64 {
-        let o = &self.opts;
-        let a = if gpd < 0.0 {
-            let mut a = o.gamma_theta.min(o.gamma_phi * theta / -gpd);
-            if theta <= self.theta_min {
-                a = a.min(o.delta * theta.powf(o.s_theta) / (-gpd).powf(o.s_phi));
-            }
-            a
-        } else {
-            o.gamma_theta
-        };
-        (o.alpha_min_frac * a).max(f64::EPSILON)
-    }
-
     /// Backtracking filter line search with second-order corrections. On success the
     /// trial point is accepted.
     pub(super) fn line_search(&mut self, shared: &mut Shared) -> LineSearch {
@@ -138,7 +68,7 @@ impl Core<'_> {
         let phi = self.barrier(&self.it.w, self.it.f, self.mu);
         let gpd = self.barrier_dir_deriv(&self.dir.dw);
         let alpha_max = self.max_step_primal(&self.dir.dw, self.tau);
-        let alpha_min = self.alpha_min(theta, gpd);
+        let alpha_min = self.accept.alpha_min(theta, gpd);
         let mut alpha = alpha_max;
         let mut ls = 0usize;
         loop {
@@ -157,12 +87,24 @@ impl Core<'_> {
             if finite {
                 let theta_t = one_norm(&self.trial.c);
                 let phi_t = self.barrier(&self.trial.w, self.trial.f, self.mu);
-                if self.is_acceptable(alpha, theta, phi, gpd, theta_t, phi_t) {
+                if self.accept.is_acceptable(
+                    &self.filter,
+                    alpha,
+                    (theta, phi),
+                    gpd,
+                    (theta_t, phi_t),
+                ) {
                     for i in 0..self.lay.m {
                         self.trial.y[i] = self.it.y[i] + alpha * self.dir.dy[i];
                     }
                     if self.eval_trial_derivs() {
-                        let ftype = self.update_filter_after_step(alpha, theta, phi, gpd, phi_t);
+                        let ftype = self.accept.after_step(
+                            &mut self.filter,
+                            alpha,
+                            (theta, phi),
+                            gpd,
+                            phi_t,
+                        );
                         let alpha_du = self.max_step_dual(&self.dir.dzl, &self.dir.dzu, self.tau);
                         self.take_dual_step(alpha_du, false);
                         self.accept_trial();
@@ -207,13 +149,24 @@ impl Core<'_> {
                         }
                         let th = one_norm(&self.trial.c);
                         let ph = self.barrier(&self.trial.w, self.trial.f, self.mu);
-                        if self.is_acceptable(alpha, theta, phi, gpd, th, ph) {
+                        if self.accept.is_acceptable(
+                            &self.filter,
+                            alpha,
+                            (theta, phi),
+                            gpd,
+                            (th, ph),
+                        ) {
                             for i in 0..self.lay.m {
                                 self.trial.y[i] = self.it.y[i] + a_soc * self.dir_soc.dy[i];
                             }
                             if self.eval_trial_derivs() {
-                                let ftype =
-                                    self.update_filter_after_step(alpha, theta, phi, gpd, ph);
+                                let ftype = self.accept.after_step(
+                                    &mut self.filter,
+                                    alpha,
+                                    (theta, phi),
+                                    gpd,
+                                    ph,
+                                );
                                 let alpha_du = self.max_step_dual(
                                     &self.dir_soc.dzl,
                                     &self.dir_soc.dzu,

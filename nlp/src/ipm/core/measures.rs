@@ -6,7 +6,10 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::barrier_value;
+use super::inf_norm;
+use super::one_norm;
+use super::Core;
 
 impl Core<'_> {
     // ------------------------------------------------------------------ error measures

@@ -13,15 +13,15 @@ use std::time::Instant;
 use crate::callback::Observer;
 use crate::frontend::scaled::Scaling;
 use crate::frontend::{KktResiduals, Termination};
-use crate::ipm::barrier::{loqo_mu, monotone_next, mu_floor, mu_floor_adaptive, probing_mu, tau};
-use crate::ipm::error::{At, CoreError};
-use crate::ipm::filter::Filter;
+use crate::ipm::barrier::{mu_floor, tau};
+use crate::ipm::error::CoreError;
+use crate::ipm::filter::{Acceptance, Filter};
 use crate::ipm::reduced::IpmProblem;
 use crate::ipm::restoration;
-use crate::kkt::Kkt;
-use crate::options::{IpmOptions, MuOracle, MuStrategy};
+use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::{IterationRecord, Stats, Status};
 
+mod buffers;
 mod direction;
 mod init;
 mod iterate;
@@ -32,6 +32,7 @@ mod mu;
 mod perturbation;
 mod soft_resto;
 
+pub(crate) use buffers::Buffers;
 use direction::Direction;
 pub(crate) use iterate::Iterate;
 use iterate::Trial;
@@ -49,71 +50,48 @@ pub(crate) struct Shared<'c> {
 }
 
 /// How to start the iteration.
-pub(crate) enum Start {
+#[derive(Clone, Copy)]
+pub(crate) enum Start<'a> {
     /// Push x0 into the bounds, least-squares y, bound multipliers = bound_mult_init_val.
     Cold,
     /// Warm start: x0 from the problem, given y and z (length n); warm-start pushes.
     Warm {
-        y: Vec<f64>,
-        zl: Vec<f64>,
-        zu: Vec<f64>,
+        y: &'a [f64],
+        zl: &'a [f64],
+        zu: &'a [f64],
     },
     /// Exact full iterate (restoration): w = [x; s], y, z for all of w.
     Exact {
-        w: Vec<f64>,
-        y: Vec<f64>,
-        zl: Vec<f64>,
-        zu: Vec<f64>,
+        w: &'a [f64],
+        y: &'a [f64],
+        zl: &'a [f64],
+        zu: &'a [f64],
     },
 }
 
 /// Parameters of one run of the core.
-pub(crate) struct Setup {
+pub(crate) struct Setup<'s> {
     pub mu_init: f64,
     pub bound_relax_factor: f64,
     pub in_resto: bool,
     /// The scaling of the problem's rows (for the user's units in the log and the
     /// termination tests).
-    pub scaling: Scaling,
+    pub scaling: &'s Scaling,
     pub mu_strategy: MuStrategy,
 }
 
-/// Result of a run.
+/// How a run ended; its final point is the core's iterate ([`Core::iterate`], or
+/// [`Buffers::iterate`] once the core is taken apart).
 pub(crate) struct Outcome {
     pub status: Status,
-    pub w: Vec<f64>,
-    pub y: Vec<f64>,
-    pub zl: Vec<f64>,
-    pub zu: Vec<f64>,
     pub message: String,
     /// For restoration: the inner problem converged (optimal) rather than being stopped
     /// by the acceptance hook.
     pub resto_converged: bool,
 }
 
-impl Outcome {
-    /// A solve that ends before iterating: at `w` with zero multipliers for `m` rows and
-    /// `w`'s entries.
-    pub(crate) fn at_start(
-        status: Status,
-        w: Vec<f64>,
-        m: usize,
-        message: impl Into<String>,
-    ) -> Outcome {
-        let nw = w.len();
-        Outcome {
-            status,
-            w,
-            y: vec![0.0; m],
-            zl: vec![0.0; nw],
-            zu: vec![0.0; nw],
-            message: message.into(),
-            resto_converged: false,
-        }
-    }
-}
 /// How the primal vector w = [x; s] is laid out and bounded: fixed for a run.
-#[derive(Clone)]
+#[derive(Clone, Default)]
 pub(crate) struct Layout {
     pub(crate) n: usize,
     pub(crate) m: usize,
@@ -173,12 +151,18 @@ pub(crate) struct Core<'p> {
     mu: f64,
     tau: f64,
     filter: Filter,
-    theta_min: f64,
-    theta_max: f64,
+    /// The line search's acceptance rules (θ_min, θ_max set by `initialize`).
+    accept: Acceptance,
     free_mode: bool,
     kkt_refs: Vec<f64>,
     /// Scratch of the quality-function μ oracle (reused every free-mode iteration).
     quality_pairs: crate::ipm::quality::Pairs,
+    /// Scratch: the problem's starting point (see `Core::initialize`).
+    x_start: Vec<f64>,
+    /// Scratch: the multipliers before a least-squares re-estimate (`recalc_y`).
+    y_saved: Vec<f64>,
+    /// Scratch of `Layout::fill`, returned with the buffers.
+    bounds: [Vec<f64>; 4],
     /// The convergence test's state (acceptable streak, previous objective).
     termination: Termination,
     setup_in_resto: bool,
@@ -241,147 +225,54 @@ pub(crate) fn barrier_value(
 }
 
 impl<'p> Core<'p> {
-    /// The iteration on `nlp`, with `kkt` (a KKT system analysed for `nlp`'s Hessian and
-    /// Jacobian patterns, kept from an earlier solve) or a new one.
+    /// The iteration on `nlp` in `buffers` (from [`Core::into_buffers`] of a run on a
+    /// problem with the same Hessian and Jacobian patterns, or the default).
     pub(crate) fn new(
         nlp: &'p mut dyn IpmProblem,
         opts: &IpmOptions,
-        setup: &Setup,
-        kkt: Option<Kkt>,
+        setup: &Setup<'_>,
+        mut buffers: Buffers,
     ) -> Result<Self, CoreError> {
-        let n = nlp.n();
-        let m = nlp.m();
-        let mut x_l = vec![0.0; n];
-        let mut x_u = vec![0.0; n];
-        let mut g_l = vec![0.0; m];
-        let mut g_u = vec![0.0; m];
-        nlp.bounds(&mut x_l, &mut x_u, &mut g_l, &mut g_u);
-        let mut slack_of_row = vec![usize::MAX; m];
-        let mut row_of_slack = Vec::new();
-        let mut g_eq = vec![0.0; m];
-        for i in 0..m {
-            if g_l[i] == g_u[i] {
-                g_eq[i] = g_l[i];
-            } else {
-                slack_of_row[i] = row_of_slack.len();
-                row_of_slack.push(i);
-            }
-        }
-        let ni = row_of_slack.len();
-        let nw = n + ni;
-        let mut wl = vec![f64::NEG_INFINITY; nw];
-        let mut wu = vec![f64::INFINITY; nw];
-        wl[..n].copy_from_slice(&x_l);
-        wu[..n].copy_from_slice(&x_u);
-        for (k, &i) in row_of_slack.iter().enumerate() {
-            wl[n + k] = g_l[i];
-            wu[n + k] = g_u[i];
-        }
-        let rf = setup.bound_relax_factor;
-        for j in 0..nw {
-            if wl[j].is_finite() {
-                wl[j] -= rf * wl[j].abs().max(1.0);
-            }
-            if wu[j].is_finite() {
-                wu[j] += rf * wu[j].abs().max(1.0);
-            }
-        }
-        let has_l: Vec<bool> = wl.iter().map(|v| v.is_finite()).collect();
-        let has_u: Vec<bool> = wu.iter().map(|v| v.is_finite()).collect();
-        let mut kkt = match kkt {
-            Some(mut kkt) => {
-                kkt.reset();
-                kkt
-            }
-            None => Kkt::new(n, m, nlp.hess_l_sparsity(), nlp.jac_g_sparsity())?,
-        };
-        let nnz_j = nlp.jac_g_sparsity().row_idx().len();
-        let nnz_h = nlp.hess_l_sparsity().row_idx().len();
-        kkt.min_refinement_steps = opts.min_refinement_steps;
-        kkt.max_refinement_steps = opts.max_refinement_steps;
-        kkt.residual_ratio_max = opts.residual_ratio_max;
-        // Refinement target: K without the static regularisation of equality rows.
-        let shift = vec![0.0; n + m];
-        let mut hess_diag = vec![usize::MAX; n];
-        {
-            let hp = nlp.hess_l_sparsity();
-            for (j, d) in hess_diag.iter_mut().enumerate() {
-                for p in hp.col_range(j) {
-                    if hp.row_idx()[p] == j {
-                        *d = p;
-                    }
-                }
-            }
-        }
-        let lay = Layout {
-            n,
-            m,
-            ni,
-            nw,
-            slack_of_row,
-            row_of_slack,
-            g_eq,
-            wl,
-            wu,
-            has_l,
-            has_u,
-        };
+        buffers.prepare(&*nlp, opts, setup.bound_relax_factor, setup.scaling)?;
+        let Buffers {
+            lay,
+            it,
+            trial,
+            dir,
+            dir_soc,
+            c_soc,
+            kw,
+            filter,
+            kkt_refs,
+            quality_pairs,
+            scaling,
+            x_start,
+            y_saved,
+            bounds,
+        } = buffers;
+        let m = lay.m;
         Ok(Core {
             nlp,
             opts: opts.clone(),
             lay,
-            it: Iterate {
-                w: vec![0.0; nw],
-                y: vec![0.0; m],
-                zl: vec![0.0; nw],
-                zu: vec![0.0; nw],
-                f: 0.0,
-                grad: vec![0.0; n],
-                g: vec![0.0; m],
-                c: vec![0.0; m],
-                jac: vec![0.0; nnz_j],
-                hess: vec![0.0; nnz_h],
-            },
-            trial: Trial {
-                w: vec![0.0; nw],
-                y: vec![0.0; m],
-                f: 0.0,
-                grad: vec![0.0; n],
-                g: vec![0.0; m],
-                c: vec![0.0; m],
-                jac: vec![0.0; nnz_j],
-                hess: vec![0.0; nnz_h],
-            },
-            dir: Direction::new(nw, m),
-            dir_soc: Direction::new(nw, m),
-            c_soc: vec![0.0; m],
-            kw: KktWork {
-                kkt,
-                kdx: vec![0.0; n],
-                kdc: vec![0.0; m],
-                rhs: vec![0.0; n + m],
-                rhs_s: vec![0.0; ni],
-                rhs_copy: vec![0.0; n + m],
-                ds: vec![0.0; ni],
-                shift,
-                eq_reg: vec![0.0; m],
-                eq_reg_step: vec![0.0; m],
-                hess_diag,
-                hzero: vec![0.0; nnz_h],
-                work_nw: vec![0.0; nw],
-                lm: crate::lbfgs::LimitedMemoryHessian::from_options(opts, n),
-                reg_scale: 1.0,
-            },
+            it,
+            trial,
+            dir,
+            dir_soc,
+            c_soc,
+            kw: kw.expect("Buffers::prepare builds the KKT work"),
             pert: Perturbation::default(),
             count: Counters::default(),
             mu: setup.mu_init,
             tau: tau(setup.mu_init, opts),
-            filter: Filter::new(),
-            theta_min: 0.0,
-            theta_max: 0.0,
+            filter,
+            accept: Acceptance::default(),
             free_mode: setup.mu_strategy == MuStrategy::Adaptive,
-            kkt_refs: Vec::new(),
-            quality_pairs: Default::default(),
+            kkt_refs,
+            quality_pairs,
+            x_start,
+            y_saved,
+            bounds,
             termination: Termination::default(),
             setup_in_resto: setup.in_resto,
             recalc_y: !setup.in_resto
@@ -389,10 +280,31 @@ impl<'p> Core<'p> {
                 && opts
                     .recalc_y
                     .unwrap_or(opts.hessian_approximation == crate::IpmHessian::LimitedMemory),
-            scaling: setup.scaling.clone(),
+            scaling,
             mu_strategy: setup.mu_strategy,
             resto_start: None,
         })
+    }
+
+    /// The vectors of this run (its final iterate among them), for a later run on a
+    /// problem with the same structure.
+    pub(crate) fn into_buffers(self) -> Buffers {
+        Buffers {
+            lay: self.lay,
+            it: self.it,
+            trial: self.trial,
+            dir: self.dir,
+            dir_soc: self.dir_soc,
+            c_soc: self.c_soc,
+            kw: Some(self.kw),
+            filter: self.filter,
+            kkt_refs: self.kkt_refs,
+            quality_pairs: self.quality_pairs,
+            scaling: self.scaling,
+            x_start: self.x_start,
+            y_saved: self.y_saved,
+            bounds: self.bounds,
+        }
     }
 
     // ------------------------------------------------------------------ records
@@ -447,11 +359,11 @@ impl<'p> Core<'p> {
         }
         if self.opts.print_level >= 5 {
             if shared.stats.records.len() % 10 == 1 {
-                println!("{}", crate::log::header());
+                println!("{}", crate::log::Columns::Ipm.header());
             }
             println!(
                 "{}",
-                crate::log::format_record(shared.stats.records.last().unwrap_or(
+                crate::log::Columns::Ipm.format(shared.stats.records.last().unwrap_or(
                     &IterationRecord {
                         iter: 0,
                         restoration: false,
@@ -481,10 +393,6 @@ impl<'p> Core<'p> {
     ) -> Outcome {
         Outcome {
             status,
-            w: self.it.w.clone(),
-            y: self.it.y.clone(),
-            zl: self.it.zl.clone(),
-            zu: self.it.zu.clone(),
             message: message.into(),
             resto_converged,
         }
@@ -542,7 +450,7 @@ impl<'p> Core<'p> {
         Ok(e0)
     }
 
-    pub(crate) fn run(&mut self, shared: &mut Shared, start: Start) -> Outcome {
+    pub(crate) fn run(&mut self, shared: &mut Shared, start: Start<'_>) -> Outcome {
         if let Err(e) = self.initialize(start) {
             return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
         }
@@ -669,10 +577,7 @@ impl<'p> Core<'p> {
             if !std::mem::take(&mut self.count.filter_has_current) {
                 let theta = one_norm(&self.it.c);
                 let phi = self.barrier(&self.it.w, self.it.f, self.mu);
-                self.filter.add(
-                    (1.0 - self.opts.gamma_theta) * theta,
-                    phi - self.opts.gamma_phi * theta,
-                );
+                self.accept.augment(&mut self.filter, theta, phi);
             }
             match restoration::restore(self, shared) {
                 Ok(()) => {
@@ -702,12 +607,6 @@ impl<'p> Core<'p> {
             return true;
         }
         false
-    }
-
-    /// The KKT system (its symbolic analysis), to keep for the next solve of a problem
-    /// with the same structure.
-    pub(crate) fn into_kkt(self) -> Kkt {
-        self.kw.kkt
     }
 
     // ------------------------------------------------------------------ for restoration
@@ -764,7 +663,7 @@ impl<'p> Core<'p> {
 
     /// θ_max of the filter (the largest constraint violation accepted).
     pub(crate) fn theta_max(&self) -> f64 {
-        self.theta_max
+        self.accept.theta_max
     }
 
     /// The scaling of the problem (objective and rows), for the user's units.

@@ -7,8 +7,16 @@
     clippy::too_many_arguments
 )]
 
-use super::*;
+use super::Core;
+use super::Shared;
+use crate::ipm::barrier::loqo_mu;
+use crate::ipm::barrier::monotone_next;
+use crate::ipm::barrier::mu_floor;
+use crate::ipm::barrier::mu_floor_adaptive;
+use crate::ipm::barrier::probing_mu;
+use crate::ipm::barrier::tau;
 use crate::ipm::quality;
+use crate::options::MuOracle;
 
 impl Core<'_> {
     // ------------------------------------------------------------------ barrier update

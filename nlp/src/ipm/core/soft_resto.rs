@@ -8,8 +8,11 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use super::line_search::LineSearch;
 use super::line_search::StepKind;
-use super::*;
+use super::one_norm;
+use super::Core;
+use super::Shared;
 
 /// An accepted soft restoration step.
 pub(super) struct SoftStep {
@@ -75,7 +78,9 @@ impl Core<'_> {
         let phi_t = self.barrier(&self.trial.w, self.trial.f, self.mu);
         // IPOPT tests with step size 0: the switching condition fails, so this is the
         // sufficient-reduction test and the filter.
-        let original = self.is_acceptable(0.0, theta, phi, 0.0, theta_t, phi_t);
+        let original =
+            self.accept
+                .is_acceptable(&self.filter, 0.0, (theta, phi), 0.0, (theta_t, phi_t));
         for i in 0..self.lay.m {
             self.trial.y[i] = self.it.y[i] + alpha * self.dir.dy[i];
         }
@@ -131,10 +136,7 @@ impl Core<'_> {
                 // IPOPT's PrepareRestoPhaseStart: the filter gets the current point.
                 let theta = one_norm(&self.it.c);
                 let phi = self.barrier(&self.it.w, self.it.f, self.mu);
-                self.filter.add(
-                    (1.0 - self.opts.gamma_theta) * theta,
-                    phi - self.opts.gamma_phi * theta,
-                );
+                self.accept.augment(&mut self.filter, theta, phi);
                 self.count.filter_has_current = true;
                 (ls, 0)
             }
