@@ -751,26 +751,14 @@ fn free_gait(
     } else {
         ("crawl", "biped-pair")
     };
-    // Three independent chains share the threads: the crossing search
-    // ([`crossing_search`]) from the better plan then the schedule search from its
-    // result; the schedule search from the other plan; the reference without (10).
-    // Their logs are recorded afterwards, in a fixed order, and the best plan is chosen
-    // in that order, so the outcome does not depend on the number of threads.
-    let (better_chain, (from_worse, reference)) = rayon::join(
-        || -> Result<_, PlanningError> {
-            let crossed = crossing_search::run(s, terrain, &candidate, &better)?;
-            let from = crossed.best_run().unwrap_or(&better);
-            let searched = search_from(s, terrain, &candidate, from, better_label)?;
-            Ok((crossed, searched))
-        },
-        || {
-            rayon::join(
-                || search_from(s, terrain, &candidate, &worse, worse_label),
-                || objective_without_10(s, terrain, &reference_start, &candidate),
-            )
-        },
-    );
-    let ((crossed, from_better), from_worse, reference) = (better_chain?, from_worse?, reference?);
+    let (crossed, from_better, from_worse, reference) = chains(
+        s,
+        terrain,
+        &candidate,
+        (&better, better_label),
+        (&worse, worse_label),
+        &reference_start,
+    )?;
     let better = crossed.record(better, settings, phases);
     let (crawl_run, pair_run, from_crawl, from_pair) = if pair_better {
         (worse, better, from_worse, from_better)
@@ -785,6 +773,47 @@ fn free_gait(
         }
     }
     Ok((best, reference))
+}
+
+/// The free gait's solves after the crawl and pair plans, not yet recorded: three
+/// independent chains sharing the threads: the crossing search ([`crossing_search`])
+/// from the better plan then the schedule search from its result; the schedule search
+/// from the other plan; the reference without (10) from `reference_start`. Their logs
+/// are recorded afterwards, in a fixed order, and the best plan is chosen in that
+/// order, so the outcome does not depend on the number of threads.
+#[allow(clippy::type_complexity)]
+fn chains(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    candidate: &Settings,
+    (better, better_label): (&Run, &str),
+    (worse, worse_label): (&Run, &str),
+    reference_start: &[f64],
+) -> Result<
+    (
+        crossing_search::Searched,
+        Vec<Solved>,
+        Vec<Solved>,
+        Option<f64>,
+    ),
+    PlanningError,
+> {
+    let (better_chain, (from_worse, reference)) = rayon::join(
+        || -> Result<_, PlanningError> {
+            let crossed = crossing_search::run(s, terrain, candidate, better)?;
+            let from = crossed.best_run().unwrap_or(better);
+            let searched = search_from(s, terrain, candidate, from, better_label)?;
+            Ok((crossed, searched))
+        },
+        || {
+            rayon::join(
+                || search_from(s, terrain, candidate, worse, worse_label),
+                || objective_without_10(s, terrain, reference_start, candidate),
+            )
+        },
+    );
+    let (crossed, from_better) = better_chain?;
+    Ok((crossed, from_better, from_worse?, reference?))
 }
 
 /// The better of the crawl and biped-pair runs (the crawl run on a tie or when both fail).
