@@ -15,7 +15,7 @@
 //! gap depth 0.5 ran 984 iterations on one before).
 use crate::check::GOAL_TOL;
 use crate::crossing::{self, Candidate};
-use crate::plan::{Plan, STANCE_LEN};
+use crate::plan::Plan;
 use crate::scenario::{dist2, Biped, Foot, Scenario};
 use crate::schedule_search::NULL_MOVE;
 use crate::solve::{
@@ -43,24 +43,22 @@ pub fn walking_horizon(plan: &Plan) -> usize {
     (last_move + 1 + TAIL_MARGIN).min(n)
 }
 
-/// A flat plan extended to `n` stances by repeating its last stance.
-pub fn extend(flat: &[f64], n: usize) -> Vec<f64> {
-    let mut out = flat.to_vec();
-    let last = flat[flat.len() - STANCE_LEN..].to_vec();
-    while out.len() < n * STANCE_LEN {
-        out.extend_from_slice(&last);
+/// A plan extended to `n` stances by repeating its last stance (unchanged when it has
+/// `n` or more, or none).
+pub fn extend(plan: &Plan, n: usize) -> Plan {
+    let mut out = plan.clone();
+    if let Some(&last) = plan.stances.last() {
+        out.stances.resize(n.max(plan.stances.len()), last);
     }
     out
 }
 
-/// Whether the final CoMs of a flat plan are within [`GOAL_TOL`] of their goals.
-fn reaches_goal(s: &Scenario, flat: &[f64]) -> bool {
-    Plan::from_flat(s, flat).is_ok_and(|p| {
-        p.stances.last().is_some_and(|last| {
-            Biped::ALL
-                .iter()
-                .all(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt() <= GOAL_TOL)
-        })
+/// Whether the final CoMs of a plan are within [`GOAL_TOL`] of their goals.
+fn reaches_goal(s: &Scenario, plan: &Plan) -> bool {
+    plan.stances.last().is_some_and(|last| {
+        Biped::ALL
+            .iter()
+            .all(|&j| dist2(last.com.get(j), s.goal.get(j)).sqrt() <= GOAL_TOL)
     })
 }
 
@@ -110,45 +108,92 @@ fn solve_candidate(
         &name,
         true,
     )?;
-    solved.run.flat = extend(&solved.run.flat, s.n_step);
+    solved.run.plan = extend(&solved.run.plan, s.n_step);
     solved.run.schedule = schedule.to_vec();
-    solved.run.solution.objective = Plan::from_flat(s, &solved.run.flat)?.cost(s);
+    solved.run.solution.objective = solved.run.plan.cost(s);
     Ok(solved)
 }
 
-/// The crossing search ([`crate::crossing`]) from a solved run: each round solves, in
-/// parallel, every candidate in which one foot crosses a keep-out zone one move earlier
-/// (on the walking horizon, module docs), and keeps the best that succeeds with a lower
-/// objective (and reaches the goal when `best` does), for up to [`CROSSING_ROUNDS`]
-/// rounds.
+/// The solves of a crossing search, not yet recorded ([`record`]), in the order they
+/// ran, and which of them is the best plan (`None`: none beat the start).
+pub(crate) struct Searched {
+    pub(crate) solved: Vec<Solved>,
+    pub(crate) best: Option<usize>,
+}
+
+impl Searched {
+    /// The best plan's run (`None`: the start stays the best).
+    pub(crate) fn best_run(&self) -> Option<&Run> {
+        self.best.map(|k| &self.solved[k].run)
+    }
+
+    /// Records every solve in order ([`record`]) and returns the best run: the
+    /// search's best, or `start` when none beat it.
+    pub(crate) fn record(self, start: Run, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
+        let mut best = start;
+        for (k, solved) in self.solved.into_iter().enumerate() {
+            let run = record(solved, settings, phases);
+            if Some(k) == self.best {
+                best = run;
+            }
+        }
+        best
+    }
+}
+
+/// The crossing search ([`crate::crossing`]) from a solved run, recorded: [`run`] then
+/// [`Searched::record`].
 pub(crate) fn search(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     settings: &Settings,
-    mut best: Run,
+    start: Run,
     phases: &mut Vec<Phase>,
 ) -> Result<Run, PlanningError> {
+    Ok(run(s, terrain, settings, &start)?.record(start, settings, phases))
+}
+
+/// The crossing search ([`crate::crossing`]) from a solved run, not yet recorded (so
+/// that it can run alongside other solves): each round solves, in parallel, every
+/// candidate in which one foot crosses a keep-out zone one move earlier (on the walking
+/// horizon, module docs), and keeps the best that succeeds with a lower objective (and
+/// reaches the goal when the plan it started from does), compared in a fixed order, for
+/// up to [`CROSSING_ROUNDS`] rounds.
+pub(crate) fn run(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    settings: &Settings,
+    start: &Run,
+) -> Result<Searched, PlanningError> {
     use rayon::prelude::*;
+    let mut out = Searched {
+        solved: Vec::new(),
+        best: None,
+    };
     for round in 1..=CROSSING_ROUNDS {
-        if !best.solution.status.is_success() {
+        let current = out.best_run().unwrap_or(start);
+        if !current.solution.status.is_success() {
             break;
         }
-        let plan = Plan::from_flat(s, &best.flat)?;
-        let candidates = crossing::earlier_crossings(s, terrain, &plan, &best.schedule);
+        let candidates = crossing::earlier_crossings(s, terrain, &current.plan, &current.schedule);
         if candidates.is_empty() {
             break;
         }
-        let horizon = walking_horizon(&plan);
+        let horizon = walking_horizon(&current.plan);
+        let schedule = &current.schedule;
         let solved: Vec<Result<Solved, PlanningError>> = candidates
             .par_iter()
-            .map(|c| solve_candidate(s, terrain, &best.schedule, c, settings, horizon, round))
+            .map(|c| solve_candidate(s, terrain, schedule, c, settings, horizon, round))
             .collect();
-        let needs_goal = reaches_goal(s, &best.flat);
+        let needs_goal = reaches_goal(s, &current.plan);
         let mut improved = false;
         for r in solved {
-            let next = record(r?, settings, phases);
-            if next.beats(&best) && (!needs_goal || reaches_goal(s, &next.flat)) {
-                best = next;
+            let next = r?;
+            let best = out.best_run().unwrap_or(start);
+            let wins = next.run.beats(best) && (!needs_goal || reaches_goal(s, &next.run.plan));
+            out.solved.push(next);
+            if wins {
+                out.best = Some(out.solved.len() - 1);
                 improved = true;
             }
         }
@@ -156,5 +201,5 @@ pub(crate) fn search(
             break;
         }
     }
-    Ok(best)
+    Ok(out)
 }

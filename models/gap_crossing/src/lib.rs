@@ -26,6 +26,7 @@
 //!   and the animated plan page (`plan.html`);
 //! - [`schedule_search`]: the free gait's search over foot schedules (shortest path over
 //!   foothold counts);
+//! - [`shard`]: a sweep split into shards run anywhere, and their results merged;
 //! - [`output`]: writing a run's files all or nothing;
 //! - [`limits`]: the largest `n_step` the memory allows, checked before building;
 //! - [`strict_json`]: JSON parsing that rejects duplicate keys.
@@ -46,6 +47,7 @@ pub mod render;
 pub mod replan;
 pub mod scenario;
 pub mod schedule_search;
+pub mod shard;
 pub mod solve;
 pub mod status;
 pub mod strict_json;

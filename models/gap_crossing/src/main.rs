@@ -15,6 +15,7 @@ use gap_crossing::output::{self, OutputError};
 use gap_crossing::plan::{PlanError, SolutionFile, SolverInfo};
 use gap_crossing::render;
 use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
+use gap_crossing::shard::{self, Shard, ShardError, ShardFile};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
 use gap_crossing::sweep::{self, Grid, GridError, PointResult};
 use std::path::{Path, PathBuf};
@@ -40,8 +41,9 @@ enum Command {
     Check(CheckArgs),
     /// Redraw the SVGs and plan.html of a solution file.
     Render(RenderArgs),
-    /// Solve a grid of scenarios in parallel and summarise.
-    Sweep(SweepArgs),
+    /// Solve a grid of scenarios in parallel and summarise (or one shard of it, `--shard
+    /// I/N`; `sweep merge DIR…` merges the shards).
+    Sweep(SweepCmd),
     /// Write an initial guess (not a solution) as a plan file, with its plan.svg.
     Guess(GuessArgs),
     /// Re-plan the rest of a plan from a measured stance (a perturbed CoM or foot): the
@@ -136,14 +138,44 @@ struct RenderArgs {
 }
 
 #[derive(Args, Debug)]
-struct SweepArgs {
-    /// Grid file (.toml or .json): an optional `base` scenario and `axes`, lists of values
-    /// for dotted scenario keys, e.g. `gap.min = [2.0, 2.25, 2.5]`.
-    #[arg(long, value_name = "FILE")]
-    grid: PathBuf,
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+struct SweepCmd {
+    #[command(subcommand)]
+    merge: Option<SweepSub>,
+    #[command(flatten)]
+    run: SweepArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum SweepSub {
+    /// Merge the results of every shard of a sweep (`sweep --shard I/N`) into the
+    /// summary of one run: sweep.csv, sweep.json and sweep.svg.
+    Merge(MergeArgs),
+}
+
+#[derive(Args, Debug)]
+struct MergeArgs {
+    /// Shard result files, or directories holding them (shard-I-of-N.json).
+    #[arg(required = true, value_name = "DIR")]
+    dirs: Vec<PathBuf>,
     /// Output directory; writes sweep.csv, sweep.json and sweep.svg.
     #[arg(long, value_name = "DIR", default_value = "out/sweep")]
     out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct SweepArgs {
+    /// Grid file (.toml or .json): an optional `base` scenario and `axes`, lists of values
+    /// for dotted scenario keys, e.g. `gap.min = [2.0, 2.25, 2.5]`.
+    #[arg(long, value_name = "FILE", required = true)]
+    grid: Option<PathBuf>,
+    /// Output directory; writes sweep.csv, sweep.json and sweep.svg (with `--shard`:
+    /// shard-I-of-N.json, for `sweep merge`).
+    #[arg(long, value_name = "DIR", default_value = "out/sweep")]
+    out: PathBuf,
+    /// Run only shard I of N (1-based): the points whose index k has k mod N = I − 1.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
@@ -213,6 +245,8 @@ enum CliError {
     Planning(#[from] PlanningError),
     #[error(transparent)]
     Grid(#[from] GridError),
+    #[error(transparent)]
+    Shard(#[from] ShardError),
     #[error("writing the output (nothing was changed): {0}")]
     Output(#[from] OutputError),
     #[error("cannot start {0} worker threads: {1}")]
@@ -462,7 +496,11 @@ fn foot_moves(p: &gap_crossing::plan::Plan) -> String {
 }
 
 fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
-    let grid = Grid::load(&a.grid)?;
+    let path = a
+        .grid
+        .as_ref()
+        .ok_or_else(|| CliError::Opt("sweep needs --grid FILE".into()))?;
+    let grid = Grid::load(path)?;
     // Points run in parallel: no iteration logs (`print_level` is ignored here).
     let mut settings = settings(&a.solver, 0)?;
     settings.set_print_level(0);
@@ -471,14 +509,20 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         .num_threads(threads)
         .build()
         .map_err(|e| CliError::Threads(threads, e.to_string()))?;
-    let n = grid.len();
+    let n = match a.shard {
+        Some(sh) => (0..grid.len()).filter(|&k| sh.holds(k)).count(),
+        None => grid.len(),
+    };
     let points_dir = a.out.join("points");
     if a.solutions {
         std::fs::create_dir_all(&points_dir).map_err(io(&points_dir))?;
     }
     let axes: Vec<&str> = grid.axes.iter().map(|ax| ax.key.as_str()).collect();
+    let of = a.shard.map_or(String::new(), |sh| {
+        format!(" of shard {}/{}", sh.index, sh.count)
+    });
     eprintln!(
-        "sweep: {n} points ({}) on {threads} threads",
+        "sweep: {n} points{of} ({}) on {threads} threads",
         if axes.is_empty() {
             "no axes: the base scenario".to_string()
         } else {
@@ -514,14 +558,62 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         }
         bar.inc(1);
     };
-    let results = pool.install(|| sweep::run(&grid, &settings, &done));
+    let results = pool.install(|| match a.shard {
+        Some(sh) => shard::run(&grid, sh, &settings, &done),
+        None => sweep::run(&grid, &settings, &done),
+    });
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
     for e in save_errors.into_inner().unwrap_or_default() {
         eprintln!("warning: {e}");
     }
 
-    let files = sweep::write_outputs(&a.out, &grid, &results, wall, threads)?;
+    let files = match a.shard {
+        Some(shard) => {
+            let file = ShardFile {
+                grid: grid.clone(),
+                shard,
+                results: results.clone(),
+                wall_seconds: wall,
+                threads,
+            };
+            vec![file.write(&a.out)?]
+        }
+        None => sweep::write_outputs(&a.out, &grid, &results, wall, threads)?,
+    };
+    Ok(report_sweep(&grid, &results, wall, threads, &files))
+}
+
+/// `sweep merge`: the shards' results as the summary of one run.
+fn sweep_merge(a: &MergeArgs) -> Result<ExitCode, CliError> {
+    let files = shard::find(&a.dirs)?;
+    let merged = shard::merge(shard::read(&files)?)?;
+    eprintln!("sweep merge: {} shard files", files.len());
+    let written = sweep::write_outputs(
+        &a.out,
+        &merged.grid,
+        &merged.results,
+        merged.wall_seconds,
+        merged.threads,
+    )?;
+    Ok(report_sweep(
+        &merged.grid,
+        &merged.results,
+        merged.wall_seconds,
+        merged.threads,
+        &written,
+    ))
+}
+
+/// Prints a sweep's table and summary; exit code 0 when every point was solved and
+/// checked, else 1.
+fn report_sweep(
+    grid: &Grid,
+    results: &[PointResult],
+    wall: f64,
+    threads: usize,
+    files: &[PathBuf],
+) -> ExitCode {
     let widths: Vec<usize> = grid.axes.iter().map(|ax| ax.key.len().max(6)).collect();
     let mut head = String::from("point");
     for (ax, w) in grid.axes.iter().zip(&widths) {
@@ -531,7 +623,7 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         "{head}  {:<22} {:>6} {:>13} {:>6} {:>8}",
         "status", "check", "objective", "iter", "time"
     );
-    for r in &results {
+    for r in results {
         let mut line = format!("{:>5}", r.index);
         for ((_, v), w) in r.overrides.iter().zip(&widths) {
             line += &format!("  {:>w$}", sweep::label(v));
@@ -561,7 +653,7 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         results.len(),
         wall
     );
-    let by_status: Vec<String> = sweep::counts(&results)
+    let by_status: Vec<String> = sweep::counts(results)
         .into_iter()
         .map(|(k, n)| format!("{k} {n}"))
         .collect();
@@ -574,11 +666,11 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    Ok(if ok == results.len() {
+    if ok == results.len() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
-    })
+    }
 }
 
 fn check_cmd(a: &CheckArgs) -> Result<ExitCode, CliError> {
@@ -715,7 +807,11 @@ fn main() -> ExitCode {
         Some(Command::Solve(a)) => solve_or_clear(a),
         Some(Command::Check(a)) => check_cmd(a),
         Some(Command::Render(a)) => render_cmd(a),
-        Some(Command::Sweep(a)) => sweep(a),
+        Some(Command::Sweep(SweepCmd {
+            merge: Some(SweepSub::Merge(a)),
+            ..
+        })) => sweep_merge(a),
+        Some(Command::Sweep(a)) => sweep(&a.run),
         Some(Command::Guess(a)) => guess_cmd(a),
         Some(Command::Replan(a)) => replan_cmd(a),
     };

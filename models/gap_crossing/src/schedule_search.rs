@@ -53,6 +53,7 @@ pub const MIN_RELATIVE_GAIN: f64 = 1e-5;
 pub struct StanceSolver {
     problem: Problem,
     compiled: Compiled,
+    settings: Settings,
     solver: Box<dyn Solver>,
 }
 
@@ -83,7 +84,14 @@ impl StanceSolver {
             problem,
             compiled,
             solver: settings.solver(),
+            settings,
         })
+    }
+
+    /// The settings its solves run with (the caller's, with the two exceptions of
+    /// [`StanceSolver::with_settings`]).
+    pub fn settings(&self) -> &Settings {
+        &self.settings
     }
 
     /// The CoMs and forces of least cost for `feet`, starting from `start`'s CoMs and

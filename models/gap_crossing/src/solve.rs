@@ -11,11 +11,19 @@
 //!      same heuristic with that order, on a second thread alongside 1;
 //!   3. the crossing search ([`crate::crossing`], [`CROSSING_ROUNDS`] rounds) from the
 //!      better of 1 and 2, which the crawl gait also runs after its solve; then
-//!   4. the schedule search ([`crate::schedule_search`]) from each of 1 and 2: the
-//!      cheapest schedule in a band of foothold counts around the current one (exact
-//!      per-stance evaluation), each round re-solved with every variable free from the
-//!      improved plan, until nothing improves or [`SEARCH_ROUNDS`] rounds have run; a
-//!      re-solve that stalls ([`STALL_ITERATIONS`]) counts as failed.
+//!   4. the schedule search ([`crate::schedule_search`]) from the crossing search's
+//!      result and from the other plan of 1 and 2: the cheapest schedule in a band of
+//!      foothold counts around the current one (exact per-stance evaluation), each
+//!      round re-solved with every variable free from the improved plan, until nothing
+//!      improves or [`SEARCH_ROUNDS`] rounds have run; a re-solve that stalls
+//!      ([`STALL_ITERATIONS`]) counts as failed.
+//!
+//!   Independent solves share the threads (rayon): 1 ‖ 2; then three chains, 3 → 4
+//!   from the better plan ‖ 4 from the other ‖ the reference without (10); the
+//!   candidates of a crossing-search round among themselves. Their records are logged
+//!   and the best plan chosen in a fixed order afterwards, so the outcome is
+//!   bit-identical whatever the number of threads. A plan is decoded from the solver's
+//!   vector once per solve (`Run` holds it).
 //!
 //!   Every model is built in a fresh symx arena ([`symx::with_fresh_arena`]), emptied
 //!   and freed after the solve: at n_step 1000 each build adds 1.8 million nodes, which
@@ -277,7 +285,8 @@ fn step_sq(x: &[f64], k: usize, i: Foot) -> f64 {
 /// A solved candidate of the plan.
 pub(crate) struct Run {
     pub(crate) solution: Solution,
-    pub(crate) flat: Vec<f64>,
+    /// The solution as a plan, decoded once when the solve ends.
+    pub(crate) plan: Plan,
     pub(crate) schedule: Vec<Foot>,
     /// Index of its [`Phase`].
     pub(crate) phase: usize,
@@ -344,6 +353,7 @@ fn solve_scheduled_here(
         }
     })?;
     let flat = model.problem.evaluate(&model.layout, &solution.x)?;
+    let plan = Plan::from_flat(s, &flat)?;
     let phase = Phase {
         name: name.to_string(),
         status: solution.status,
@@ -357,7 +367,7 @@ fn solve_scheduled_here(
         name: name.to_string(),
         run: Run {
             solution,
-            flat,
+            plan,
             schedule: schedule.to_vec(),
             phase: 0,
         },
@@ -552,7 +562,7 @@ fn finish(
     phases: Vec<Phase>,
     started: Instant,
 ) -> Result<Outcome, PlanningError> {
-    let plan = Plan::from_flat(s, &last.flat)?;
+    let plan = last.plan;
     let solver = SolverInfo {
         name: settings.options().solver().name().into(),
         status: String::new(),
@@ -723,43 +733,38 @@ fn free_gait(
     );
     let crawl_run = record(crawl_run?, settings, phases);
     let pair_run = record(pair_run?, settings, phases);
+    let pair_better = pair_run.beats(&crawl_run);
+    let (better, worse) = if pair_better {
+        (pair_run, crawl_run)
+    } else {
+        (crawl_run, pair_run)
+    };
+    if !better.solution.status.is_success() {
+        return Ok((better, None));
+    }
     // The reference without (10) starts from the better of the two plans as solved (a
     // crossing-search plan ends in exact copies of its last stance, from which the
     // reference stalled at n_step 300 and 1000).
-    let reference_start = if pair_run.beats(&crawl_run) {
-        pair_run.flat.clone()
+    let reference_start = better.plan.to_flat();
+    let (better_label, worse_label) = if pair_better {
+        ("biped-pair", "crawl")
     } else {
-        crawl_run.flat.clone()
+        ("crawl", "biped-pair")
     };
-    // The crossing search ([`crossing_search`]) from the better of the two plans; the
-    // schedule searches below start from its result.
-    let (crawl_run, pair_run) = if pair_run.beats(&crawl_run) {
-        let pair_run = crossing_search::search(s, terrain, &candidate, pair_run, phases)?;
-        (crawl_run, pair_run)
+    let (crossed, from_better, from_worse, reference) = chains(
+        s,
+        terrain,
+        &candidate,
+        (&better, better_label),
+        (&worse, worse_label),
+        &reference_start,
+    )?;
+    let better = crossed.record(better, settings, phases);
+    let (crawl_run, pair_run, from_crawl, from_pair) = if pair_better {
+        (worse, better, from_worse, from_better)
     } else {
-        let crawl_run = crossing_search::search(s, terrain, &candidate, crawl_run, phases)?;
-        (crawl_run, pair_run)
+        (better, worse, from_better, from_worse)
     };
-    let start = if pair_run.beats(&crawl_run) {
-        &pair_run
-    } else {
-        &crawl_run
-    };
-    if !start.solution.status.is_success() {
-        return Ok((pair_run_or(crawl_run, pair_run), None));
-    }
-    // The searches from both plans and the reference without (10) are independent:
-    // they share the threads; their logs are printed afterwards, in this order.
-    let (from_crawl, (from_pair, reference)) = rayon::join(
-        || search_from(s, terrain, &candidate, &crawl_run, "crawl"),
-        || {
-            rayon::join(
-                || search_from(s, terrain, &candidate, &pair_run, "biped-pair"),
-                || objective_without_10(s, terrain, &reference_start, &candidate),
-            )
-        },
-    );
-    let (from_crawl, from_pair, reference) = (from_crawl?, from_pair?, reference?);
     let mut best = pair_run_or(crawl_run, pair_run);
     for solved in from_crawl.into_iter().chain(from_pair) {
         let next = record(solved, settings, phases);
@@ -768,6 +773,47 @@ fn free_gait(
         }
     }
     Ok((best, reference))
+}
+
+/// The free gait's solves after the crawl and pair plans, not yet recorded: three
+/// independent chains sharing the threads: the crossing search ([`crossing_search`])
+/// from the better plan then the schedule search from its result; the schedule search
+/// from the other plan; the reference without (10) from `reference_start`. Their logs
+/// are recorded afterwards, in a fixed order, and the best plan is chosen in that
+/// order, so the outcome does not depend on the number of threads.
+#[allow(clippy::type_complexity)]
+fn chains(
+    s: &Scenario,
+    terrain: &(dyn Terrain + Sync),
+    candidate: &Settings,
+    (better, better_label): (&Run, &str),
+    (worse, worse_label): (&Run, &str),
+    reference_start: &[f64],
+) -> Result<
+    (
+        crossing_search::Searched,
+        Vec<Solved>,
+        Vec<Solved>,
+        Option<f64>,
+    ),
+    PlanningError,
+> {
+    let (better_chain, (from_worse, reference)) = rayon::join(
+        || -> Result<_, PlanningError> {
+            let crossed = crossing_search::run(s, terrain, candidate, better)?;
+            let from = crossed.best_run().unwrap_or(better);
+            let searched = search_from(s, terrain, candidate, from, better_label)?;
+            Ok((crossed, searched))
+        },
+        || {
+            rayon::join(
+                || search_from(s, terrain, candidate, worse, worse_label),
+                || objective_without_10(s, terrain, reference_start, candidate),
+            )
+        },
+    );
+    let (crossed, from_better) = better_chain?;
+    Ok((crossed, from_better, from_worse?, reference?))
 }
 
 /// The better of the crawl and biped-pair runs (the crawl run on a tie or when both fail).
@@ -796,12 +842,11 @@ fn search_from(
         return Ok(out);
     }
     let search_settings = candidate.warm();
-    let mut stance_solver = StanceSolver::with_settings(s, terrain, candidate)?;
+    let mut stance_solver = stance_solver(s, terrain, candidate)?;
     let mut best = from;
     for round in 1..=SEARCH_ROUNDS {
-        let current = Plan::from_flat(s, &best.flat)?;
         let Some(proposal) =
-            schedule_search::propose(s, &mut stance_solver, &current, &best.schedule)
+            schedule_search::propose(s, &mut stance_solver, &best.plan, &best.schedule)
         else {
             break;
         };
@@ -827,6 +872,16 @@ fn search_from(
         best = &out.last().expect("just pushed").run;
     }
     Ok(out)
+}
+
+/// The stance solver of the schedule search, from the settings of the free gait's
+/// candidates: the user's back end and options ([`StanceSolver::with_settings`]).
+fn stance_solver(
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    candidate: &Settings,
+) -> Result<StanceSolver, BuildError> {
+    StanceSolver::with_settings(s, terrain, candidate)
 }
 
 /// The reference objective of the problem without (10): every foot may move at every
@@ -909,6 +964,31 @@ mod tests {
             alpha_pr_char: 'h',
             ls: 15,
         }
+    }
+
+    /// The schedule search's stance solves take the user's back end and options
+    /// (issue 23 item 3): with `--solver sqp --opt tol=1e-9 --opt max_wall_time=7
+    /// --opt print_level=5`, the stance solver that [`search_from`] builds from the
+    /// free gait's candidate settings runs the SQP with that tolerance and wall-time
+    /// limit, at most [`schedule_search::STANCE_MAX_ITER`] iterations and print level 0.
+    #[test]
+    fn stance_solves_take_the_users_back_end_and_options() {
+        let s = Scenario::default();
+        let t = terrain::of(&s);
+        let mut user = Settings {
+            backend: Backend::Sqp,
+            ..Settings::default()
+        };
+        user.set_by_name(&["tol=1e-9", "max_wall_time=7", "print_level=5"])
+            .unwrap();
+        let solver = stance_solver(&s, &*t, &user.candidate()).unwrap();
+        let got = solver.settings();
+        assert_eq!(got.backend, Backend::Sqp);
+        assert_eq!(got.sqp.tol, 1e-9);
+        assert_eq!(got.sqp.max_wall_time, 7.0);
+        assert_eq!(got.sqp.print_level, 0);
+        assert!(got.sqp.max_iter <= schedule_search::STANCE_MAX_ITER);
+        assert_eq!(got.ipm.tol, IpmOptions::default().tol);
     }
 
     /// The guard trips on the `STALL_ITERATIONS`-th consecutive short step, not before;

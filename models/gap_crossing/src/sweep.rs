@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// One axis of a grid: a dotted scenario key and the values it takes, in order.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Axis {
     /// Dotted scenario key, e.g. `gap.min`.
     pub key: String,
@@ -451,8 +451,18 @@ pub fn run(
     settings: &Settings,
     done: &(dyn Fn(&PointResult, Option<&SolutionFile>) + Sync),
 ) -> Vec<PointResult> {
+    run_points(grid, &grid.points(), settings, done)
+}
+
+/// [`run`] on some of the grid's points (a shard, [`crate::shard`]), results in the
+/// order of `points`.
+pub fn run_points(
+    grid: &Grid,
+    points: &[Point],
+    settings: &Settings,
+    done: &(dyn Fn(&PointResult, Option<&SolutionFile>) + Sync),
+) -> Vec<PointResult> {
     use rayon::prelude::*;
-    let points = grid.points();
     let settings = {
         let mut s = settings.clone();
         s.ipm.print_level = 0;
