@@ -53,9 +53,7 @@ pub(super) struct Dopri<'a> {
     p: &'a [f64],
     /// Entries under error control (the original states).
     controlled: usize,
-    k: [Vec<f64>; 7],
-    stage: Vec<f64>,
-    work: Vec<f64>,
+    buf: DopriBuffers,
     h: f64,
     /// Whether `k[0]` holds `f(z)` at the current point (first same as last).
     fresh: bool,
@@ -63,21 +61,34 @@ pub(super) struct Dopri<'a> {
     stats: IntegratorStats,
 }
 
+/// The buffers of a DOPRI5 integration, kept between integrations of the same system so
+/// that a repeated integration allocates nothing.
+#[derive(Debug, Default)]
+pub(super) struct DopriBuffers {
+    k: [Vec<f64>; 7],
+    stage: Vec<f64>,
+    work: Vec<f64>,
+}
+
 impl<'a> Dopri<'a> {
+    /// A stepper for `rhs` (state length `nz`, the first `controlled` entries under error
+    /// control) using `buf`, resized as needed (no allocation when it already fits).
     pub(super) fn new(
         rhs: &'a Function,
         nz: usize,
         controlled: usize,
         p: &'a [f64],
         options: IntegratorOptions,
+        mut buf: DopriBuffers,
     ) -> Dopri<'a> {
+        buf.k.iter_mut().for_each(|k| k.resize(nz, 0.0));
+        buf.stage.resize(nz, 0.0);
+        buf.work.resize(rhs.work_size(), 0.0);
         Dopri {
             rhs,
             p,
             controlled,
-            k: std::array::from_fn(|_| vec![0.0; nz]),
-            stage: vec![0.0; nz],
-            work: vec![0.0; rhs.work_size()],
+            buf,
             h: options.initial_step.unwrap_or(0.0),
             fresh: false,
             options,
@@ -85,13 +96,18 @@ impl<'a> Dopri<'a> {
         }
     }
 
+    /// The buffers, for the next integration.
+    pub(super) fn into_buffers(self) -> DopriBuffers {
+        self.buf
+    }
+
     fn eval(&mut self, z_is_stage: bool, z: &[f64], into: usize) {
-        let input = if z_is_stage { &self.stage[..] } else { z };
-        let mut out = std::mem::take(&mut self.k[into]);
+        let input = if z_is_stage { &self.buf.stage[..] } else { z };
+        let mut out = std::mem::take(&mut self.buf.k[into]);
         self.rhs
-            .eval(&[input, self.p], &mut [&mut out], &mut self.work)
+            .eval(&[input, self.p], &mut [&mut out], &mut self.buf.work)
             .expect("sizes fixed at construction");
-        self.k[into] = out;
+        self.buf.k[into] = out;
         self.stats.rhs_evaluations += 1;
     }
 
@@ -102,23 +118,28 @@ impl<'a> Dopri<'a> {
     /// Hairer's starting step (Solving ODEs I, §II.4): from ‖z‖, ‖f(z)‖ and one Euler step.
     fn initial_step(&mut self, z: &[f64], span: f64) -> f64 {
         let n = self.controlled;
-        let w: Vec<f64> = z[..n].iter().map(|&v| self.weight(v, v)).collect();
+        let (atol, rtol) = (self.options.atol, self.options.rtol);
+        // Weighted by atol + rtol·|z| (`weight(z, z)`), without a buffer.
         let rms = |v: &mut dyn Iterator<Item = f64>| {
-            (v.zip(&w).map(|(a, b)| (a / b).powi(2)).sum::<f64>() / n.max(1) as f64).sqrt()
+            let sum = v
+                .zip(&z[..n])
+                .map(|(a, &zi)| (a / (atol + rtol * zi.abs())).powi(2))
+                .sum::<f64>();
+            (sum / n.max(1) as f64).sqrt()
         };
         let d0 = rms(&mut z.iter().copied());
-        let d1 = rms(&mut self.k[0].iter().copied());
+        let d1 = rms(&mut self.buf.k[0].iter().copied());
         let h0 = if d0 < 1e-5 || d1 < 1e-5 {
             1e-6
         } else {
             0.01 * d0 / d1
         };
         let h0 = h0.min(span);
-        for ((s, &zi), &ki) in self.stage.iter_mut().zip(z).zip(&self.k[0]) {
+        for ((s, &zi), &ki) in self.buf.stage.iter_mut().zip(z).zip(&self.buf.k[0]) {
             *s = zi + h0 * ki;
         }
         self.eval(true, z, 1);
-        let d2 = rms(&mut self.k[1].iter().zip(&self.k[0]).map(|(a, b)| a - b)) / h0;
+        let d2 = rms(&mut self.buf.k[1].iter().zip(&self.buf.k[0]).map(|(a, b)| a - b)) / h0;
         let h1 = if d1.max(d2) <= 1e-15 {
             (h0 * 1e-3).max(1e-6)
         } else {
@@ -154,23 +175,23 @@ impl Stepper for Dopri<'_> {
                 return Err(IntegratorError::StepTooSmall { t: *t, h });
             }
             for s in 1..7 {
-                for (i, (stage, &zi)) in self.stage.iter_mut().zip(z.iter()).enumerate() {
+                for (i, (stage, &zi)) in self.buf.stage.iter_mut().zip(z.iter()).enumerate() {
                     let mut acc = 0.0;
                     for (j, &a) in A[s][..s].iter().enumerate() {
-                        acc += a * self.k[j][i];
+                        acc += a * self.buf.k[j][i];
                     }
                     *stage = zi + h * acc;
                 }
                 self.eval(true, z, s);
             }
             // The 5th-order solution is the last stage's point (FSAL).
-            let znew = &self.stage;
+            let znew = &self.buf.stage;
             let mut sum = 0.0;
             let mut finite = true;
             for i in 0..self.controlled {
                 let mut e = 0.0;
                 for (s, &w) in E.iter().enumerate() {
-                    e += w * self.k[s][i];
+                    e += w * self.buf.k[s][i];
                 }
                 let r = h * e / self.weight(z[i], znew[i]);
                 finite &= r.is_finite();
@@ -180,8 +201,8 @@ impl Stepper for Dopri<'_> {
             let finite = finite && znew.iter().all(|v| v.is_finite());
             if finite && err <= 1.0 {
                 *t = if last { target } else { *t + h };
-                z.copy_from_slice(&self.stage);
-                self.k.swap(0, 6);
+                z.copy_from_slice(&self.buf.stage);
+                self.buf.k.swap(0, 6);
                 self.stats.accepted += 1;
             } else {
                 self.stats.rejected += 1;

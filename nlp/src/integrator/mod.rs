@@ -31,10 +31,10 @@ mod stepper;
 
 pub use options::{IntegratorError, IntegratorOptions, IntegratorStats, Method};
 
-use dopri::Dopri;
+use dopri::{Dopri, DopriBuffers};
 use level::Level;
 use sdirk::Sdirk;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 use stepper::Stepper;
 use symx::{Expr, Function, Matrix};
 
@@ -166,8 +166,10 @@ impl Integrator {
     /// and `p`, output `xf`), with its Jacobian and Hessian (the sensitivity equations of
     /// first and second order, built here once); third derivatives are refused with
     /// [`SymxError::NoDerivative`]. A failed integration makes the outputs NaN (the
-    /// solver calling it then rejects the point). Evaluation allocates its buffers per
-    /// call.
+    /// solver calling it then rejects the point). With [`Method::Dopri5`], evaluation
+    /// allocates nothing once warm: each evaluator keeps a pool of buffers, one set per
+    /// concurrent caller (results do not depend on which set is used); [`Method::Sdirk4`]
+    /// still allocates its LU factors per call.
     ///
     /// ```
     /// use nlp::integrator::{Integrator, IntegratorOptions};
@@ -202,18 +204,24 @@ impl Integrator {
         for k in (0..=ORDER).rev() {
             let int = int.clone();
             let picked = sel[k].clone();
-            let nz = int.levels[k].nz;
             let name = match k {
                 0 => "integrator".to_string(),
                 1 => "jac_integrator".to_string(),
                 _ => format!("jac{k}_integrator"),
             };
+            // Buffers kept between evaluations, one set per concurrent caller.
+            let pool: Mutex<Vec<Workspace>> = Mutex::new(Vec::new());
             let eval = move |args: &[f64], out: &mut [f64]| {
-                let mut z = vec![0.0; nz];
-                match int.run(k, &args[..nx], &args[nx..], &[int.tf], &mut z) {
-                    Ok(_) => out.iter_mut().zip(&picked).for_each(|(o, &i)| *o = z[i]),
+                let take = || pool.lock().unwrap_or_else(PoisonError::into_inner).pop();
+                let mut ws = take().unwrap_or_default();
+                match int.run_in(k, &args[..nx], &args[nx..], &[int.tf], &mut [], &mut ws) {
+                    Ok(_) => out
+                        .iter_mut()
+                        .zip(&picked)
+                        .for_each(|(o, &i)| *o = ws.state[i]),
                     Err(_) => out.fill(f64::NAN),
                 }
+                pool.lock().unwrap_or_else(PoisonError::into_inner).push(ws);
             };
             let out_name = if k == 0 { "xf" } else { "jac" };
             let f = Function::external(
@@ -292,18 +300,35 @@ impl Integrator {
         times: &[f64],
         out: &mut [f64],
     ) -> Result<IntegratorStats, IntegratorError> {
+        self.run_in(k, x0, p, times, out, &mut Workspace::default())
+    }
+
+    /// [`Integrator::run`] with the buffers of `ws` (reused: a DOPRI5 integration that
+    /// fits in them allocates nothing). The final state is left in `ws.state`.
+    fn run_in(
+        &self,
+        k: usize,
+        x0: &[f64],
+        p: &[f64],
+        times: &[f64],
+        out: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<IntegratorStats, IntegratorError> {
         let nz = self.levels[k].nz;
-        let mut z = vec![0.0; nz];
-        self.initial_state(k, x0, &mut z);
+        ws.state.resize(nz, 0.0);
+        self.initial_state(k, x0, &mut ws.state);
         match self.options.method {
             Method::Dopri5 => {
                 let rhs = &self.levels[k].rhs;
-                let dopri = Dopri::new(rhs, nz, self.nx, p, self.options);
-                self.drive(dopri, &mut z, times, out)
+                let buffers = std::mem::take(&mut ws.dopri);
+                let mut dopri = Dopri::new(rhs, nz, self.nx, p, self.options, buffers);
+                let result = self.drive(&mut dopri, &mut ws.state, times, out);
+                ws.dopri = dopri.into_buffers();
+                result
             }
             Method::Sdirk4 => {
-                let sdirk = Sdirk::new(&self.levels[..=k], self.nx, p, self.options);
-                self.drive(sdirk, &mut z, times, out)
+                let mut sdirk = Sdirk::new(&self.levels[..=k], self.nx, p, self.options);
+                self.drive(&mut sdirk, &mut ws.state, times, out)
             }
         }
     }
@@ -311,7 +336,7 @@ impl Integrator {
     /// Steps `z` from `t0` through `times`, copying a block of `out` at each.
     fn drive(
         &self,
-        mut stepper: impl Stepper,
+        stepper: &mut impl Stepper,
         z: &mut [f64],
         times: &[f64],
         out: &mut [f64],
@@ -383,4 +408,11 @@ fn check_options(t0: f64, tf: f64, options: &IntegratorOptions) -> Result<(), In
         check("initial_step", h, h > 0.0 && h.is_finite(), finite_positive)?;
     }
     Ok(())
+}
+
+/// The buffers of one integration: the state and the explicit stepper's stages.
+#[derive(Debug, Default)]
+struct Workspace {
+    state: Vec<f64>,
+    dopri: DopriBuffers,
 }
