@@ -165,7 +165,7 @@ impl Integrator {
     /// This integrator as an external symx function `F(x0, p) → xf` (inputs named `x0`
     /// and `p`, output `xf`), with its Jacobian and Hessian (the sensitivity equations of
     /// first and second order, built here once); third derivatives are refused with
-    /// [`SymxError::NoDerivative`]. A failed integration makes the outputs NaN (the
+    /// [`symx::SymxError::NoDerivative`]. A failed integration makes the outputs NaN (the
     /// solver calling it then rejects the point). With [`Method::Dopri5`], evaluation
     /// allocates nothing once warm: each evaluator keeps a pool of buffers, one set per
     /// concurrent caller (results do not depend on which set is used); [`Method::Sdirk4`]

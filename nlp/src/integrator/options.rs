@@ -77,7 +77,7 @@ pub enum IntegratorError {
     Symbolic(#[from] SymxError),
 }
 
-/// Tolerances and limits of [`Integrator`] (CasADi/CVODES names and meanings).
+/// Tolerances and limits of [`Integrator`](super::Integrator) (CasADi/CVODES names and meanings).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IntegratorOptions {
     /// Relative tolerance (default 1e-8).
