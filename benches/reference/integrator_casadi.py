@@ -32,6 +32,10 @@ def problems():
         "vdp1000": (x, mu, vdp, [2.0, 0.0], [1000.0], 1000.0),
         # stiff: Robertson, T = 40 (Hairer & Wanner's test set)
         "robertson": (y, k, rob, [1.0, 0.0, 0.0], [0.04, 1e4, 3e7], 40.0),
+        # stiff: Robertson to T = 4e10 (the long-time test of Hairer & Wanner's test set)
+        "robertson4e10": (y, k, rob, [1.0, 0.0, 0.0], [0.04, 1e4, 3e7], 4e10),
+        # stiff: Van der Pol, mu = 1000, T = 2000: more than one period ((3 - 2 ln 2) mu ~ 1614)
+        "vdp1000_2000": (x, mu, vdp, [2.0, 0.0], [1000.0], 2000.0),
     }
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# nlp::integrator (DOPRI5) against CasADi 3.8.2 / CVODES, same tolerances, run back to back
+# nlp::integrator (DOPRI5 and SDIRK4) against CasADi 3.8.2 / CVODES, same tolerances, run back to back
 # twice each (interleaved) on the same machine. Usage: bash benches/reference/integrator_compare.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."

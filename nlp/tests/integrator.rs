@@ -1,7 +1,7 @@
 //! nlp::integrator against closed forms and against CasADi 3.8.2 / CVODES reference values
 //! (`benches/reference/integrator_casadi.py`, output kept in
 //! `benches/reference/results/integrator_casadi.json`, CVODES at rtol 1e-12, atol 1e-14).
-use nlp::integrator::{Integrator, IntegratorError, IntegratorOptions};
+use nlp::integrator::{Integrator, IntegratorError, IntegratorOptions, Method};
 use symx::{gradient, hessian, Function, Matrix, SymxError};
 
 fn tight() -> IntegratorOptions {
@@ -132,9 +132,18 @@ fn results_are_bit_identical_across_runs() {
 
 #[test]
 fn integrator_function_derivatives_match_closed_forms() {
+    // Both methods; with SDIRK4 the second-order sensitivities use its exactly solved
+    // linear stages twice over.
+    for method in [Method::Dopri5, Method::Sdirk4] {
+        function_derivatives_match_closed_forms(method);
+    }
+}
+
+fn function_derivatives_match_closed_forms(method: Method) {
     // xf = x0·e^{−kT}: gradient and Hessian through the call node.
     let t = 1.5;
-    let f = Integrator::new(&decay(), 0.0, t, tight())
+    let options = IntegratorOptions { method, ..tight() };
+    let f = Integrator::new(&decay(), 0.0, t, options)
         .unwrap()
         .to_function()
         .unwrap();
