@@ -422,6 +422,11 @@ impl Problem {
             .count()
     }
 
+    /// Number of constraint rows as added, before rows become simple bounds.
+    pub(crate) fn n_raw_rows(&self) -> usize {
+        self.rows.len()
+    }
+
     /// All variables, in the order of `x`.
     pub fn variables(&self) -> &[Expr] {
         &self.variables
