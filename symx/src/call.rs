@@ -128,6 +128,17 @@ impl Function {
     /// assert!((out[1][0] - 3.0 * 0.6f64.cos()).abs() < 1e-15 && (out[1][1] - 0.6f64.sin()).abs() < 1e-15);
     /// ```
     pub fn apply(&self, args: &[&[Expr]]) -> Result<Vec<Vec<Expr>>, SymxError> {
+        self.check_args(args)?;
+        let flat: Vec<u32> = args.iter().flat_map(|a| a.iter().map(|e| e.id)).collect();
+        let outs = graph::with(|g| {
+            let f = g.function_arc(self);
+            g.call(&f, flat)
+        });
+        Ok(self.split_outputs(outs))
+    }
+
+    /// As many arguments as inputs, each of the input's length.
+    fn check_args(&self, args: &[&[Expr]]) -> Result<(), SymxError> {
         if args.len() != self.input_sizes.len() {
             return Err(SymxError::ArgumentCount {
                 what: "arguments",
@@ -145,17 +156,41 @@ impl Function {
                 });
             }
         }
+        Ok(())
+    }
+
+    /// The function's computation written out on `args` as expressions — the operations
+    /// of its tape, in order, with no call node (the calls it makes stay calls) — where
+    /// [`Function::apply`] adds one call node. Errors as [`Function::apply`], and for an
+    /// external function or a lookup table, which have no expressions
+    /// ([`SymxError::NoDerivative`], naming the function).
+    ///
+    /// ```
+    /// use symx::{Function, Matrix};
+    /// let x = Matrix::sym_vec("x", 2);
+    /// let f = Function::new(&[&x], &[&[x[0] * x[1].sin()]]).unwrap();
+    /// let z = Matrix::sym_vec("z", 2);
+    /// let y = f.inline(&[&[z[1], z[0]]]).unwrap()[0][0];
+    /// assert_eq!(y.to_string(), "(z[1]*sin(z[0]))");
+    /// ```
+    pub fn inline(&self, args: &[&[Expr]]) -> Result<Vec<Vec<Expr>>, SymxError> {
+        self.check_args(args)?;
+        if self.external.is_some() || self.lookup_table().is_some() {
+            return Err(SymxError::NoDerivative {
+                name: self.name.clone(),
+            });
+        }
         let flat: Vec<u32> = args.iter().flat_map(|a| a.iter().map(|e| e.id)).collect();
-        let outs = graph::with(|g| {
-            let f = g.function_arc(self);
-            g.call(&f, flat)
-        });
+        let outs = graph::with(|g| instantiate_on(g, self, flat));
+        Ok(self.split_outputs(outs))
+    }
+
+    fn split_outputs(&self, outs: Vec<u32>) -> Vec<Vec<Expr>> {
         let mut it = outs.into_iter().map(Expr::from_id);
-        Ok(self
-            .output_sizes
+        self.output_sizes
             .iter()
             .map(|&n| it.by_ref().take(n).collect())
-            .collect())
+            .collect()
     }
 }
 
@@ -173,9 +208,16 @@ fn input_symbols(g: &mut Graph, f: &Function) -> Vec<u32> {
 /// Rebuilds `f`'s computation in `g` on fresh symbols: the input symbols (stacked) and the
 /// output nodes (stacked).
 fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
+    let inputs = input_symbols(g, f);
+    let outputs = instantiate_on(g, f, inputs.clone());
+    (inputs, outputs)
+}
+
+/// Rebuilds `f`'s computation in `g` on the nodes `inputs` (stacked): the output nodes
+/// (stacked).
+fn instantiate_on(g: &mut Graph, f: &Function, inputs: Vec<u32>) -> Vec<u32> {
     const UNSET: u32 = u32::MAX;
     let mut reg = vec![UNSET; f.work_size];
-    let inputs = input_symbols(g, f);
     let mut p = 0;
     for (&n, &at) in f.input_sizes.iter().zip(&f.input_offsets) {
         reg[at..at + n].copy_from_slice(&inputs[p..p + n]);
@@ -212,14 +254,12 @@ fn instantiate(g: &mut Graph, f: &Function) -> (Vec<u32>, Vec<u32>) {
         };
         reg[ins.d as usize] = v;
     }
-    let outputs = f
-        .output_sizes
+    f.output_sizes
         .iter()
         .zip(&f.output_offsets)
         .flat_map(|(&n, &at)| at..at + n)
         .map(|r| reg[r])
-        .collect();
-    (inputs, outputs)
+        .collect()
 }
 
 /// The Jacobian function of `f` with respect to the input entries where `wrt` is true

@@ -37,6 +37,7 @@ mod map;
 mod matrix;
 mod native;
 mod op;
+mod serialize;
 mod simplify;
 pub mod sparsity;
 mod table;
@@ -54,6 +55,7 @@ pub use map::Map;
 pub use matrix::{Matrix, SparseMatrix};
 pub use native::{Evaluator, SourceOptions};
 pub use op::Op;
+pub use serialize::{FunctionFileError, FUNCTION_FILE_FORMAT, FUNCTION_FILE_VERSION};
 pub use sparsity::Sparsity;
 
 /// The guide `docs/dsl.md`, compiled and run as doc tests so that its examples stay true.

@@ -4,7 +4,9 @@
 ///
 /// `Const` and `Sym` are leaves; the others take one, two or three operands.
 /// Comparisons and logical operations return `1.0` for true and `0.0` for false.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 #[repr(u8)]
 pub enum Op {
     /// A numeric constant.

@@ -13,7 +13,7 @@
 pub(crate) type Fit1 = fn(&[f64], &[f64]) -> Vec<[f64; 4]>;
 
 /// A piecewise polynomial on the cells of a rectilinear grid.
-#[derive(Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Table {
     /// The grid points of each axis (strictly increasing, at least 2).
     grids: Vec<Vec<f64>>,
@@ -87,6 +87,32 @@ impl Table {
             coeffs,
             extrapolate,
         }
+    }
+
+    /// Why this table (read from a file) cannot be evaluated, if it cannot: 1 to 8 axes of
+    /// at least 2 finite, strictly increasing points, `4^d` coefficients per cell.
+    pub fn check(&self) -> Result<(), String> {
+        let d = self.dims();
+        if !(1..=8).contains(&d) {
+            return Err(format!("{d} axes (1 to 8 supported)"));
+        }
+        for (k, g) in self.grids.iter().enumerate() {
+            let increasing = g.windows(2).all(|w| w[0] < w[1]);
+            if g.len() < 2 || !increasing || g.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "axis {k} is not 2 or more finite, increasing points"
+                ));
+            }
+        }
+        let cells: usize = self.grids.iter().map(|g| g.len() - 1).product();
+        if self.coeffs.len() != cells << (2 * d) {
+            return Err(format!(
+                "{} coefficients for {cells} cells of {d} axes (expected {})",
+                self.coeffs.len(),
+                cells << (2 * d)
+            ));
+        }
+        Ok(())
     }
 
     /// Number of coordinates.

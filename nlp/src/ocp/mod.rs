@@ -13,9 +13,14 @@
 //! held once). Each transcription evaluates the dynamics through [`Dynamics::eval`].
 //! Multiple shooting can also compile one interval's integration as a function and call
 //! it once per interval ([`Method::multiple_shooting_with_calls`]).
+//!
+//! Several phases (a contact sequence) joined by linkage constraints are one
+//! [`MultiPhaseOcp`], written as one problem.
 mod butcher;
 mod collocation;
 mod grid;
+mod multi_phase;
+mod phase;
 mod shift;
 mod simulator;
 mod trajectory;
@@ -24,6 +29,7 @@ mod transcription;
 pub use butcher::ButcherTableau;
 pub use collocation::{Collocation, CollocationPoints};
 pub use grid::{ControlInterpolation, Grid};
+pub use multi_phase::{MultiPhaseOcp, MultiPhaseTranscription, PhaseId};
 pub use shift::Shift;
 pub use simulator::Simulator;
 pub use trajectory::{CollocationStates, Trajectory};

@@ -1,9 +1,10 @@
 //! Transcription of an [`Ocp`] into a [`Problem`]: direct multiple shooting, direct
 //! collocation, trapezoidal or Hermite–Simpson collocation on a uniform or user-given
 //! [`Grid`] of `N` intervals, with controls piecewise constant or linear between nodes.
+use super::phase::Phase;
 use super::{
-    ButcherTableau, Collocation, CollocationPoints, ControlInterpolation, Grid, Ocp, OcpError,
-    Trajectory,
+    ButcherTableau, Collocation, CollocationPoints, ControlInterpolation, Grid, Horizon, Ocp,
+    OcpError, Trajectory,
 };
 use crate::compiled::Compiled;
 use crate::constraint::{Constraint, Relation};
@@ -102,20 +103,7 @@ impl Method {
 /// parameters are the OCP's. [`Transcription::problem_mut`] allows adding anything else before compiling.
 pub struct Transcription {
     problem: Problem,
-    intervals: usize,
-    grid: Grid,
-    control_interpolation: ControlInterpolation,
-    states: Matrix,
-    controls: Matrix,
-    collocation_states: Option<Matrix>,
-    final_time: Expr,
-    tau: Vec<f64>,
-    state_names: Vec<String>,
-    control_names: Vec<String>,
-    initial_state_parameter: Option<String>,
-    /// The constraint groups written once per stage, in raw rows (before simple-bound
-    /// detection), for [`Transcription::shift_plan`].
-    staged_rows: Vec<StagedRows>,
+    phase: Phase,
 }
 
 /// A constraint group written once per stage: `stages` consecutive runs of `per_stage`
@@ -129,14 +117,25 @@ pub(crate) struct StagedRows {
 }
 
 /// Counts the raw rows added to the problem and records the per-stage groups.
-#[derive(Default)]
-struct RowLog {
+struct RowLog<'a> {
     count: usize,
     staged: Vec<StagedRows>,
+    /// Prefix of the group names (the phase's, empty for one phase).
+    prefix: &'a str,
 }
 
-impl RowLog {
-    /// Adds `c` as the group `name`; `stages`: the number of stages it repeats over.
+impl<'a> RowLog<'a> {
+    /// A log of a problem that already has `count` raw rows, naming groups with `prefix`.
+    fn starting_at(count: usize, prefix: &'a str) -> Self {
+        RowLog {
+            count,
+            staged: Vec::new(),
+            prefix,
+        }
+    }
+
+    /// Adds `c` as the group `name` (after the prefix); `stages`: the number of stages it
+    /// repeats over.
     fn add(
         &mut self,
         pb: &mut Problem,
@@ -145,6 +144,7 @@ impl RowLog {
         stages: Option<usize>,
     ) -> Result<(), OcpError> {
         let len = c.len();
+        let name = &format!("{}{name}", self.prefix);
         pb.subject_to_named(name, c)?;
         if let (Some(stages), true) = (stages, len > 0) {
             if len % stages != 0 {
@@ -167,6 +167,62 @@ impl RowLog {
 
 const RESERVED: [&str; 5] = ["X", "U", "T", "Xc", "Xm"];
 
+/// The parameters of a problem being written. The phases of a
+/// [`MultiPhaseOcp`](super::MultiPhaseOcp) share a parameter by name: a name declared
+/// again must come with the same values.
+#[derive(Default)]
+pub(crate) struct ParameterTable {
+    /// Name, symbols, values and the phase that declared it first.
+    entries: Vec<(String, Matrix, Vec<f64>, String)>,
+}
+
+impl ParameterTable {
+    /// The OCP's parameters stacked as `p` (declared in `pb` unless an earlier phase did)
+    /// and the parameter that `x(0)` equals, if any.
+    fn declare(
+        &mut self,
+        pb: &mut Problem,
+        ocp: &Ocp,
+        phase: &str,
+    ) -> Result<(Matrix, Option<Matrix>), OcpError> {
+        let (mut p_all, mut x0) = (Vec::new(), None);
+        for (name, values) in &ocp.parameters {
+            if RESERVED.contains(&name.as_str()) {
+                return Err(OcpError::Invalid {
+                    what: format!("parameter '{name}'"),
+                    why: format!("the names {RESERVED:?} are used by the transcription"),
+                });
+            }
+            let p = match self.entries.iter().find(|e| &e.0 == name) {
+                Some((_, p, old, _)) if old == values => p.clone(),
+                Some((_, _, old, first)) => {
+                    return Err(OcpError::Invalid {
+                        what: format!("parameter '{name}' of phase '{phase}'"),
+                        why: format!("phase '{first}' declared it with the values {old:?}, this phase with {values:?}"),
+                    })
+                }
+                None => {
+                    let p = pb.parameter(name, values.len())?;
+                    pb.set_value(&p, values)?;
+                    let entry = (name.clone(), p.clone(), values.clone(), phase.to_string());
+                    self.entries.push(entry);
+                    p
+                }
+            };
+            if ocp.initial_state_parameter.as_deref() == Some(name.as_str()) {
+                x0 = Some(p.clone());
+            }
+            p_all.extend_from_slice(&p);
+        }
+        Ok((Matrix::from_vec(p_all), x0))
+    }
+
+    /// Every parameter, stacked in the order of first declaration.
+    pub(crate) fn stacked(&self) -> Matrix {
+        Matrix::from_vec(self.entries.iter().flat_map(|e| e.1.to_vec()).collect())
+    }
+}
+
 impl Ocp {
     /// Writes the problem on `intervals` (N ≥ 1) uniform intervals with `method`
     /// ([`Ocp::transcribe_on`] with [`Grid::uniform`]).
@@ -187,90 +243,32 @@ impl Ocp {
     /// Errors: no dynamics, no horizon ([`OcpError::NoHorizon`]), closures returning the
     /// wrong sizes, and what the [`Problem`] builder reports.
     pub fn transcribe_on(&self, method: &Method, grid: &Grid) -> Result<Transcription, OcpError> {
-        let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
-        let horizon = self.horizon.ok_or(OcpError::NoHorizon)?;
-        let (nx, nu, n) = (self.nx(), self.nu(), grid.intervals());
-        if nx == 0 {
-            return Err(OcpError::Invalid {
-                what: "transcription".into(),
-                why: "needs at least one state".into(),
-            });
-        }
-        if let Method::MultipleShooting { steps: 0, .. } = method {
-            return Err(OcpError::Invalid {
-                what: "multiple shooting".into(),
-                why: "steps per interval must be ≥ 1".into(),
-            });
-        }
-        let linear = self.control_interpolation == ControlInterpolation::PiecewiseLinear;
-        let n_u = if linear { n + 1 } else { n };
-        let mut pb = Problem::new();
-        let x = pb.variable_matrix("X", nx, n + 1)?;
-        let u = if nu > 0 {
-            pb.variable_matrix("U", nu, n_u)?
-        } else {
-            Matrix::zeros(0, n_u)
-        };
-        let t_f = match horizon {
-            super::Horizon::Fixed(t) => Expr::constant(t),
-            super::Horizon::Free {
-                lower,
-                upper,
-                guess,
-            } => {
-                let t = pb.scalar_variable("T")?;
-                pb.set_bounds(&[t], lower, upper)?;
-                pb.set_initial(&[t], &[guess])?;
-                t
-            }
-        };
-        let mut p_all = Vec::new();
-        let mut x0_parameter = None;
-        for (name, values) in &self.parameters {
-            if RESERVED.contains(&name.as_str()) {
-                return Err(OcpError::Invalid {
-                    what: format!("parameter '{name}'"),
-                    why: format!("the names {RESERVED:?} are used by the transcription"),
-                });
-            }
-            let p = pb.parameter(name, values.len())?;
-            pb.set_value(&p, values)?;
-            if self.initial_state_parameter.as_deref() == Some(name.as_str()) {
-                x0_parameter = Some(p.clone());
-            }
-            p_all.extend_from_slice(&p);
-        }
-        let p = Matrix::from_vec(p_all);
-        let col = |m: &Matrix, k: usize| m.column(k).map_err(OcpError::from);
-        // The closures are checked once on the first stage (their shapes do not change).
-        let f0 = dynamics.eval(&col(&x, 0)?, &col(&u, 0)?, &p)?;
-        if f0.len() != nx {
-            return Err(OcpError::Size {
-                what: "dynamics output".into(),
-                expected: nx,
-                got: f0.len(),
-            });
-        }
-        for i in 0..nx {
-            let (lo, hi) = (self.state_bounds.0[i], self.state_bounds.1[i]);
-            pb.set_bounds(&x.row(i)?, lo, hi)?;
-        }
-        for j in 0..nu {
-            let (lo, hi) = (self.control_bounds.0[j], self.control_bounds.1[j]);
-            pb.set_bounds(&u.row(j)?, lo, hi)?;
-        }
-        let mut log = RowLog::default();
-        if let Some(x0) = &self.initial_state {
-            let c = col(&x, 0)?.eq(&Matrix::from_f64(x0));
-            log.add(&mut pb, "initial state", c, None)?;
-        }
-        if let Some(p0) = &x0_parameter {
-            log.add(&mut pb, "initial state", col(&x, 0)?.eq(p0), None)?;
-        }
-        if let Some(xf) = &self.final_state {
-            let c = col(&x, n)?.eq(&Matrix::from_f64(xf));
-            log.add(&mut pb, "final state", c, None)?;
-        }
+        let mut problem = Problem::new();
+        let mut parameters = ParameterTable::default();
+        let (phase, cost) = self.write_phase(&mut problem, "", method, grid, &mut parameters)?;
+        problem.minimize(cost);
+        Ok(Transcription { problem, phase })
+    }
+
+    /// Writes this OCP as one phase of `pb`: its variables and constraint groups named with
+    /// `prefix` (`"{prefix}X"`, `"{prefix}continuity"`...), its parameters through
+    /// `parameters`, its guess. Returns the phase's layout and its cost (Lagrange and Mayer
+    /// terms), which the caller minimises (summed over the phases).
+    pub(crate) fn write_phase(
+        &self,
+        pb: &mut Problem,
+        prefix: &str,
+        method: &Method,
+        grid: &Grid,
+        parameters: &mut ParameterTable,
+    ) -> Result<(Phase, Expr), OcpError> {
+        let horizon = self.check_transcribable(method)?;
+        let n = grid.intervals();
+        let (x, u, t_f) = self.declare_variables(pb, prefix, horizon, n)?;
+        let (p, x0_parameter) = parameters.declare(pb, self, prefix.trim_end_matches('.'))?;
+        self.check_dynamics_output(&x, &u, &p)?;
+        let mut log = RowLog::starting_at(pb.n_raw_rows(), prefix);
+        self.write_end_states(pb, &mut log, &x, x0_parameter.as_ref())?;
         // Interval lengths: T/N on a uniform grid (one expression), (s_{k+1} − s_k)·T otherwise.
         let s = grid.fractions();
         let h: Vec<Expr> = (0..n)
@@ -279,6 +277,7 @@ impl Ocp {
                 false => t_f * (s[k + 1] - s[k]),
             })
             .collect();
+        let linear = self.control_interpolation == ControlInterpolation::PiecewiseLinear;
         let stage = Stage {
             ocp: self,
             x: &x,
@@ -286,47 +285,13 @@ impl Ocp {
             p: &p,
             h: &h,
             linear,
+            prefix,
         };
-        let (mut cost, xc, tau) = match method {
-            Method::MultipleShooting {
-                tableau,
-                steps,
-                step_calls,
-            } => (
-                stage.shooting(&mut pb, &mut log, tableau, *steps, *step_calls)?,
-                None,
-                vec![0.0],
-            ),
-            Method::Collocation(c) => {
-                let (cost, xc) = stage.collocation(&mut pb, &mut log, c)?;
-                (cost, Some(xc), c.tau.clone())
-            }
-            Method::Trapezoidal => (stage.trapezoidal(&mut pb, &mut log)?, None, vec![0.0]),
-            Method::HermiteSimpson { separated } => {
-                let (cost, xm) = stage.hermite_simpson(&mut pb, &mut log, *separated)?;
-                let tau = if xm.is_some() {
-                    vec![0.0, 0.5]
-                } else {
-                    vec![0.0]
-                };
-                (cost, xm, tau)
-            }
-        };
-        for (name, c) in &self.path {
-            let rows = (0..=n)
-                .map(|k| Ok(c(&col(&x, k)?, &stage.node_control(k)?, &p)))
-                .collect::<Result<Vec<_>, OcpError>>()?;
-            log.add(&mut pb, name, Constraint::all(rows), Some(n + 1))?;
+        let (mut cost, xc, tau) = stage.write(pb, &mut log, method)?;
+        if let Some(phi) = self.write_path_and_boundary(pb, &mut log, &stage, t_f)? {
+            cost += phi;
         }
-        for (name, b) in &self.boundary {
-            log.add(&mut pb, name, b(&col(&x, 0)?, &col(&x, n)?, &p, t_f), None)?;
-        }
-        if let Some(phi) = &self.terminal_cost {
-            cost += phi(&col(&x, n)?, &p, t_f);
-        }
-        pb.minimize(cost);
-        let tr = Transcription {
-            problem: pb,
+        let phase = Phase {
             intervals: n,
             grid: grid.clone(),
             control_interpolation: self.control_interpolation,
@@ -340,40 +305,163 @@ impl Ocp {
             initial_state_parameter: self.initial_state_parameter.clone(),
             staged_rows: log.staged,
         };
-        self.apply_guess(tr, horizon.guess())
+        self.apply_guess(pb, &phase, horizon.guess())?;
+        Ok((phase, cost))
     }
 
-    fn apply_guess(&self, mut tr: Transcription, t_f: f64) -> Result<Transcription, OcpError> {
-        let n = tr.intervals;
-        let grid = tr.grid.clone();
+    /// The horizon, after checking that the problem can be transcribed with `method`.
+    fn check_transcribable(&self, method: &Method) -> Result<Horizon, OcpError> {
+        self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
+        let horizon = self.horizon.ok_or(OcpError::NoHorizon)?;
+        if self.nx() == 0 {
+            return Err(OcpError::Invalid {
+                what: "transcription".into(),
+                why: "needs at least one state".into(),
+            });
+        }
+        if let Method::MultipleShooting { steps: 0, .. } = method {
+            return Err(OcpError::Invalid {
+                what: "multiple shooting".into(),
+                why: "steps per interval must be ≥ 1".into(),
+            });
+        }
+        Ok(horizon)
+    }
+
+    /// Declares `X`, `U` (with their bounds) and, for a free horizon, `T`, on `n` intervals.
+    fn declare_variables(
+        &self,
+        pb: &mut Problem,
+        prefix: &str,
+        horizon: Horizon,
+        n: usize,
+    ) -> Result<(Matrix, Matrix, Expr), OcpError> {
+        let (nx, nu) = (self.nx(), self.nu());
+        let linear = self.control_interpolation == ControlInterpolation::PiecewiseLinear;
+        let n_u = if linear { n + 1 } else { n };
+        let x = pb.variable_matrix(&format!("{prefix}X"), nx, n + 1)?;
+        let u = if nu > 0 {
+            pb.variable_matrix(&format!("{prefix}U"), nu, n_u)?
+        } else {
+            Matrix::zeros(0, n_u)
+        };
+        let t_f = match horizon {
+            Horizon::Fixed(t) => Expr::constant(t),
+            Horizon::Free {
+                lower,
+                upper,
+                guess,
+            } => {
+                let t = pb.scalar_variable(&format!("{prefix}T"))?;
+                pb.set_bounds(&[t], lower, upper)?;
+                pb.set_initial(&[t], &[guess])?;
+                t
+            }
+        };
+        for i in 0..nx {
+            let (lo, hi) = (self.state_bounds.0[i], self.state_bounds.1[i]);
+            pb.set_bounds(&x.row(i)?, lo, hi)?;
+        }
+        for j in 0..nu {
+            let (lo, hi) = (self.control_bounds.0[j], self.control_bounds.1[j]);
+            pb.set_bounds(&u.row(j)?, lo, hi)?;
+        }
+        Ok((x, u, t_f))
+    }
+
+    /// Checks the dynamics' output length once, on the first stage (shapes do not change).
+    fn check_dynamics_output(&self, x: &Matrix, u: &Matrix, p: &Matrix) -> Result<(), OcpError> {
+        let dynamics = self.dynamics.as_ref().ok_or(OcpError::NoDynamics)?;
+        let f0 = dynamics.eval(&x.column(0)?, &u.column(0)?, p)?;
+        if f0.len() != self.nx() {
+            return Err(OcpError::Size {
+                what: "dynamics output".into(),
+                expected: self.nx(),
+                got: f0.len(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The rows fixing `x(0)` (to constants or to a parameter) and `x(T)`.
+    fn write_end_states(
+        &self,
+        pb: &mut Problem,
+        log: &mut RowLog,
+        x: &Matrix,
+        x0_parameter: Option<&Matrix>,
+    ) -> Result<(), OcpError> {
+        if let Some(x0) = &self.initial_state {
+            let c = x.column(0)?.eq(&Matrix::from_f64(x0));
+            log.add(pb, "initial state", c, None)?;
+        }
+        if let Some(p0) = x0_parameter {
+            log.add(pb, "initial state", x.column(0)?.eq(p0), None)?;
+        }
+        if let Some(xf) = &self.final_state {
+            let c = x.column(x.ncols() - 1)?.eq(&Matrix::from_f64(xf));
+            log.add(pb, "final state", c, None)?;
+        }
+        Ok(())
+    }
+
+    /// The path constraints at every node and the boundary constraints; returns the Mayer
+    /// term, if any.
+    fn write_path_and_boundary(
+        &self,
+        pb: &mut Problem,
+        log: &mut RowLog,
+        stage: &Stage,
+        t_f: Expr,
+    ) -> Result<Option<Expr>, OcpError> {
+        let (x, p) = (stage.x, stage.p);
+        let n = x.ncols() - 1;
+        for (name, c) in &self.path {
+            let rows = (0..=n)
+                .map(|k| Ok(c(&x.column(k)?, &stage.node_control(k)?, p)))
+                .collect::<Result<Vec<_>, OcpError>>()?;
+            log.add(pb, name, Constraint::all(rows), Some(n + 1))?;
+        }
+        for (name, b) in &self.boundary {
+            log.add(pb, name, b(&x.column(0)?, &x.column(n)?, p, t_f), None)?;
+        }
+        Ok(match &self.terminal_cost {
+            Some(phi) => Some(phi(&x.column(n)?, p, t_f)),
+            None => None,
+        })
+    }
+
+    /// Sets the initial guess of the phase's states and controls from the guess closures,
+    /// `t_f` the horizon's guess.
+    fn apply_guess(&self, pb: &mut Problem, phase: &Phase, t_f: f64) -> Result<(), OcpError> {
+        let n = phase.intervals;
+        let grid = &phase.grid;
         if let Some(g) = &self.state_guess {
             let mut set = |m: &Matrix, col: usize, t: f64| -> Result<(), OcpError> {
                 let v = g(t, t_f);
-                tr.problem
-                    .set_initial(&m.column(col)?, &v)
-                    .map_err(|e| match e {
-                        crate::BuildError::Size { expected, got, .. } => OcpError::Size {
-                            what: format!("state guess at t = {t}"),
-                            expected,
-                            got,
-                        },
-                        e => e.into(),
-                    })
+                pb.set_initial(&m.column(col)?, &v).map_err(|e| match e {
+                    crate::BuildError::Size { expected, got, .. } => OcpError::Size {
+                        what: format!("state guess at t = {t}"),
+                        expected,
+                        got,
+                    },
+                    e => e.into(),
+                })
             };
             for k in 0..=n {
-                set(&tr.states, k, grid.time(k, t_f))?;
+                set(&phase.states, k, grid.time(k, t_f))?;
             }
-            if let Some(xc) = &tr.collocation_states {
-                let d = tr.tau.len() - 1;
+            if let Some(xc) = &phase.collocation_states {
+                let d = phase.tau.len() - 1;
                 for k in 0..n {
                     for j in 1..=d {
-                        set(xc, k * d + j - 1, grid.time_in(k, tr.tau[j], t_f))?;
+                        set(xc, k * d + j - 1, grid.time_in(k, phase.tau[j], t_f))?;
                     }
                 }
             }
         }
         if let (Some(g), true) = (&self.control_guess, self.nu() > 0) {
-            for k in 0..tr.controls.ncols() {
+            for k in 0..phase.controls.ncols() {
                 let t = grid.time(k, t_f);
                 let v = g(t, t_f);
                 if v.len() != self.nu() {
@@ -383,10 +471,10 @@ impl Ocp {
                         got: v.len(),
                     });
                 }
-                tr.problem.set_initial(&tr.controls.column(k)?, &v)?;
+                pb.set_initial(&phase.controls.column(k)?, &v)?;
             }
         }
-        Ok(tr)
+        Ok(())
     }
 }
 
@@ -400,6 +488,8 @@ struct Stage<'a> {
     h: &'a [Expr],
     /// Controls at the nodes, linear in between (else one per interval).
     linear: bool,
+    /// Prefix of the variable names (the phase's, empty for one phase).
+    prefix: &'a str,
 }
 
 /// `ẋ` and the Lagrange integrand at one point.
@@ -408,6 +498,40 @@ type PointValues = (Matrix, Option<Expr>);
 impl Stage<'_> {
     fn dynamics(&self) -> &super::Dynamics {
         self.ocp.dynamics.as_ref().expect("checked by transcribe")
+    }
+
+    /// The rows of `method` tying the states to the dynamics; returns the Lagrange cost,
+    /// the collocation or midpoint states and their fractions `τ` of an interval.
+    fn write(
+        &self,
+        pb: &mut Problem,
+        log: &mut RowLog,
+        method: &Method,
+    ) -> Result<(Expr, Option<Matrix>, Vec<f64>), OcpError> {
+        Ok(match method {
+            Method::MultipleShooting {
+                tableau,
+                steps,
+                step_calls,
+            } => (
+                self.shooting(pb, log, tableau, *steps, *step_calls)?,
+                None,
+                vec![0.0],
+            ),
+            Method::Collocation(c) => {
+                let (cost, xc) = self.collocation(pb, log, c)?;
+                (cost, Some(xc), c.tau.clone())
+            }
+            Method::Trapezoidal => (self.trapezoidal(pb, log)?, None, vec![0.0]),
+            Method::HermiteSimpson { separated } => {
+                let (cost, xm) = self.hermite_simpson(pb, log, *separated)?;
+                let tau = match xm {
+                    Some(_) => vec![0.0, 0.5],
+                    None => vec![0.0],
+                };
+                (cost, xm, tau)
+            }
+        })
     }
 
     /// The control at the fraction `tau ∈ [0, 1]` of interval `k`.
@@ -501,7 +625,7 @@ impl Stage<'_> {
     ) -> Result<(Expr, Option<Matrix>), OcpError> {
         let (nx, n) = (self.ocp.nx(), self.h.len());
         let xm_var = if separated {
-            let xm = pb.variable_matrix("Xm", nx, n)?;
+            let xm = pb.variable_matrix(&format!("{}Xm", self.prefix), nx, n)?;
             for i in 0..nx {
                 let (lo, hi) = (self.ocp.state_bounds.0[i], self.ocp.state_bounds.1[i]);
                 pb.set_bounds(&xm.row(i)?, lo, hi)?;
@@ -676,7 +800,7 @@ impl Stage<'_> {
         c: &Collocation,
     ) -> Result<(Expr, Matrix), OcpError> {
         let (nx, n, d) = (self.ocp.nx(), self.h.len(), c.degree());
-        let xc = pb.variable_matrix("Xc", nx, n * d)?;
+        let xc = pb.variable_matrix(&format!("{}Xc", self.prefix), nx, n * d)?;
         for i in 0..nx {
             let (lo, hi) = (self.ocp.state_bounds.0[i], self.ocp.state_bounds.1[i]);
             pb.set_bounds(&xc.row(i)?, lo, hi)?;
@@ -732,104 +856,53 @@ impl Transcription {
 
     /// Number of intervals N.
     pub fn intervals(&self) -> usize {
-        self.intervals
+        self.phase.intervals
     }
 
     /// The grid states `X` (`nx × (N+1)`).
     pub fn states(&self) -> &Matrix {
-        &self.states
+        &self.phase.states
     }
 
     /// The controls `U` (`nu × N`; `nu × (N+1)` for piecewise-linear controls).
     pub fn controls(&self) -> &Matrix {
-        &self.controls
+        &self.phase.controls
     }
 
     /// The time grid.
     pub fn grid(&self) -> &Grid {
-        &self.grid
+        &self.phase.grid
     }
 
     /// How the controls vary between nodes.
     pub fn control_interpolation(&self) -> ControlInterpolation {
-        self.control_interpolation
+        self.phase.control_interpolation
     }
 
     /// The final time: the variable `T` or the fixed value as a constant.
     pub fn final_time(&self) -> Expr {
-        self.final_time
+        self.phase.final_time
     }
 
     /// The name of the parameter that `x(0)` equals, if the OCP declared one
     /// ([`Ocp::set_initial_state_parameter`]).
     pub fn initial_state_parameter(&self) -> Option<&str> {
-        self.initial_state_parameter.as_deref()
+        self.phase.initial_state_parameter.as_deref()
     }
 
     /// The collocation states `Xc` (`nx × N·d`, stage `k`'s `d` columns from `k·d`), for
     /// direct collocation, or the midpoint states `Xm` (`nx × N`) for separated
     /// Hermite–Simpson.
     pub fn collocation_states(&self) -> Option<&Matrix> {
-        self.collocation_states.as_ref()
+        self.phase.collocation_states.as_ref()
     }
 
     pub(crate) fn staged_rows(&self) -> &[StagedRows] {
-        &self.staged_rows
+        &self.phase.staged_rows
     }
 
     /// Reads a solution of the compiled problem as a trajectory.
     pub fn trajectory(&self, sol: &Solution) -> Result<Trajectory, OcpError> {
-        let n_var = self.problem.n_variables();
-        if sol.x.len() != n_var {
-            return Err(OcpError::Size {
-                what: "solution x".into(),
-                expected: n_var,
-                got: sol.x.len(),
-            });
-        }
-        let values = |m: &Matrix| -> Result<Vec<Vec<f64>>, OcpError> {
-            let idx = self.problem.variable_indices(m)?;
-            let rows = m.nrows();
-            Ok((0..rows)
-                .map(|i| (0..m.ncols()).map(|k| sol.x[idx[k * rows + i]]).collect())
-                .collect())
-        };
-        let t_f = match self.final_time.value() {
-            Some(t) => t,
-            None => sol.x[self.problem.variable_indices(&[self.final_time])?[0]],
-        };
-        let n = self.intervals;
-        let grid = &self.grid;
-        let collocation = match &self.collocation_states {
-            Some(xc) => {
-                let d = self.tau.len() - 1;
-                Some(super::CollocationStates {
-                    time: (0..n * d)
-                        .map(|i| grid.time_in(i / d, self.tau[i % d + 1], t_f))
-                        .collect(),
-                    states: values(xc)?,
-                })
-            }
-            None => None,
-        };
-        let controls = if self.controls.nrows() > 0 {
-            values(&self.controls)?
-        } else {
-            Vec::new()
-        };
-        let time: Vec<f64> = (0..=n).map(|k| grid.time(k, t_f)).collect(); // t_N exactly T
-        Ok(Trajectory {
-            state_names: self.state_names.clone(),
-            states: values(&self.states)?,
-            control_names: self.control_names.clone(),
-            control_time: time[..self.controls.ncols()].to_vec(),
-            control_interpolation: self.control_interpolation,
-            time,
-            controls,
-            final_time: t_f,
-            objective: sol.objective,
-            status: sol.status,
-            collocation,
-        })
+        self.phase.trajectory(&self.problem, sol, 0.0)
     }
 }

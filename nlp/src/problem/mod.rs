@@ -7,12 +7,14 @@ pub mod bounds;
 pub mod complementarity;
 pub mod cone;
 pub mod error;
+pub mod file;
 pub mod to_function;
 
 pub use bounds::PerEntry;
 pub use complementarity::ComplementarityReport;
 pub use cone::{Cone, CONE_SMOOTHING};
 pub use error::BuildError;
+pub use file::{ProblemFileError, PROBLEM_FILE_FORMAT, PROBLEM_FILE_VERSION};
 pub use to_function::{SolverFunction, ToFunctionError};
 
 use crate::compiled::{CompileOptions, Compiled};
@@ -420,6 +422,11 @@ impl Problem {
         (0..self.rows.len())
             .filter(|&i| self.simple_bound_of(i).is_none())
             .count()
+    }
+
+    /// Number of constraint rows as added, before rows become simple bounds.
+    pub(crate) fn n_raw_rows(&self) -> usize {
+        self.rows.len()
     }
 
     /// All variables, in the order of `x`.
