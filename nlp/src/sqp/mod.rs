@@ -54,7 +54,7 @@ mod line_search;
 pub mod options;
 mod polish;
 pub(crate) mod qp;
-mod rti;
+pub mod rti;
 mod state;
 mod stop;
 mod subproblem;
