@@ -4,6 +4,9 @@
 //! `mpc_cart_pole_ipm_warm_resolve`: by one `Ipm` across the loop, as `Mpc` does (its KKT
 //! symbolic analysis kept between solves); `mpc_cart_pole_ipm_warm_resolve_fresh_solver`:
 //! by a new `Ipm` each time (the analysis rebuilt), for the ratio.
+//! `mpc_cart_pole_sqp_warm_resolve`: the same re-solve by the SQP.
+//! `mpc_cart_pole_rti_prepare` / `mpc_cart_pole_rti_feedback`: the two phases of one
+//! real-time iteration (`nlp::Rti`) at the same state, from the same plan.
 //!
 //! ```text
 //! cargo bench --bench mpc
@@ -14,10 +17,11 @@
 mod mpc_cart_pole;
 
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 use nlp::mpc::Mpc;
-use nlp::Ipm;
+use nlp::{Ipm, Rti, Sqp, SqpOptions};
 
 /// Closed-loop steps taken before the benchmarked re-solve (mid swing-up stabilisation,
 /// where a warm step takes 2–3 iterations as most of the loop's steps do).
@@ -52,6 +56,36 @@ fn warm_resolve(c: &mut Criterion) {
                     .solve_warm(compiled, &shifted)
                     .expect("warm solve"),
             )
+        })
+    });
+    let sqp = Sqp::default();
+    let warm = sqp.solve_warm(compiled, &shifted).expect("warm SQP solve");
+    assert!(warm.status.is_success(), "warm SQP solve: {}", warm.status);
+    c.bench_function("mpc_cart_pole_sqp_warm_resolve", |b| {
+        b.iter(|| black_box(sqp.solve_warm(compiled, &shifted).expect("warm solve")))
+    });
+    // RTI: the plan of step STEPS_BEFORE − 1 shifted is the linearisation point, x the
+    // measured state; prepare and feedback from the same plan each time.
+    let mut rti = Rti::from_transcription(&tr, SqpOptions::default()).expect("RTI");
+    rti.initialize(&shifted).expect("plan");
+    c.bench_function("mpc_cart_pole_rti_prepare", |b| {
+        b.iter(|| {
+            rti.initialize(&shifted).expect("plan");
+            rti.prepare().expect("prepare");
+        })
+    });
+    // The feedback alone: each repetition prepares untimed, then times the feedback.
+    c.bench_function("mpc_cart_pole_rti_feedback", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                rti.initialize(&shifted).expect("plan");
+                rti.prepare().expect("prepare");
+                let t = Instant::now();
+                black_box(rti.feedback(&x).expect("feedback"));
+                total += t.elapsed();
+            }
+            total
         })
     });
 }

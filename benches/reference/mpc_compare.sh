@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# The MPC examples side by side: symnlp (IPM, SQP) and CasADi 3.8.2 (IPOPT, sqpmethod +
+# The MPC examples side by side: symnlp (IPM, SQP, RTI) and CasADi 3.8.2 (IPOPT, sqpmethod +
 # qrqp, RTI = sqpmethod max_iter 1 + qrqp) on identical transcriptions, plants and warm
 # starts (examples/mpc_*.rs, benches/reference/mpc_casadi.py), in ROUNDS interleaved
 # rounds; prints per configuration the median over rounds of the per-step latency median
-# and max, the iterations, the closed-loop cost, and the ratios to symnlp's IPM.
+# and max, the iterations, the closed-loop cost, and the ratios to symnlp's IPM and to
+# CasADi's RTI; for symnlp's RTI also the feedback phase's median (the latency from the
+# measured state to the control when the preparation runs ahead) and its share of the
+# step. Both RTIs converge their first step (sqpmethod / the IPM) and take one iteration
+# per later step.
 # fatrop is not in CasADi's PyPI wheel's plugin list here, so it is not run.
 # Usage: bash benches/reference/mpc_compare.sh [ROUNDS=3] [PROBLEMS=cart_pole,car,quadrotor]
 set -euo pipefail
@@ -18,7 +22,7 @@ cargo build --release -q --example mpc_cart_pole --example mpc_car --example mpc
 : > "$OUT"
 for round in $(seq 1 "$ROUNDS"); do
     for p in ${PROBLEMS//,/ }; do
-        for s in ipm sqp; do
+        for s in ipm sqp rti; do
             if ! timeout "$SQP_TIMEOUT" "target/release/examples/mpc_$p" "$s" --json 2>/dev/null \
                 | sed "s/^{/{\"round\":$round,/" >> "$OUT"; then
                 echo "{\"round\":$round,\"problem\":\"$p\",\"solver\":\"$s\",\"timed_out\":$SQP_TIMEOUT}" >> "$OUT"
@@ -34,18 +38,25 @@ rows = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
 by = {}
 for r in rows:
     by.setdefault((r["problem"], r["solver"]), []).append(r)
-print(f"| problem | solver | median ms | max ms | iterations mean / max | all steps succeeded | closed-loop cost | median / symnlp IPM's |")
-print("|---|---|---:|---:|---:|---|---:|---:|")
+print(f"| problem | solver | median ms | max ms | feedback median ms (share of step) | iterations mean / max | all steps succeeded | closed-loop cost | median / symnlp IPM's | median / CasADi RTI's |")
+print("|---|---|---:|---:|---:|---:|---|---:|---:|---:|")
 for (p, s), rs in by.items():
     ok = [r for r in rs if "median_ms" in r]
     if not ok:
-        print(f"| {p} | {s} | timed out ({rs[0]['timed_out']} s) | | | | | |")
+        print(f"| {p} | {s} | timed out ({rs[0]['timed_out']} s) | | | | | | | |")
         continue
     med = statistics.median(r["median_ms"] for r in ok)
     mx = statistics.median(r["max_ms"] for r in ok)
     ipm = [r["median_ms"] for r in by.get((p, "ipm"), []) if "median_ms" in r]
     ratio = med / statistics.median(ipm) if ipm else float("nan")
+    crti = [r["median_ms"] for r in by.get((p, "casadi_rti"), []) if "median_ms" in r]
+    ratio_rti = med / statistics.median(crti) if crti else float("nan")
+    fb = ""
+    if s == "rti":
+        fbm = statistics.median(r["feedback_median_ms"] for r in ok)
+        later = statistics.median(r["later_median_ms"] for r in ok)
+        fb = f"{fbm:.3f} ({100 * fbm / later:.0f} %)"
     r = ok[0]
-    print(f"| {p} | {s} | {med:.2f} | {mx:.1f} | {r['iterations_mean']:.2f} / {r['iterations_max']} "
-          f"| {r['all_succeeded']} | {r['closed_loop_cost']:.10g} | {ratio:.2f} |")
+    print(f"| {p} | {s} | {med:.2f} | {mx:.1f} | {fb} | {r['iterations_mean']:.2f} / {r['iterations_max']} "
+          f"| {r['all_succeeded']} | {r['closed_loop_cost']:.10g} | {ratio:.2f} | {ratio_rti:.2f} |")
 PY

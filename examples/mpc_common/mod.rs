@@ -1,9 +1,9 @@
 //! What the MPC examples share: a closed loop of an OCP whose initial state is the
 //! parameter `x0`, on the nominal plant (the transcription's RK4 step), with its cost
-//! `dt Σ_s l(x_s, u_s)` and a command line `[ipm|sqp] [--json]`.
-use symnlp::nlp::mpc::{ClosedLoop, Mpc};
+//! `dt Σ_s l(x_s, u_s)` and a command line `[ipm|sqp|rti] [--json]`.
+use symnlp::nlp::mpc::{ClosedLoop, Mpc, MpcError};
 use symnlp::nlp::ocp::{ButcherTableau, Method, Ocp, Simulator, Transcription};
-use symnlp::nlp::{Ipm, Solver, Sqp};
+use symnlp::nlp::{Ipm, Solver, Sqp, SqpOptions};
 use symnlp::symx::{Expr, Function, Matrix};
 
 /// One MPC example: the OCP (initial state the parameter `x0`), its grid and loop.
@@ -40,8 +40,25 @@ impl MpcExample {
         &self,
         solver: Box<dyn Solver>,
     ) -> Result<ClosedLoop, Box<dyn std::error::Error>> {
+        self.closed_loop_with(|tr| Mpc::new(tr, solver))
+    }
+
+    /// The closed loop with real-time iterations (SQP defaults), the first step solved to
+    /// convergence by the interior point, as CasADi's RTI loop in
+    /// `benches/reference/mpc_casadi.py` does with its sqpmethod.
+    pub fn closed_loop_rti(&self) -> Result<ClosedLoop, Box<dyn std::error::Error>> {
+        self.closed_loop_with(|tr| {
+            Mpc::with_rti(tr, SqpOptions::default(), Box::new(Ipm::default()))
+        })
+    }
+
+    /// The closed loop with the controller `make` builds for the transcription.
+    pub fn closed_loop_with(
+        &self,
+        make: impl FnOnce(&Transcription) -> Result<Mpc, MpcError>,
+    ) -> Result<ClosedLoop, Box<dyn std::error::Error>> {
         let (tr, mut plant) = self.setup()?;
-        let mut mpc = Mpc::new(&tr, solver)?;
+        let mut mpc = make(&tr)?;
         let dt = self.dt;
         Ok(mpc.run(&self.x_init, self.steps, |x, u, next| {
             plant.step_into(x, u, dt, next)
@@ -61,18 +78,25 @@ impl MpcExample {
         Ok(self.dt * total)
     }
 
-    /// `[ipm|sqp] [--json]`: runs the loop; prints the steps as CSV (or one JSON summary
-    /// line with `--json`) on stdout and a summary on stderr.
+    /// `[ipm|sqp|rti] [--json]`: runs the loop; prints the steps as CSV (or one JSON
+    /// summary line with `--json`) on stdout and a summary on stderr.
     pub fn main(&self) -> Result<(), Box<dyn std::error::Error>> {
         let args: Vec<String> = std::env::args().skip(1).collect();
-        let solver: Box<dyn Solver> = if args.iter().any(|a| a == "sqp") {
-            Box::new(Sqp::default())
+        let (name, run) = if args.iter().any(|a| a == "rti") {
+            ("rti", self.closed_loop_rti()?)
+        } else if args.iter().any(|a| a == "sqp") {
+            ("sqp", self.closed_loop(Box::new(Sqp::default()))?)
         } else {
-            Box::new(Ipm::default())
+            ("ipm", self.closed_loop(Box::new(Ipm::default()))?)
         };
-        let name = solver.name();
-        let run = self.closed_loop(solver)?;
         let (median, max) = run.latency();
+        // The steps after the first (RTI's first step is a converged solve).
+        let later = ClosedLoop {
+            steps: run.steps[1.min(run.steps.len())..].to_vec(),
+            ..ClosedLoop::default()
+        };
+        let (feedback_median, feedback_max) = later.feedback_latency();
+        let (later_median, _) = later.latency();
         let (mean_it, max_it) = run.iterations();
         let cost = self.cost(&run)?;
         if args.iter().any(|a| a == "--json") {
@@ -83,12 +107,15 @@ impl MpcExample {
                 "problem": self.name, "solver": name, "closed_loop_cost": cost,
                 "all_succeeded": run.all_succeeded(), "failed_steps": failed,
                 "median_ms": 1e3 * median, "max_ms": 1e3 * max,
+                "later_median_ms": 1e3 * later_median,
+                "feedback_median_ms": 1e3 * feedback_median,
+                "feedback_max_ms": 1e3 * feedback_max,
                 "iterations_mean": mean_it, "iterations_max": max_it,
                 "final_state": run.states.last(),
             });
             println!("{summary}");
         } else {
-            println!("step,status,iterations,ms,state...,control...");
+            println!("step,status,iterations,ms,feedback ms,state...,control...");
             for (s, r) in run.steps.iter().enumerate() {
                 let v: Vec<String> = run.states[s]
                     .iter()
@@ -96,20 +123,22 @@ impl MpcExample {
                     .map(|v| format!("{v:.6}"))
                     .collect();
                 println!(
-                    "{s},{},{},{:.3},{}",
+                    "{s},{},{},{:.3},{:.3},{}",
                     r.status,
                     r.iterations,
                     1e3 * r.seconds,
+                    1e3 * r.feedback_seconds,
                     v.join(",")
                 );
             }
         }
         eprintln!(
-            "{} {name}: all succeeded {}, closed-loop cost {cost:.10}, latency median {:.3} ms max {:.3} ms, iterations mean {mean_it:.2} max {max_it}",
+            "{} {name}: all succeeded {}, closed-loop cost {cost:.10}, latency median {:.3} ms max {:.3} ms (feedback median {:.3} ms after the first step), iterations mean {mean_it:.2} max {max_it}",
             self.name,
             run.all_succeeded(),
             1e3 * median,
             1e3 * max,
+            1e3 * feedback_median,
         );
         Ok(())
     }

@@ -238,6 +238,12 @@ impl Compiled {
         &self.variable_blocks
     }
 
+    /// The parameter blocks, in declaration order (where a parameter's entries sit in
+    /// [`Compiled::parameter_values`]).
+    pub fn parameter_blocks(&self) -> &[Block] {
+        self.parameter_index.blocks()
+    }
+
     /// The named constraint groups, in the order of `g`.
     pub fn constraint_blocks(&self) -> &[Block] {
         &self.constraint_blocks

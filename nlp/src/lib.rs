@@ -59,4 +59,4 @@ pub use options::{
 pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
 pub use solution::{IterationRecord, Solution, Stats, Status};
 pub use solution_file::{SolutionFileError, SOLUTION_FILE_VERSION};
-pub use sqp::{HessianApproximation, Sqp, SqpOptions};
+pub use sqp::{HessianApproximation, Rti, RtiError, Sqp, SqpOptions};

@@ -8,6 +8,11 @@
 //! the first control of the new plan. [`Mpc::run`] closes the loop with a plant (for
 //! instance a [`Simulator`](crate::ocp::Simulator)). See `docs/mpc.md`.
 //!
+//! [`Mpc::with_rti`] runs real-time iterations instead ([`Rti`]): the first step (and the
+//! first after [`Mpc::reset`]) is solved to convergence by a solver, every later one is
+//! one SQP iteration split into a preparation (shift, linearise, factorise; also
+//! callable ahead with [`Mpc::prepare`]) and a feedback with the measured state.
+//!
 //! The time budget of a step is the solver's: its options' `max_iter` and
 //! `max_wall_time` (a step that hits them reports `MaximumIterationsExceeded` /
 //! `MaximumWallTimeExceeded` and its iterate is still applied and used as the next warm
@@ -27,6 +32,7 @@ use crate::frontend::Solver;
 use crate::ocp::{OcpError, Shift, Transcription};
 use crate::problem::BuildError;
 use crate::solution::{Solution, Status};
+use crate::sqp::{Rti, RtiError, SqpOptions};
 
 /// Why an MPC set-up or step failed.
 #[derive(Debug, Error)]
@@ -46,6 +52,9 @@ pub enum MpcError {
     /// The solver refused the problem.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The real-time iteration refused the problem or a step.
+    #[error(transparent)]
+    Rti(#[from] RtiError),
 }
 
 /// What one MPC step did.
@@ -55,10 +64,17 @@ pub struct StepReport {
     pub status: Status,
     /// Solver iterations.
     pub iterations: usize,
-    /// Wall seconds of the whole step: parameter update, shift and solve.
+    /// Wall seconds of the whole step: parameter update, shift and solve; with real-time
+    /// iterations the preparation and the feedback (wherever the preparation ran: in the
+    /// step, or ahead of it through [`Mpc::prepare`]).
     pub seconds: f64,
-    /// Wall seconds inside the solver (its `stats.total_seconds`).
+    /// Wall seconds inside the solver (its `stats.total_seconds`; with real-time
+    /// iterations the preparation and the feedback).
     pub solve_seconds: f64,
+    /// Wall seconds of the real-time iteration's feedback phase, the latency from the
+    /// measured state to the control when the preparation runs ahead; equal to
+    /// `solve_seconds` for a solver (all of its work follows the measurement).
+    pub feedback_seconds: f64,
     /// Objective of the new plan.
     pub objective: f64,
     /// Whether the solve was warm-started (every step but the first one and the first
@@ -67,7 +83,7 @@ pub struct StepReport {
 }
 
 /// A closed loop run by [`Mpc::run`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ClosedLoop {
     /// Plant states `x₀ … x_S` (S + 1 entries).
     pub states: Vec<Vec<f64>>,
@@ -86,12 +102,13 @@ impl ClosedLoop {
     /// Median and maximum of the steps' wall seconds ([`StepReport::seconds`]); `(0, 0)`
     /// for no step.
     pub fn latency(&self) -> (f64, f64) {
-        let mut t: Vec<f64> = self.steps.iter().map(|s| s.seconds).collect();
-        t.sort_by(f64::total_cmp);
-        match t.len() {
-            0 => (0.0, 0.0),
-            n => (median_of_sorted(&t), t[n - 1]),
-        }
+        median_and_max(self.steps.iter().map(|s| s.seconds))
+    }
+
+    /// Median and maximum of the steps' feedback seconds
+    /// ([`StepReport::feedback_seconds`]); `(0, 0)` for no step.
+    pub fn feedback_latency(&self) -> (f64, f64) {
+        median_and_max(self.steps.iter().map(|s| s.feedback_seconds))
     }
 
     /// Mean and maximum of the iterations per step.
@@ -99,6 +116,15 @@ impl ClosedLoop {
         let total: usize = self.steps.iter().map(|s| s.iterations).sum();
         let max = self.steps.iter().map(|s| s.iterations).max().unwrap_or(0);
         (total as f64 / self.steps.len().max(1) as f64, max)
+    }
+}
+
+fn median_and_max(t: impl Iterator<Item = f64>) -> (f64, f64) {
+    let mut t: Vec<f64> = t.collect();
+    t.sort_by(f64::total_cmp);
+    match t.len() {
+        0 => (0.0, 0.0),
+        n => (median_of_sorted(&t), t[n - 1]),
     }
 }
 
@@ -135,8 +161,7 @@ fn median_of_sorted(t: &[f64]) -> f64 {
 /// assert!(run.states[20][0].abs() < 1e-2); // regulated to 0
 /// ```
 pub struct Mpc {
-    solver: Box<dyn Solver>,
-    compiled: Compiled,
+    engine: Engine,
     shift: Shift,
     x0_parameter: String,
     /// Number of states.
@@ -148,10 +173,55 @@ pub struct Mpc {
     control: Vec<f64>,
 }
 
+/// What solves a step.
+enum Engine {
+    /// A solver, re-solving warm.
+    Solver {
+        solver: Box<dyn Solver>,
+        compiled: Box<Compiled>,
+    },
+    /// Real-time iterations after a first step solved by `first`.
+    Rti {
+        rti: Box<Rti>,
+        first: Box<dyn Solver>,
+        /// Whether the RTI plan is started (a first step was solved).
+        started: bool,
+        /// Whether the plan is shifted and prepared for the next feedback, and how long
+        /// that took.
+        prepared: Option<f64>,
+    },
+}
+
 impl Mpc {
     /// A controller for `tr` (compiled here, its shift planned once) solved by `solver`.
     /// Errors: no initial-state parameter, a free horizon, or what compiling reports.
     pub fn new(tr: &Transcription, solver: Box<dyn Solver>) -> Result<Mpc, MpcError> {
+        let compiled = Box::new(tr.compile()?);
+        Mpc::with_engine(tr, Engine::Solver { solver, compiled })
+    }
+
+    /// A controller for `tr` by real-time iterations ([`Rti`] with the SQP's `options`):
+    /// the first step (and the first after [`Mpc::reset`]) is solved to convergence by
+    /// `first`, each later one is one preparation ([`Rti::prepare`] at the shifted plan)
+    /// and one feedback ([`Rti::feedback`] with the measured state). A step's status is
+    /// the feedback's (`MaximumIterationsExceeded`: one iteration, by design), so judge
+    /// such a loop by its cost, not by [`ClosedLoop::all_succeeded`].
+    pub fn with_rti(
+        tr: &Transcription,
+        options: SqpOptions,
+        first: Box<dyn Solver>,
+    ) -> Result<Mpc, MpcError> {
+        let rti = Box::new(Rti::from_transcription(tr, options)?);
+        let engine = Engine::Rti {
+            rti,
+            first,
+            started: false,
+            prepared: None,
+        };
+        Mpc::with_engine(tr, engine)
+    }
+
+    fn with_engine(tr: &Transcription, engine: Engine) -> Result<Mpc, MpcError> {
         let x0_parameter = tr
             .initial_state_parameter()
             .ok_or(MpcError::NoInitialStateParameter)?
@@ -165,8 +235,7 @@ impl Mpc {
             Vec::new()
         };
         Ok(Mpc {
-            solver,
-            compiled: tr.compile()?,
+            engine,
             shift: tr.shift_plan()?,
             x0_parameter,
             nx: tr.states().nrows(),
@@ -180,7 +249,8 @@ impl Mpc {
     /// One step from the measured state `x0`: sets the parameter, shifts the previous
     /// solution (if any) and re-solves warm from it, or solves from the problem's initial
     /// point on the first step. The solution becomes the next step's warm start whatever
-    /// its status (the report tells the status).
+    /// its status (the report tells the status). With real-time iterations: prepares (if
+    /// [`Mpc::prepare`] has not) and runs the feedback.
     pub fn step(&mut self, x0: &[f64]) -> Result<StepReport, MpcError> {
         let start = Instant::now();
         let nx = self.nx;
@@ -192,31 +262,104 @@ impl Mpc {
             }
             .into());
         }
-        self.compiled.set_value(self.x0_parameter.as_str(), x0)?;
-        let warm = self.previous.is_some();
-        let sol = match self.previous.as_mut() {
-            Some(prev) => {
-                self.shift.apply(prev)?;
-                self.solver.solve_warm(&mut self.compiled, prev)?
+        let mut report = match &mut self.engine {
+            Engine::Solver { solver, compiled } => {
+                compiled.set_value(self.x0_parameter.as_str(), x0)?;
+                let sol = match self.previous.as_mut() {
+                    Some(prev) => {
+                        self.shift.apply(prev)?;
+                        solver.solve_warm(&mut **compiled, prev)?
+                    }
+                    None => solver.solve(&mut **compiled)?,
+                };
+                let report = solver_report(&sol, self.previous.is_some());
+                self.previous = Some(sol);
+                report
             }
-            None => self.solver.solve(&mut self.compiled)?,
+            Engine::Rti { .. } => self.rti_step(x0)?,
+        };
+        let plan = match &self.engine {
+            Engine::Solver { .. } => self.previous.as_ref().expect("solved above"),
+            Engine::Rti { rti, .. } => rti.plan(),
         };
         for (c, &j) in self.control.iter_mut().zip(&self.first_control) {
-            *c = sol.x[j];
+            *c = plan.x[j];
         }
-        let report = StepReport {
-            status: sol.status,
-            iterations: sol.stats.iterations,
-            seconds: 0.0,
-            solve_seconds: sol.stats.total_seconds,
-            objective: sol.objective,
-            warm,
+        report.seconds += start.elapsed().as_secs_f64();
+        Ok(report)
+    }
+
+    /// A real-time iteration step: the first solved to convergence, the others one
+    /// feedback after a preparation. `seconds` holds the preparation if it ran ahead.
+    fn rti_step(&mut self, x0: &[f64]) -> Result<StepReport, MpcError> {
+        let Engine::Rti { started, .. } = &self.engine else {
+            unreachable!("called for the RTI engine only")
         };
-        self.previous = Some(sol);
+        if !*started {
+            let Engine::Rti {
+                rti,
+                first,
+                started,
+                ..
+            } = &mut self.engine
+            else {
+                unreachable!("checked above")
+            };
+            rti.compiled_mut()
+                .set_value(self.x0_parameter.as_str(), x0)?;
+            let sol = first.solve(rti.compiled_mut())?;
+            rti.initialize(&sol)?;
+            *started = true;
+            return Ok(solver_report(&sol, false));
+        }
+        let ahead = match &self.engine {
+            Engine::Rti {
+                prepared: Some(t), ..
+            } => *t,
+            _ => 0.0,
+        };
+        let prepare_seconds = if ahead > 0.0 { 0.0 } else { self.prepare()? };
+        let Engine::Rti { rti, prepared, .. } = &mut self.engine else {
+            unreachable!("checked above")
+        };
+        let prepare_seconds = prepare_seconds + ahead;
+        *prepared = None;
+        let fb = rti.feedback(x0)?;
         Ok(StepReport {
-            seconds: start.elapsed().as_secs_f64(),
-            ..report
+            status: fb.status,
+            iterations: 1,
+            seconds: ahead,
+            solve_seconds: prepare_seconds + fb.seconds,
+            feedback_seconds: fb.seconds,
+            objective: rti.plan().objective,
+            warm: true,
         })
+    }
+
+    /// With real-time iterations: shifts the plan and runs the preparation phase now
+    /// (e.g. while waiting for the next measurement), so that the next [`Mpc::step`]
+    /// only runs the feedback; returns its wall seconds. Does nothing (0) for a solver,
+    /// before the first step, or when already prepared.
+    pub fn prepare(&mut self) -> Result<f64, MpcError> {
+        let Engine::Rti {
+            rti,
+            started: true,
+            prepared,
+            ..
+        } = &mut self.engine
+        else {
+            return Ok(0.0);
+        };
+        if prepared.is_some() {
+            return Ok(0.0);
+        }
+        let start = Instant::now();
+        rti.shift(&self.shift)?;
+        rti.prepare()?;
+        // A measured 0 still marks the plan prepared.
+        let t = start.elapsed().as_secs_f64().max(f64::MIN_POSITIVE);
+        *prepared = Some(t);
+        Ok(t)
     }
 
     /// Closes the loop for `steps` steps from `x_init`: each step solves from the
@@ -249,9 +392,16 @@ impl Mpc {
         &self.control
     }
 
-    /// The latest solution (the plan over the horizon), if a step was taken.
+    /// The latest solution (the plan over the horizon), if a step was taken. With
+    /// real-time iterations, [`Rti::plan`] (shifted once [`Mpc::prepare`] ran).
     pub fn solution(&self) -> Option<&Solution> {
-        self.previous.as_ref()
+        match &self.engine {
+            Engine::Solver { .. } => self.previous.as_ref(),
+            Engine::Rti {
+                rti, started: true, ..
+            } => Some(rti.plan()),
+            Engine::Rti { .. } => None,
+        }
     }
 
     /// The sampling period `T / N` (one stage of the grid): the plant must advance by it
@@ -262,12 +412,35 @@ impl Mpc {
 
     /// The compiled problem, e.g. to change other parameters (a reference) between steps.
     pub fn compiled_mut(&mut self) -> &mut Compiled {
-        &mut self.compiled
+        match &mut self.engine {
+            Engine::Solver { compiled, .. } => compiled,
+            Engine::Rti { rti, .. } => rti.compiled_mut(),
+        }
     }
 
     /// Forgets the previous solution: the next step solves from the problem's initial
     /// point (e.g. after a large disturbance).
     pub fn reset(&mut self) {
         self.previous = None;
+        if let Engine::Rti {
+            started, prepared, ..
+        } = &mut self.engine
+        {
+            *started = false;
+            *prepared = None;
+        }
+    }
+}
+
+/// The report of a solver's step (its `seconds` filled by the caller).
+fn solver_report(sol: &Solution, warm: bool) -> StepReport {
+    StepReport {
+        status: sol.status,
+        iterations: sol.stats.iterations,
+        seconds: 0.0,
+        solve_seconds: sol.stats.total_seconds,
+        feedback_seconds: sol.stats.total_seconds,
+        objective: sol.objective,
+        warm,
     }
 }

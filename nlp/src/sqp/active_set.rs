@@ -29,7 +29,9 @@ use std::collections::HashSet;
 use faer::sparse::SymbolicSparseColMat;
 
 use super::iterate::Mult;
-use super::polish::{equality_qp_step, jac_times, stationarity, Side, WorkingSet};
+use super::polish::{
+    equality_qp_step, jac_times, solve_working_set, stationarity, Side, WorkingSet,
+};
 use super::qp::{QpData, QpResult};
 use crate::kkt::Kkt;
 
@@ -125,6 +127,9 @@ pub(super) fn fits(w: &WorkingSet, p: &QpData) -> bool {
 /// Solves the QP of `p` from the working set `start` (see the module documentation).
 /// `jp`, `hp`: the patterns of `p.jac` and `p.hess`; `n_elastic`: the length of the
 /// (zero) elastic part of the result; every factorisation is counted in `n_fact`.
+/// `factored`: `kkt` already holds the factorisation of `start`'s equality QP for this
+/// B, J and weights (`polish::factor_working_set`, the real-time iteration's
+/// preparation), so the first iteration only solves with it.
 pub(super) fn solve(
     kkt: &mut Kkt,
     p: &QpData,
@@ -132,6 +137,7 @@ pub(super) fn solve(
     start: WorkingSet,
     (max_iter, n_elastic): (usize, usize),
     n_fact: &mut usize,
+    factored: bool,
 ) -> Result<Solved, Failure> {
     let (n, m) = (p.x.len(), p.g.len());
     if kkt.n() != n || kkt.m() != m || !fits(&start, p) {
@@ -144,7 +150,12 @@ pub(super) fn solve(
     // After a repeated working set, one change per iteration (the largest violation).
     let mut one_at_a_time = false;
     for iteration in 1..=max_iter {
-        let (d, lambda) = equality_qp_step(kkt, p, &w, n_fact).ok_or(Failure::EqualityQp)?;
+        let step = if factored && iteration == 1 {
+            solve_working_set(kkt, p, &w)
+        } else {
+            equality_qp_step(kkt, p, &w, n_fact)
+        };
+        let (d, lambda) = step.ok_or(Failure::EqualityQp)?;
         let s = stationarity(p, (jp, hp), &d, &lambda);
         let jd = jac_times(p, jp, &d);
         let lam_max = lambda.iter().chain(&s).fold(1.0f64, |a, v| a.max(v.abs()));
@@ -493,6 +504,7 @@ mod tests {
             cold(c),
             (50, 0),
             &mut n_fact,
+            false,
         ) {
             Ok(s) => s,
             Err(f) => {
@@ -525,6 +537,7 @@ mod tests {
             s.working_set.clone(),
             (50, 0),
             &mut n_fact,
+            false,
         )
         .unwrap_or_else(|f| panic!("{label}: warm start failed: {f:?}"));
         assert_eq!(n_fact - before, 1, "{label}");

@@ -37,7 +37,9 @@
 //! accepting or rejecting a step), `subproblem.rs` (the QP step with its retry policies
 //! and the elastic mode), `line_search.rs` (merit and line search), `convexify.rs`,
 //! `bfgs.rs`, `iterate.rs` (the iterate and its KKT error), `geometry.rs` (bounds,
-//! cones, violations), `qp.rs` (the clarabel subproblem), `polish.rs`, `stop.rs`.
+//! cones, violations), `qp.rs` (the clarabel subproblem), `polish.rs`, `stop.rs`;
+//! `rti.rs`: real-time iterations ([`Rti`]), one iteration per sampling instant split
+//! into a preparation and a feedback, built on the same parts.
 //! Scaling, evaluation counters and the returned `Solution` are the front end's
 //! (`frontend/scaled.rs`, `frontend/user_solution.rs`), shared with the IPM.
 
@@ -52,6 +54,7 @@ mod line_search;
 pub mod options;
 mod polish;
 pub(crate) mod qp;
+pub mod rti;
 mod state;
 mod stop;
 mod subproblem;
@@ -68,6 +71,7 @@ use crate::numeric::NumericNlp;
 use crate::solution::{IterationRecord, Solution};
 
 pub use options::{HessianApproximation, SqpOptions};
+pub use rti::{Feedback, Rti, RtiError, RtiResidual};
 use state::SqpState;
 use stop::Stop;
 

@@ -112,16 +112,40 @@ pub(super) fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64])
 /// a row i with weight w_i > 0 gets the diagonal −1/w_i (its multiplier is then
 /// w_i·J_i d, the term's gradient), a bound weight is added to the diagonal of B (rows
 /// and bounds of W need neither: the term is constant on W). `None` unless the inertia is
-/// (n, m) and the solve accurate.
+/// (n, m) and the solve accurate. The two halves, [`factor_working_set`] and
+/// [`solve_working_set`], may run apart (the real-time iteration factorises before the
+/// new initial state is known).
 pub(super) fn equality_qp_step(
     kkt: &mut Kkt,
     p: &QpData,
     w: &WorkingSet,
     n_fact: &mut usize,
 ) -> Option<(Vec<f64>, Vec<f64>)> {
+    if !factor_working_set(kkt, p, w, n_fact) {
+        return None;
+    }
+    solve_working_set(kkt, p, w)
+}
+
+/// Regularisation of the zero block of W's rows, removed again by iterative refinement.
+const ZERO_BLOCK_REG: f64 = 1e-10;
+
+/// The diagonal weight that fixes a bound of W (far above the Hessian's entries).
+fn fixing_weight(p: &QpData) -> f64 {
+    1e14 * p.hess.iter().fold(1.0f64, |a, v| a.max(v.abs()))
+}
+
+/// Factorises the KKT matrix of W's equality QP (see [`equality_qp_step`]): it depends on
+/// B, J, the weights and W, not on the constraint values or the point. `false` unless the
+/// inertia is (n, m).
+pub(super) fn factor_working_set(
+    kkt: &mut Kkt,
+    p: &QpData,
+    w: &WorkingSet,
+    n_fact: &mut usize,
+) -> bool {
     let (n, m) = (p.x.len(), p.g.len());
-    let hmax = p.hess.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let big = 1e14 * hmax;
+    let big = fixing_weight(p);
     let dx: Vec<f64> = (0..n)
         .map(|j| {
             p.shift
@@ -132,19 +156,28 @@ pub(super) fn equality_qp_step(
                 }
         })
         .collect();
-    const REG: f64 = 1e-10;
     let dc: Vec<f64> = (0..m)
         .map(|i| match (w.rows[i], p.row_weight[i]) {
             (Side::Free, r) if r > 0.0 => 1.0 / r,
             (Side::Free, _) => 1e20,
-            _ => REG,
+            _ => ZERO_BLOCK_REG,
         })
         .collect();
     *n_fact += 1;
-    match kkt.factorize(p.hess, &dx, p.jac, &dc) {
-        Ok(inertia) if inertia.positive == n && inertia.negative == m => {}
-        _ => return None,
-    }
+    matches!(kkt.factorize(p.hess, &dx, p.jac, &dc),
+        Ok(inertia) if inertia.positive == n && inertia.negative == m)
+}
+
+/// Solves W's equality QP with the factorisation [`factor_working_set`] left in `kkt`
+/// for the same B, J, weights and W (the point and the constraint values may differ).
+/// `None` when the solve is inaccurate.
+pub(super) fn solve_working_set(
+    kkt: &mut Kkt,
+    p: &QpData,
+    w: &WorkingSet,
+) -> Option<(Vec<f64>, Vec<f64>)> {
+    let (n, m) = (p.x.len(), p.g.len());
+    let big = fixing_weight(p);
     let mut rhs = vec![0.0; n + m];
     for j in 0..n {
         rhs[j] = -p.grad[j]
@@ -165,7 +198,7 @@ pub(super) fn equality_qp_step(
     let shift: Vec<f64> = (0..n + m)
         .map(|k| {
             if k >= n && w.rows[k - n] != Side::Free {
-                REG
+                ZERO_BLOCK_REG
             } else {
                 0.0
             }

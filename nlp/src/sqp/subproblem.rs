@@ -61,6 +61,7 @@ impl SqpState<'_> {
             start,
             (o.qp_active_set_max_iter as usize, self.qp.n_elastic()),
             &mut self.work.n_fact,
+            false,
         );
         self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
         let solved = solved.ok()?;
@@ -84,7 +85,7 @@ impl SqpState<'_> {
 }
 
 /// The QP data at iterate `it` with shift `shift` and penalty `rho`.
-fn qp_data<'d>(
+pub(super) fn qp_data<'d>(
     it: &'d Iterate,
     geo: &'d Geometry,
     curv: &'d Curvature,
