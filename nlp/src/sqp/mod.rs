@@ -26,7 +26,7 @@
 //! (tol 1e-8, s_max, dual_inf_tol, constr_viol_tol, compl_inf_tol, acceptable_*), on
 //! the problem scaled by the same gradient-based factors.
 //!
-//! In the iteration table, `lg(mu)` is log10 of the augmented weight ρ_a (the record's
+//! In the iteration table, `lg(ra)` is log10 of the augmented weight ρ_a (the record's
 //! `augmented_weight`; "-" when 0),
 //! `lg(rg)` is the Hessian shift δ,
 //! the 'r' mark after the iteration number flags elastic mode, and the step character

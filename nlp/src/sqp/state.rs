@@ -309,7 +309,7 @@ impl<'a> SqpState<'a> {
         self.stats.records.push(self.record);
         if o.print_level >= 5 {
             if iter % 10 == 0 {
-                println!("{}", crate::log::header());
+                println!("{}", crate::log::Columns::Sqp.header());
             }
             println!("{}", crate::log::format_record(&self.record));
         }
