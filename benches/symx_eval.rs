@@ -38,6 +38,9 @@
 //! Hessian, with the JIT's compile times (benches/reference/native_casadi.py measures
 //! CasADi's VM and its generated C on the same functions).
 //!
+//! `native_compile` (`cargo bench --bench symx_eval -- native_compile`): the JIT's compile
+//! time per 1000 instructions at several sizes (linear if flat).
+//!
 //! `map` (`cargo bench --bench symx_eval -- map`): 10 000 evaluations of the RK4 step F
 //! with `Function::map`, serial and on 2 threads.
 use criterion::{criterion_group, BenchmarkId, Criterion, SamplingMode};
@@ -55,6 +58,9 @@ mod hanging_chain;
 mod quadrotor_ocp;
 
 const LINKS: usize = 1000;
+
+/// Stages of the quadrotor OCP in the native groups (issue 24's size).
+const NATIVE_STAGES: usize = 320;
 
 /// An NLP in symbolic form: objective, constraints, variables.
 struct Symbolic {
@@ -590,7 +596,7 @@ fn bench_native(c: &mut Criterion) {
         native_versus_tape(c, "native_gap", &fns, [&x, &sigma, &lambda]);
     }
     if selected("native_quadrotor/eval/hess_L") {
-        const STAGES: usize = 320;
+        const STAGES: usize = NATIVE_STAGES;
         let o = quadrotor_ocp::build(STAGES, false);
         let fns = compile(&differentiate(Symbolic {
             f: o.f,
@@ -603,13 +609,64 @@ fn bench_native(c: &mut Criterion) {
     }
 }
 
+/// `native_compile` (`cargo bench --bench symx_eval -- native_compile`): the JIT's
+/// compile time of ∇f, ∂g/∂x and the Hessian against their size, on the hanging chain and
+/// the quadrotor OCP (inlined RK4) at several sizes and on the gap model: one line per
+/// function with the instructions, the compile time (median of 3) and the time per 1000
+/// instructions, which stays flat when compile time is linear in the size.
+fn bench_native_compile(_c: &mut Criterion) {
+    if !selected("native_compile") {
+        return;
+    }
+    let report = |problem: String, fns: &Compiled| {
+        for (name, f) in [
+            ("grad_f", &fns.grad),
+            ("jac_g", &fns.jac),
+            ("hess_L", &fns.hess),
+        ] {
+            let mut ms: Vec<f64> = (0..3)
+                .map(|_| {
+                    let t = Instant::now();
+                    black_box(f.jit().unwrap());
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect();
+            ms.sort_by(f64::total_cmp);
+            let n = f.instruction_count();
+            eprintln!(
+                "native_compile {problem:16} {name:6} instructions {n:8}  compile {:9.2} ms  {:6.3} ms per 1000 instructions",
+                ms[1],
+                1e3 * ms[1] / n as f64
+            );
+        }
+    };
+    for links in [125, 250, 500, 1000, 2000] {
+        report(
+            format!("chain_{links}"),
+            &compile(&differentiate(chain(links).0)),
+        );
+    }
+    for stages in [10, 20, 40, 80] {
+        let o = quadrotor_ocp::build(stages, false);
+        let fns = compile(&differentiate(Symbolic {
+            f: o.f,
+            g: o.g,
+            x: o.w,
+        }));
+        report(format!("quadrotor_{stages}"), &fns);
+    }
+    let m = gap_model(&gap_scenario());
+    report("gap".into(), &compile(&differentiate(gap_symbolic(&m))));
+}
+
 criterion_group!(
     benches,
     bench,
     bench_gap,
     bench_ocp,
     bench_map,
-    bench_native
+    bench_native,
+    bench_native_compile
 );
 
 /// With `SYMX_OCP_MEMORY=inlined | calls | none` in the environment the binary builds,
@@ -637,9 +694,100 @@ fn memory_run(mode: &str) {
     );
 }
 
+/// With `SYMX_NATIVE_PROFILE=problem:function:evaluator:calls` in the environment
+/// (`problem` one of `gap`, `quadrotor`, `chain`; `function` one of `grad_f`, `jac_g`,
+/// `hess_L`; `evaluator` `tape` or `jit`), the binary calls that function `calls` times
+/// inside [`hot_loop`] and exits: run under `valgrind --tool=callgrind
+/// --collect-atstart=no --toggle-collect='*hot_loop*'`, the instructions counted divided by
+/// `calls` are the instructions per call (benches/reference/native_side_by_side.sh). It
+/// then prints the per-call median wall time of [`per_call`].
+fn profile_run(spec: &str) {
+    let parts: Vec<&str> = spec.split(':').collect();
+    let [problem, function, evaluator, calls] = parts[..] else {
+        eprintln!("SYMX_NATIVE_PROFILE={spec}: expected problem:function:evaluator:calls");
+        std::process::exit(2);
+    };
+    let (fns, x, sigma, lambda) = match problem {
+        "gap" => {
+            let m = gap_model(&gap_scenario());
+            let fns = compile(&differentiate(gap_symbolic(&m)));
+            let compiled = m.problem.compile().unwrap();
+            let mut x0 = vec![0.0; compiled.n()];
+            compiled.initial_point(&mut x0);
+            let (x, s, l) = inputs(compiled.m(), &x0);
+            (fns, x, s, l)
+        }
+        "quadrotor" => {
+            let o = quadrotor_ocp::build(NATIVE_STAGES, false);
+            let fns = compile(&differentiate(Symbolic {
+                f: o.f,
+                g: o.g,
+                x: o.w,
+            }));
+            let m = (NATIVE_STAGES + 1) * quadrotor_ocp::NX;
+            let (x, s, l) = inputs(m, &quadrotor_ocp::point(NATIVE_STAGES));
+            (fns, x, s, l)
+        }
+        "chain" => {
+            let (p, x0) = chain(LINKS);
+            let fns = compile(&differentiate(p));
+            let (x, s, l) = inputs(LINKS, &x0);
+            (fns, x, s, l)
+        }
+        other => {
+            eprintln!("SYMX_NATIVE_PROFILE: unknown problem '{other}' (gap, quadrotor, chain)");
+            std::process::exit(2);
+        }
+    };
+    let all = [&x[..], &sigma[..], &lambda[..]];
+    let (f, args) = match function {
+        "grad_f" => (&fns.grad, &all[..1]),
+        "jac_g" => (&fns.jac, &all[..1]),
+        "hess_L" => (&fns.hess, &all[..]),
+        other => {
+            eprintln!("SYMX_NATIVE_PROFILE: unknown function '{other}' (grad_f, jac_g, hess_L)");
+            std::process::exit(2);
+        }
+    };
+    let native;
+    let f = match evaluator {
+        "tape" => f,
+        "jit" => {
+            native = f.jit().unwrap();
+            &native
+        }
+        other => {
+            eprintln!("SYMX_NATIVE_PROFILE: unknown evaluator '{other}' (tape, jit)");
+            std::process::exit(2);
+        }
+    };
+    let calls: usize = calls.parse().unwrap_or(100);
+    let mut out = vec![0.0; f.output_sizes()[0]];
+    let mut work = vec![0.0; f.work_size()];
+    hot_loop(f, args, &mut out, &mut work, calls);
+    let sum: f64 = out.iter().sum();
+    let (median, _) = per_call(f, args);
+    eprintln!(
+        "{problem} {function} {evaluator}: {calls} calls, sum {sum:.16e}, per-call median {median:.3} us"
+    );
+}
+
+/// `calls` evaluations of `f` (the region callgrind counts in [`profile_run`]).
+#[inline(never)]
+fn hot_loop(f: &Function, args: &[&[f64]], out: &mut [f64], work: &mut [f64], calls: usize) {
+    for _ in 0..calls {
+        f.eval(black_box(args), &mut [&mut *out], work).unwrap();
+        black_box(&out);
+    }
+}
+
 fn main() {
     if let Ok(mode) = std::env::var("SYMX_OCP_MEMORY") {
         memory_run(&mode);
+        return;
+    }
+    if let Ok(spec) = std::env::var("SYMX_NATIVE_PROFILE") {
+        profile_run(&spec);
         return;
     }
     benches();

@@ -15,6 +15,10 @@ For each function:
 Run (takes several minutes, mostly gcc):
   cargo build --release -p gap_crossing --example export
   python3 benches/reference/native_casadi.py --export-bin target/release/examples/export
+With `--problem quadrotor` (and `--stages N`, default 320) the functions are those of the
+quadrotor OCP of benches/reference/ocp_chain_casadi.py (RK4 inlined), the `native_quadrotor`
+group; `--export-bin` is then not needed. `--only grad_f,jac_g` limits the functions (gcc
+on the quadrotor's Hessian takes very long).
 With `--keep DIR` the C files and executables stay in DIR, and a later run with the same DIR
 reuses them (the gcc time recorded the first time), so repeated side-by-side timings take
 seconds.
@@ -106,16 +110,34 @@ def casadi_c(name, F, inputs, out_nnz, tmp):
     return gcc_s, float(out[0]), float(out[1]), os.path.getsize(src)
 
 
+def quadrotor(stages):
+    """The quadrotor OCP's three functions, expressions and initial point (as
+    `build_all` returns them for the gap model)."""
+    import ocp_chain_casadi as oc
+    w, f, g = oc.build(stages)
+    sigma = ca.SX.sym("sigma")
+    lam = ca.SX.sym("lambda", g.numel())
+    exprs = {"grad_f": ([w], ca.gradient(f, w)), "jac_g": ([w], ca.jacobian(g, w)),
+             "hess_L": ([w, sigma, lam], ca.tril(ca.hessian(sigma * f + ca.dot(lam, g), w)[0]))}
+    funcs = [ca.Function(k, v[0], [v[1]]) for k, v in exprs.items()]
+    return funcs, exprs, np.array(oc.point(stages)), g.numel()
+
+
 def run(d, args):
-    (x, f, g), funcs, syms, _, exprs = build_all(d)
-    n, m = d["n"], d["m"]
-    x0 = np.array([v["x0"] for v in d["variables"]])
+    if args.problem == "quadrotor":
+        funcs, exprs, x0, m = quadrotor(args.stages)
+    else:
+        (x, f, g), funcs, syms, _, exprs = build_all(d)
+        x0 = np.array([v["x0"] for v in d["variables"]])
+        m = d["m"]
     lam0 = np.array([(i + 1) / m for i in range(m)])
     inputs = {"grad_f": [x0], "jac_g": [x0], "hess_L": [x0, 1.0, lam0]}
     rows = {}
     with (contextlib.nullcontext(args.keep) if args.keep else tempfile.TemporaryDirectory()) as tmp:
         os.makedirs(tmp, exist_ok=True)
         for name, F in zip(["grad_f", "jac_g", "hess_L"], funcs):
+            if args.only and name not in args.only.split(","):
+                continue
             ins = [ca.DM(a) for a in inputs[name]]
             nnz = F(*ins).nnz()
             rec = ca.Function(name + "_timed", exprs[name][0], [exprs[name][1]], {"record_time": True})
@@ -129,12 +151,20 @@ def run(d, args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--export-bin", required=True)
+    ap.add_argument("--export-bin", help="the gap model's export example (for --problem gap)")
+    ap.add_argument("--problem", choices=["gap", "quadrotor"], default="gap")
+    ap.add_argument("--stages", type=int, default=320, help="stages of the quadrotor OCP")
+    ap.add_argument("--only", help="comma-separated functions to measure (default: all three)")
     ap.add_argument("--no-symx", action="store_true", help="skip running the symx bench")
     ap.add_argument("--keep", metavar="DIR", help="keep the generated C and executables in DIR and "
                     "reuse them on later runs (no gcc: repeat the timings side by side)")
     args = ap.parse_args()
-    d = json.loads(subprocess.run([args.export_bin], check=True, stdout=subprocess.PIPE).stdout)
+    if args.problem == "gap":
+        if not args.export_bin:
+            ap.error("--export-bin is required for --problem gap")
+        d = json.loads(subprocess.run([args.export_bin], check=True, stdout=subprocess.PIPE).stdout)
+    else:
+        d = None
     result = {}
     sys.setrecursionlimit(1_000_000)
     threading.stack_size(512 * 1024 * 1024)
@@ -143,10 +173,10 @@ def main():
     t.join()
     rows = result["rows"]
     if not args.no_symx:
-        log = subprocess.run(["cargo", "bench", "--bench", "symx_eval", "--", "native_gap", "--noplot",
+        log = subprocess.run(["cargo", "bench", "--bench", "symx_eval", "--", f"native_{args.problem}", "--noplot",
                               "--warm-up-time", "0.1", "--measurement-time", "0.1"],
                              check=True, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True).stderr
-        pat = re.compile(r"^native_gap (\w+)\s+instructions\s+(\d+)\s+jit compile\s+([\d.]+) ms\s+tape\s+([\d.]+) us\s+jit\s+([\d.]+) us")
+        pat = re.compile(r"^native_\w+ (\w+)\s+instructions\s+(\d+)\s+jit compile\s+([\d.]+) ms\s+tape\s+([\d.]+) us\s+jit\s+([\d.]+) us")
         for line in log.splitlines():
             mt = pat.match(line)
             if mt and mt.group(1) in rows:

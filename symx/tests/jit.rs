@@ -283,3 +283,47 @@ fn long_tapes_match_the_tape() {
     assert_eq!(out, first[0]);
     assert_eq!(native.tape().evaluator(), Evaluator::Tape);
 }
+
+/// Independent isomorphic lanes, which the JIT evaluates two at a time in SIMD registers
+/// (`f64x2`): every pairable operation (`+ − × ÷`, negation, square, square root, absolute
+/// value) on every pair of special operands, NaNs of different signs and payloads in both
+/// operands included (x86 returns the first operand's NaN, so swapped operands would show),
+/// with constants, results reused by later scalar code, and outputs both side by side and
+/// scattered.
+#[test]
+fn paired_lanes_match_the_tape_on_special_values() {
+    let mut special = SPECIAL.to_vec();
+    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
+    special.push(f64::from_bits(0xfff8_0000_0000_0002));
+    special.push(-f64::NAN);
+    let n = special.len();
+    let x = Matrix::sym_vec("x", n);
+    let y = Matrix::sym_vec("y", n);
+    let binary: [fn(Expr, Expr) -> Expr; 4] =
+        [|a, b| a + b, |a, b| a - b, |a, b| a * b, |a, b| a / b];
+    let unary: [fn(Expr) -> Expr; 4] = [|a| -a, |a| a.sq(), |a| a.sqrt(), |a| a.abs()];
+    for (k, op) in binary.iter().enumerate() {
+        for (u, un) in unary.iter().enumerate() {
+            // Lane i: a group of a few instructions on x[i], y[i] and constants.
+            let lanes: Vec<Expr> = (0..n)
+                .map(|i| {
+                    let c = 0.5 + i as f64;
+                    let t = op(x[i], y[i]);
+                    let s = op(un(t), c.into());
+                    op(s, x[i]) + op(y[i], t)
+                })
+                .collect();
+            // Scalar code reading the lanes' results: a chain across the lanes.
+            let mut tail = lanes.clone();
+            let chain = lanes.iter().fold(Expr::from(0.0), |acc, &l| acc * 0.5 + l);
+            tail.push(chain);
+            let scattered: Vec<Expr> = lanes.iter().rev().step_by(2).copied().collect();
+            let f = Function::new(&[&x, &y], &[&tail, &scattered]).unwrap();
+            for shift in 0..n {
+                let xs: Vec<f64> = (0..n).map(|i| special[(i + shift) % n]).collect();
+                let ys: Vec<f64> = (0..n).map(|i| special[(i * 7 + k + u) % n]).collect();
+                same_bits(&f, &[&xs, &ys]);
+            }
+        }
+    }
+}

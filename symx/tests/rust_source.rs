@@ -108,3 +108,73 @@ fn unsupported_operations_are_errors() {
         other => panic!("{other:?}"),
     }
 }
+
+/// docs/dsl.md's `build.rs` recipe, compiled: the build script's body runs here (writing
+/// the module into an `OUT_DIR`), and the firmware crate's `src/lib.rs`, verbatim from the
+/// docs plus `#![no_std]`, is compiled by rustc as a library with that `OUT_DIR`, then
+/// called from a program that checks its value against the tape.
+#[test]
+fn the_docs_build_rs_recipe_compiles_and_computes_the_tape_values() {
+    let dir = std::env::temp_dir().join(format!("symx_build_rs_{}", std::process::id()));
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    // build.rs, as in the docs (OUT_DIR given here rather than by cargo).
+    let x = Matrix::sym_vec("x", 2);
+    let f = Function::new(&[&x], &[&[x[0].sin() * x[1]]]).unwrap();
+    std::fs::write(out_dir.join("model.rs"), f.to_rust().unwrap()).unwrap();
+    // src/lib.rs, as in the docs.
+    let lib = r#"#![no_std]
+mod model {
+    include!(concat!(env!("OUT_DIR"), "/model.rs"));
+}
+pub fn step(x: &[f64; 2], y: &mut [f64; 1]) -> Result<(), &'static str> {
+    let mut work = [0.0; model::WORK_SIZE];
+    model::eval(&[x], &mut [y], &mut work)
+}
+"#;
+    std::fs::write(dir.join("lib.rs"), lib).unwrap();
+    std::fs::write(
+        dir.join("main.rs"),
+        "fn main() { let mut y = [0.0]; firmware::step(&[0.3, -1.7], &mut y).unwrap(); println!(\"{:x}\", y[0].to_bits()); }",
+    )
+    .unwrap();
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let status = Command::new(&rustc)
+        .args([
+            "-O",
+            "--edition",
+            "2021",
+            "--crate-type",
+            "rlib",
+            "--crate-name",
+            "firmware",
+            "-o",
+        ])
+        .arg(dir.join("libfirmware.rlib"))
+        .arg(dir.join("lib.rs"))
+        .env("OUT_DIR", &out_dir)
+        .status()
+        .expect("rustc runs");
+    assert!(status.success(), "the docs' src/lib.rs does not compile");
+    let exe = dir.join("main");
+    let status = Command::new(&rustc)
+        .args(["-O", "--edition", "2021", "--extern"])
+        .arg(format!(
+            "firmware={}",
+            dir.join("libfirmware.rlib").display()
+        ))
+        .arg("-o")
+        .arg(&exe)
+        .arg(dir.join("main.rs"))
+        .status()
+        .expect("rustc runs");
+    assert!(
+        status.success(),
+        "the program calling the firmware crate does not compile"
+    );
+    let out = Command::new(&exe).output().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let bits = u64::from_str_radix(String::from_utf8(out.stdout).unwrap().trim(), 16).unwrap();
+    let want = f.call(&[&[0.3, -1.7]]).unwrap()[0][0];
+    assert_eq!(bits, want.to_bits());
+}

@@ -11,13 +11,14 @@
 //! to be spilled); a backward liveness pass decides. Constants are immediates, and only
 //! the constant outputs of the template are written. A call of another function gathers its arguments into the scratch block and
 //! calls that function's machine code, compiled once in the same module.
+use super::lanes::{self, Operand, Step};
 use super::{Entry, SymxError};
 use crate::function::{Function, Instr};
 use crate::op::{self, Op};
 use crate::table::Table;
 use cranelift_codegen::ir::{
-    condcodes::FloatCC, immediates::Ieee64, types, AbiParam, InstBuilder, MemFlags, SigRef,
-    Signature, StackSlot, StackSlotData, StackSlotKind, Value,
+    condcodes::FloatCC, immediates::Ieee64, types, AbiParam, ConstantData, Endianness, InstBuilder,
+    MemFlags, SigRef, Signature, StackSlot, StackSlotData, StackSlotKind, Value,
 };
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_codegen::Context;
@@ -139,6 +140,8 @@ struct Layout<'a> {
     f: &'a Function,
     /// Whether instruction `i`'s result must be stored to the work vector.
     store: Vec<bool>,
+    /// The last instruction reading instruction `i`'s result (see [`lanes::last_reader`]).
+    last_reader: Vec<usize>,
     /// Registers holding a constant (never written, in the template): their values.
     constant: Vec<Option<f64>>,
     /// Which template entries the machine code must write (see [`template_stores`]).
@@ -179,6 +182,12 @@ impl Jit {
             input_of: entries(&f.input_sizes, &f.input_offsets),
             output_of: entries(&f.output_sizes, &f.output_offsets),
             store: stores(f),
+            last_reader: lanes::last_reader(f, |ins, visit| {
+                reads(f, ins, &mut *visit);
+                if ins.op == Op::InterpolantN {
+                    (ins.a..ins.a + ins.b).for_each(&mut *visit);
+                }
+            }),
             template_stores: template_stores(f, &constant),
             constant,
             callees,
@@ -269,8 +278,22 @@ impl Jit {
             e.template();
         }
         for &(start, end) in ranges {
-            for i in start..end {
-                e.instruction(i);
+            let regs = lanes::Registers {
+                constant: &layout.constant,
+                input_of: &layout.input_of,
+                output_of: &layout.output_of,
+                store: &layout.store,
+                last_reader: &layout.last_reader,
+            };
+            for step in lanes::steps(layout.f, &regs, start, end) {
+                match step {
+                    Step::Single(i) => e.instruction(i),
+                    Step::Pair {
+                        start,
+                        len,
+                        operands,
+                    } => e.pair(start, len, &operands),
+                }
             }
         }
         b.ins().return_(&[]);
@@ -523,8 +546,9 @@ impl<'a, 'b> Emitter<'a, 'b> {
     /// would change a NaN's sign or payload.
     fn operand(&mut self, r: u32, first: bool) -> Value {
         if let Some((v, last)) = self.values.get_mut(&r) {
-            if self.at - *last <= WINDOW {
-                *last = self.at;
+            // (A paired instruction may read before a later-positioned access of its pair.)
+            if self.at.saturating_sub(*last) <= WINDOW {
+                *last = (*last).max(self.at);
                 return *v;
             }
         }
@@ -549,6 +573,144 @@ impl<'a, 'b> Emitter<'a, 'b> {
         };
         self.values.insert(r, (v, self.at));
         v
+    }
+
+    /// Where register `r` would be loaded from by [`Emitter::operand`] at instruction `at`
+    /// (`None`: its SSA value is live, or it is a constant).
+    fn memory(&self, r: u32, at: usize) -> Option<(Value, i32)> {
+        if let Some(&(_, last)) = self.values.get(&r) {
+            if at.saturating_sub(last) <= WINDOW {
+                return None;
+            }
+        }
+        match (
+            self.layout.constant[r as usize],
+            self.layout.input_of[r as usize],
+        ) {
+            (Some(_), _) => None,
+            (None, Some((k, i))) => Some((self.params.inputs[k as usize], 8 * i as i32)),
+            (None, None) => Some((self.w, 8 * r as i32)),
+        }
+    }
+
+    /// The two lanes `(r1 at at1, r2 at at2)` as one `f64x2`: one load when both lie
+    /// side by side in memory, one constant when both are constants, else the two scalars
+    /// put together. With `first` (the first operand of a commutative operation) a loaded
+    /// vector is loaded as integers, for the reason given at [`Emitter::operand`].
+    fn lanes(&mut self, (r1, at1): (u32, usize), (r2, at2): (u32, usize), first: bool) -> Value {
+        let ty = types::F64X2;
+        let c = &self.layout.constant;
+        if let (Some(x), Some(y)) = (c[r1 as usize], c[r2 as usize]) {
+            let bytes: Vec<u8> = [x, y].iter().flat_map(|v| v.to_le_bytes()).collect();
+            let k = self.b.func.dfg.constants.insert(ConstantData::from(bytes));
+            return self.b.ins().vconst(ty, k);
+        }
+        if let (Some((b1, o1)), Some((b2, o2))) = (self.memory(r1, at1), self.memory(r2, at2)) {
+            if b1 == b2 && o2 == o1 + 8 {
+                let flags = MemFlags::new().with_notrap();
+                let v = if first {
+                    let bits = self.b.ins().load(types::I64X2, flags, b1, o1);
+                    let little = MemFlags::new().with_endianness(Endianness::Little);
+                    self.b.ins().bitcast(ty, little, bits)
+                } else {
+                    self.b.ins().load(ty, flags, b1, o1)
+                };
+                // The scalars stay reachable as lanes of the vector.
+                for (r, at, lane) in [(r1, at1, 0), (r2, at2, 1)] {
+                    let x = self.b.ins().extractlane(v, lane);
+                    self.values.insert(r, (x, at));
+                }
+                return v;
+            }
+        }
+        self.at = at1;
+        let x = self.operand(r1, first);
+        self.at = at2;
+        let y = self.operand(r2, first);
+        let v = self.b.ins().scalar_to_vector(ty, x);
+        self.b.ins().insertlane(v, y, 1)
+    }
+
+    /// Instructions `start..start + 2 len` as `len` SIMD instructions (see
+    /// [`lanes::steps`]); the results then set their registers in tape order, so the work
+    /// vector and the outputs end as the scalar code leaves them.
+    fn pair(&mut self, start: usize, len: usize, operands: &[[Operand; 2]]) {
+        let f = self.layout.f;
+        let mut vectors: Vec<Value> = Vec::with_capacity(len);
+        for (j, ops) in operands.iter().enumerate() {
+            let op = f.tape[start + j].op;
+            let (at1, at2) = (start + j, start + len + j);
+            let commutative = matches!(op, Op::Add | Op::Mul);
+            let get = |e: &mut Self, p: usize| match ops[p] {
+                Operand::Internal(m) => vectors[m],
+                Operand::External(r1, r2) => e.lanes((r1, at1), (r2, at2), p == 0 && commutative),
+            };
+            let a = get(self, 0);
+            let v = match op {
+                Op::Neg => self.b.ins().fneg(a),
+                Op::Sq => self.b.ins().fmul(a, a),
+                Op::Sqrt => self.b.ins().sqrt(a),
+                Op::Abs => self.b.ins().fabs(a),
+                _ => {
+                    let b = get(self, 1);
+                    match op {
+                        Op::Add => self.b.ins().fadd(a, b),
+                        Op::Sub => self.b.ins().fsub(a, b),
+                        Op::Mul => self.b.ins().fmul(a, b),
+                        Op::Div => self.b.ins().fdiv(a, b),
+                        _ => unreachable!("{op:?} is not paired (lanes::pairable)"),
+                    }
+                }
+            };
+            vectors.push(v);
+        }
+        self.commit(start, len, &vectors);
+    }
+
+    /// Sets the registers of a pair's instructions from their lanes, in tape order; an
+    /// output entry and the next one written by the two lanes of one vector are stored
+    /// together.
+    fn commit(&mut self, start: usize, len: usize, vectors: &[Value]) {
+        let f = self.layout.f;
+        let window = &f.tape[start..start + 2 * len];
+        let once = |d: u32| window.iter().filter(|w| w.d == d).count() == 1;
+        let mut stored = vec![false; len];
+        for lane in 0..2u8 {
+            for (j, &v) in vectors.iter().enumerate() {
+                let i = start + lane as usize * len + j;
+                let d = f.tape[i].d;
+                self.at = i;
+                let x = self.b.ins().extractlane(v, lane);
+                self.values.insert(d, (x, i));
+                if lane == 1 && stored[j] {
+                    continue;
+                }
+                let store = self.layout.store[i];
+                let out = self.layout.output_of[d as usize];
+                if lane == 0 {
+                    let d2 = f.tape[i + len].d;
+                    let out2 = self.layout.output_of[d2 as usize];
+                    let side_by_side = matches!((out, out2), (Some((k, a)), Some((k2, b))) if k == k2 && b == a + 1);
+                    if side_by_side
+                        && store == self.layout.store[i + len]
+                        && (!store || d2 == d + 1)
+                        && once(d)
+                        && once(d2)
+                    {
+                        let (k, a) = out.expect("an output");
+                        let flags = MemFlags::new().with_notrap();
+                        let base = self.params.outputs[k as usize];
+                        self.b.ins().store(flags, v, base, 8 * a as i32);
+                        if store {
+                            self.b.ins().store(flags, v, self.w, 8 * d as i32);
+                        }
+                        stored[j] = true;
+                        continue;
+                    }
+                }
+                self.put(d, x, store);
+            }
+        }
     }
 
     /// Sets register `r` to `v`: stored to the work vector if `store`, and to the caller's

@@ -9,6 +9,8 @@
 mod c_source;
 #[cfg(feature = "jit")]
 mod jit;
+#[cfg(feature = "jit")]
+mod lanes;
 mod rust_source;
 
 use crate::error::SymxError;
