@@ -49,10 +49,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 use symx::{gradient, jacobian, lagrangian_hessian, Expr, Function, Matrix, SparseMatrix};
 
-#[path = "common/hanging_chain.rs"]
-mod hanging_chain;
-#[path = "common/quadrotor_ocp.rs"]
-mod quadrotor_ocp;
+use testkit::{hanging_chain, quadrotor_ocp};
 
 const LINKS: usize = 1000;
 

@@ -9,7 +9,6 @@
 //! Each builder uses the published starting point (feasible or not) and bounds. The
 //! same formulations, in CasADi, are in `benches/reference/hs_casadi.py`: keep both in
 //! sync. Variables are named as in the book: `x1` is `x[0]`.
-use symnlp::{nlp, symx};
 
 use nlp::{bounded, BuildError, Problem, Relation};
 use symx::{Expr, Matrix};
