@@ -36,7 +36,7 @@ use nlp::{
     SqpOptions,
 };
 
-use testkit::hs::{harness, problems, SUITE};
+use testkit::hs::{harness, SUITE};
 use testkit::mpcc as mpcc_problems;
 use testkit::mpcc_names;
 use testkit::socp as socp_problems;
