@@ -14,15 +14,12 @@
 //! `python3 benches/reference/solve_casadi.py`: iterations, status, objective, median
 //! solve wall time (5 solves up to 10³ variables, 3 at 10⁴, 1 at 10⁵), compile time,
 //! and the time split of the median solve.
-#[path = "common/solve_problems.rs"]
-mod solve_problems;
-
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 use nlp::{CommonOptions, Compiled, Ipm, IpmOptions, Problem, Solution};
-use solve_problems::{hanging_chain, van_der_pol, CHAIN_SIZES, OCP_SIZES};
+use testkit::solve_problems::{hanging_chain, van_der_pol, CHAIN_SIZES, OCP_SIZES};
 
 type Builder = fn(usize) -> Problem;
 type Sizes = [(u32, usize); 4];

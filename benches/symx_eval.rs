@@ -20,7 +20,7 @@
 //! evaluation at the problem's initial point with σ = 1, λᵢ = (i+1)/m.
 //!
 //! `ocp_chain_inlined` and `ocp_chain_calls` (`cargo bench --bench symx_eval -- ocp_chain`):
-//! the same quantities on the quadrotor OCP of benches/common/quadrotor_ocp.rs (12 states,
+//! the same quantities on the quadrotor OCP of testkit/src/quadrotor_ocp.rs (12 states,
 //! 4 controls, N = 1000 stages, RK4, multiple shooting), with the RK4 step written out at
 //! every stage or compiled once and called (call nodes); the build phase includes compiling
 //! the step function, and its derivative functions are built inside the derivative phases.
@@ -52,10 +52,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 use symx::{gradient, jacobian, lagrangian_hessian, Expr, Function, Matrix, SparseMatrix};
 
-#[path = "common/hanging_chain.rs"]
-mod hanging_chain;
-#[path = "common/quadrotor_ocp.rs"]
-mod quadrotor_ocp;
+use testkit::{hanging_chain, quadrotor_ocp};
 
 const LINKS: usize = 1000;
 

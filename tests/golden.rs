@@ -36,28 +36,14 @@ use nlp::{
     SqpOptions,
 };
 
-#[path = "hs/problems.rs"]
-#[allow(dead_code)]
-mod problems;
-
-#[path = "hs/harness.rs"]
-#[macro_use]
-#[allow(dead_code)]
-mod harness;
-
-#[path = "mpcc/problems.rs"]
-#[macro_use]
-#[allow(dead_code)]
-mod mpcc_problems;
-
-#[path = "socp/problems.rs"]
-mod socp_problems;
+use testkit::hs::{harness, SUITE};
+use testkit::mpcc as mpcc_problems;
+use testkit::mpcc_names;
+use testkit::socp as socp_problems;
 
 #[allow(dead_code)] // the example's `main` is not called here
 #[path = "../examples/race_car.rs"]
 mod race_car;
-
-hs_list!();
 
 /// Relative tolerance on the objective, relative to max(1, |f|). The iteration count
 /// pins the path; the objective catches an end point that differs at the same count.

@@ -10,44 +10,15 @@
 #[path = "../examples/mpc_cart_pole.rs"]
 mod mpc_cart_pole;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-
 use symnlp::nlp::ocp::Transcription;
 use symnlp::nlp::{Compiled, Ipm, Solution};
-
-struct Counting;
-
-static ACTIVE: AtomicBool = AtomicBool::new(false);
-static COUNT: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ACTIVE.load(Ordering::SeqCst) {
-            COUNT.fetch_add(1, Ordering::SeqCst);
-        }
-        System.alloc(layout)
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if ACTIVE.load(Ordering::SeqCst) {
-            COUNT.fetch_add(1, Ordering::SeqCst);
-        }
-        System.realloc(ptr, layout, new_size)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-}
+use testkit::alloc::Counting;
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
 fn allocations_during<T>(f: impl FnOnce() -> T) -> (T, usize) {
-    COUNT.store(0, Ordering::SeqCst);
-    ACTIVE.store(true, Ordering::SeqCst);
-    let out = f();
-    ACTIVE.store(false, Ordering::SeqCst);
-    (out, COUNT.load(Ordering::SeqCst))
+    Counting::during(f)
 }
 
 fn same_bits(a: &[f64], b: &[f64]) -> bool {

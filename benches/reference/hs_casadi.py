@@ -1,6 +1,6 @@
-"""Hock–Schittkowski problems in CasADi, solved with IPOPT (reference for tests/hs.rs).
+"""Hock–Schittkowski problems in CasADi, solved with IPOPT (reference for nlp/tests/hs.rs).
 
-Same formulations, bounds and starting points as the Rust suite in tests/hs/problems.rs
+Same formulations, bounds and starting points as the Rust suite in testkit/src/hs/problems.rs
 (W. Hock, K. Schittkowski, "Test Examples for Nonlinear Programming Codes", LNEMS 187,
 Springer 1981; optimal values as corrected in K. Schittkowski, "An updated set of 306
 test problems for nonlinear programming with validated optimal solutions", 2008).
@@ -18,7 +18,7 @@ IPOPT options: tol 1e-8 (IPOPT's default), everything else default.
     python3 benches/reference/hs_casadi.py --compare OURS.json IPOPT.json
 
 prints the Markdown comparison table of docs/performance.md from the JSON lines of
-`cargo test --release --test hs -- --ignored --nocapture hs_summary` and of this script.
+`cargo test --release -p nlp --test hs -- --ignored --nocapture hs_summary` and of this script.
 """
 import json
 import math

@@ -8,7 +8,7 @@ Usage (from the repository root):
         > benches/reference/results/hs_exact_adaptive_ipopt.jsonl
 symnlp's side:
     OPT=hessian_approximation=exact,mu_strategy=adaptive cargo test --release \
-        --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary
+        -p nlp --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary
 (add ,mu_oracle=probing for the probing oracle).
 """
 import sys, json

@@ -2,7 +2,7 @@
 tests/lbfgs_hs.rs).
 
 The problems are those of hs_casadi.py (same formulations, bounds and starting points as
-tests/hs/problems.rs). IPOPT options: tol 1e-8, hessian_approximation limited-memory
+testkit/src/hs/problems.rs). IPOPT options: tol 1e-8, hessian_approximation limited-memory
 (IPOPT's defaults otherwise: BFGS, limited_memory_max_history 6, initialization
 scalar1), everything else default.
 
@@ -17,7 +17,7 @@ with success = (status == "Solve_Succeeded").
     python3 benches/reference/hs_lbfgs_ipopt.py --compare OURS.jsonl IPOPT.jsonl
 
 prints the Markdown table of docs/solvers.md ("Limited-memory Hessian") from the JSON
-lines of `cargo test --release --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary`
+lines of `cargo test --release -p nlp --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary`
 and of this script: iterations per problem, their ratio, and the geometric mean over
 the problems both solve.
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CasADi + IPOPT on the MPCC test problems of tests/mpcc/problems.rs, in the plain
+"""CasADi + IPOPT on the MPCC test problems of testkit/src/mpcc.rs, in the plain
 products-as-constraints NLP form (a >= 0, b >= 0, a*b <= 0 -- Fletcher & Leyffer's form,
 the one symnlp's SQP back end solves directly). IPOPT gets no special treatment of the
 complementarity (no relaxation, no penalty): this records where a general interior-point

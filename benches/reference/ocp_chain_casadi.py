@@ -1,5 +1,5 @@
 """CasADi SX side of the `ocp_chain` group of benches/symx_eval.rs: the quadrotor OCP of
-benches/common/quadrotor_ocp.rs (12 states, 4 controls, N stages, one RK4 step per stage,
+testkit/src/quadrotor_ocp.rs (12 states, 4 controls, N stages, one RK4 step per stage,
 multiple shooting), built as SX (the RK4 step inlined at every stage, as SX does), then
 grad f, jac g, the lower triangle of the Lagrangian Hessian with symbolic sigma and lambda,
 and the three Functions. Prints a JSON line with the median times (ms) over `reps` runs,

@@ -1,4 +1,4 @@
-"""Cart-pole swing-up MPC of tests/mpc/cart_pole.rs, identical transcription, in CasADi
+"""Cart-pole swing-up MPC of testkit/src/cart_pole_mpc.rs, identical transcription, in CasADi
 3.8.2: N = 40, dt = 0.05, one RK4 step per interval, variables [X_0, U_0, ..., X_N],
 constraints [X_0 - x0, X_{k+1} - F(X_k, U_k)], |u| <= 20, |cart position| <= 2, cost
 sum_k dt (Q (x - goal)^2 + R u^2) + 10 Q (x_N - goal)^2. 100 closed-loop steps from the
@@ -7,7 +7,7 @@ lam_x; cold at step 0), with IPOPT and with sqpmethod + qrqp.
 
 Prints one line per solver: median and max latency (wall time of the solver call),
 iterations mean/max, closed-loop cost, failed steps. The symnlp side of the same table:
-cargo test --release --test sqp_mpc -- --ignored --nocapture cart_pole_loop_report
+cargo test --release -p nlp --test sqp_mpc -- --ignored --nocapture cart_pole_loop_report
 """
 import math
 import sys

@@ -70,12 +70,6 @@ impl Columns {
     }
 }
 
-/// Header line of the interior point's iteration table (see [`Columns::header`] for
-/// either back end's).
-pub fn header() -> String {
-    Columns::Ipm.header().to_string()
-}
-
 /// One formatted table row in the columns of the back end that wrote it
 /// ([`Columns::of`]).
 pub fn format_record(r: &IterationRecord) -> String {

@@ -7,12 +7,9 @@
 //! `cargo test --release -p nlp --test chain_large -- --ignored --nocapture`
 //! (`CHAIN_N=… ` picks another size for `chain_one_size`).
 
-// The benchmark's own builder, so the test and benches/solve.rs cannot drift apart.
-#[path = "../../benches/common/solve_problems.rs"]
-mod solve_problems;
-
 use nlp::{CommonOptions, Ipm, IpmOptions, Solution, Status};
-use solve_problems::hanging_chain;
+// The benchmark's own builder, so the test and benches/solve.rs cannot drift apart.
+use testkit::solve_problems::hanging_chain;
 
 /// The discrete catenary with `links` equal links of length ℓ = L/N (L = 2) between
 /// (0, 0) and (1, 0), a unit weight at each interior point (the objective (1/N) Σ y_i

@@ -4,12 +4,9 @@
 //! against the IPM solved cold on the same problem (both stop at the scaled KKT error
 //! 1e-8; the IPM's chain is checked against the exact discrete catenary and IPOPT in
 //! `chain_large.rs`).
-#[path = "../../benches/common/solve_problems.rs"]
-mod solve_problems;
-
 use nlp::{CommonOptions, Ipm, Problem, Relation, Solver, Sqp, SqpOptions, Status};
-use solve_problems::hanging_chain;
 use symx::{Expr, Matrix};
+use testkit::solve_problems::hanging_chain;
 
 fn sqp(print_level: u8) -> Sqp {
     Sqp::new(SqpOptions {

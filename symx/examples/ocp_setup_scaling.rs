@@ -1,5 +1,5 @@
 //! Growth of the symbolic set-up phases with the number of stages, on the inlined
-//! quadrotor OCP of benches/common/quadrotor_ocp.rs (issue 13): each phase (build, ∇f,
+//! quadrotor OCP of testkit/src/quadrotor_ocp.rs (issue 13): each phase (build, ∇f,
 //! ∂g/∂w, the lower triangle of ∇²(σf + λᵀg), the three `Function`s) is timed at
 //! N = 100, 200, 400, 800 (or the sizes given as arguments), each size in a fresh
 //! expression graph (thread CPU time, not wall time), with the graph's node count after each phase; then the growth
@@ -7,10 +7,8 @@
 //! linear; clearly above 1 is a superlinear phase.
 //!
 //! Run: `cargo run --release -p symx --example ocp_setup_scaling [N…]`.
-#[path = "../../benches/common/quadrotor_ocp.rs"]
-mod quadrotor_ocp;
-
 use symx::{gradient, jacobian, lagrangian_hessian, node_count, Expr, Function, Matrix};
+use testkit::quadrotor_ocp;
 
 const PHASES: [&str; 5] = ["build", "grad_f", "jac_g", "hess_L", "functions"];
 

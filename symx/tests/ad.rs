@@ -11,8 +11,7 @@
 //! Jacobian vs compiled) only differ by rounding and use `1e-10`.
 #![allow(clippy::needless_range_loop)] // dense matrix indexing reads best with indices
 
-#[path = "symx_common/trees.rs"]
-mod trees;
+use testkit::trees;
 
 use proptest::prelude::*;
 use symx::{

@@ -1,38 +1,14 @@
 //! Evaluating a compiled function that calls other functions (nested), and a lookup
 //! table, allocates nothing: a counting global allocator (counting only on the thread and
 //! during the span under test) must see zero allocations.
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use symx::{gradient, hessian, Function, Interpolant, Matrix};
-
-struct Counting;
-
-thread_local! {
-    static ACTIVE: Cell<bool> = const { Cell::new(false) };
-    static COUNT: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ACTIVE.with(Cell::get) {
-            COUNT.with(|c| c.set(c.get() + 1));
-        }
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-}
+use testkit::alloc::ThreadCounting;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: ThreadCounting = ThreadCounting;
 
 fn allocations_during(f: impl FnOnce()) -> usize {
-    COUNT.with(|c| c.set(0));
-    ACTIVE.with(|a| a.set(true));
-    f();
-    ACTIVE.with(|a| a.set(false));
-    COUNT.with(Cell::get)
+    ThreadCounting::during(f).1
 }
 
 #[test]

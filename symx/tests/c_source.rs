@@ -11,6 +11,7 @@ use symx::{
     gradient, hessian, if_else, jacobian, lt, parse, Expr, Function, Interpolant, Matrix,
     SourceOptions, Sparsity, SymxError,
 };
+use testkit::special::{same_or_both_nan, SPECIAL};
 
 /// Reads the points (every input's entries, as hex bits, one number per line) from stdin
 /// until its end, evaluates each through the CasADi interface (the work sizes from
@@ -133,7 +134,7 @@ fn same_as_tape(f: &Function, points: &[Vec<f64>], tag: &str) {
         let want = f.call(&inputs).unwrap().concat();
         assert_eq!(want.len(), g.len());
         for (i, (a, b)) in want.iter().zip(g).enumerate() {
-            let same = a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+            let same = same_or_both_nan(*a, *b);
             assert!(
                 same,
                 "{tag}: point {k} {p:?}, output {i}: tape {a:e}, C {b:e}"
@@ -141,25 +142,6 @@ fn same_as_tape(f: &Function, points: &[Vec<f64>], tag: &str) {
         }
     }
 }
-
-/// Operands covering signs, zeros of both signs, integers (pow's fast path), large and
-/// subnormal values, infinities and NaN.
-const SPECIAL: [f64; 14] = [
-    0.0,
-    -0.0,
-    1.0,
-    -1.0,
-    0.5,
-    -2.5,
-    3.0,
-    1e300,
-    -1e-310,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    f64::NAN,
-    std::f64::consts::FRAC_PI_4,
-    64.0,
-];
 
 /// Every operation the C generator supports, and `if_else`, on every pair of special
 /// operands.

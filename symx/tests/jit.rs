@@ -8,6 +8,7 @@ use symx::{
     gradient, hessian, if_else, jacobian, parse, with_fresh_arena, Evaluator, Expr, Function,
     Interpolant, Interpolant2, InterpolantN, Matrix,
 };
+use testkit::special::SPECIAL;
 
 /// Evaluates `f` and its JIT at `point` and asserts every output bit-identical (a NaN's
 /// payload included); returns the outputs.
@@ -27,25 +28,6 @@ fn same_bits(f: &Function, inputs: &[&[f64]]) -> Vec<Vec<f64>> {
     }
     want
 }
-
-/// Operands covering signs, zeros of both signs, integers (pow's fast path), large values,
-/// infinities and NaN.
-const SPECIAL: [f64; 14] = [
-    0.0,
-    -0.0,
-    1.0,
-    -1.0,
-    0.5,
-    -2.5,
-    3.0,
-    1e300,
-    -1e-310,
-    f64::INFINITY,
-    f64::NEG_INFINITY,
-    f64::NAN,
-    std::f64::consts::FRAC_PI_4,
-    64.0,
-];
 
 /// Every unary and binary operation, and `if_else`, on every pair of special operands.
 #[test]

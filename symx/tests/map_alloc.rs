@@ -4,36 +4,14 @@
 //! (`harness = false` in symx/Cargo.toml): the harness's main thread allocates while a test
 //! runs (measured: 148, 608, 48 and 96 bytes on thread "main" in 17 of 30 runs), so only
 //! this process's own threads (this one and the map's workers) may run.
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use symx::{Function, Matrix};
-
-struct Counting;
-
-static ACTIVE: AtomicBool = AtomicBool::new(false);
-static COUNT: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ACTIVE.load(Ordering::SeqCst) {
-            COUNT.fetch_add(1, Ordering::SeqCst);
-        }
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-}
+use testkit::alloc::Counting;
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
 fn allocations_during(f: impl FnOnce()) -> usize {
-    COUNT.store(0, Ordering::SeqCst);
-    ACTIVE.store(true, Ordering::SeqCst);
-    f();
-    ACTIVE.store(false, Ordering::SeqCst);
-    COUNT.load(Ordering::SeqCst)
+    Counting::during(f).1
 }
 
 fn main() {

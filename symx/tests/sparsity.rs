@@ -2,8 +2,7 @@
 //! at random points, are not dense where the truth is sparse, and
 //! `Function::dependency_sparsity` (bit-vector propagation on the tape) agrees with the
 //! pattern of `jacobian()`.
-#[path = "symx_common/trees.rs"]
-mod trees;
+use testkit::trees;
 
 use proptest::prelude::*;
 use symx::sparsity::{bandwidth, contains, entries, pattern_from_entries};

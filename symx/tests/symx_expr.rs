@@ -1,7 +1,6 @@
 //! Expressions: local simplification and constant folding, `Display`/`parse` round trips,
 //! error cases of `Function` and the derivative functions, threading and batch evaluation.
-#[path = "symx_common/trees.rs"]
-mod trees;
+use testkit::trees;
 
 use proptest::prelude::*;
 use symx::{

@@ -1,10 +1,10 @@
 //! MPCC test problems: (name, source, builder, published f*, known failures per back end).
-use symnlp::nlp;
 
 use nlp::{MpccBackend, Problem, Relation};
 
 /// Calls macro `$then!` with every case name, in order: the one list of cases, shared
-/// by `tests/mpcc.rs` (one `#[test]` per case and back end) and `tests/golden.rs`.
+/// by [`ALL`] and `nlp/tests/mpcc.rs` (one `#[test]` per case and back end).
+#[macro_export]
 macro_rules! mpcc_names {
     ($then:ident) => {
         $then! {
@@ -14,6 +14,14 @@ macro_rules! mpcc_names {
         }
     };
 }
+
+macro_rules! mpcc_all {
+    ($($name:ident),* $(,)?) => {
+        /// Every case, in order.
+        pub const ALL: &[fn() -> Case] = &[$($name),*];
+    };
+}
+mpcc_names!(mpcc_all);
 
 pub struct Case {
     pub name: &'static str,

@@ -1,15 +1,14 @@
 //! The Hock–Schittkowski problems, written with the `nlp::Problem` builder.
 //!
 //! Sources, cited per problem by number:
-//! - [HS81] W. Hock, K. Schittkowski, "Test Examples for Nonlinear Programming Codes",
+//! - \[HS81\] W. Hock, K. Schittkowski, "Test Examples for Nonlinear Programming Codes",
 //!   Lecture Notes in Economics and Mathematical Systems 187, Springer 1981.
-//! - [S08] K. Schittkowski, "An updated set of 306 test problems for nonlinear
-//!   programming with validated optimal solutions", 2008 (corrections of [HS81]).
+//! - \[S08\] K. Schittkowski, "An updated set of 306 test problems for nonlinear
+//!   programming with validated optimal solutions", 2008 (corrections of \[HS81\]).
 //!
 //! Each builder uses the published starting point (feasible or not) and bounds. The
 //! same formulations, in CasADi, are in `benches/reference/hs_casadi.py`: keep both in
 //! sync. Variables are named as in the book: `x1` is `x[0]`.
-use symnlp::{nlp, symx};
 
 use nlp::{bounded, BuildError, Problem, Relation};
 use symx::{Expr, Matrix};
@@ -79,7 +78,7 @@ pub fn hs001() -> Built {
     case(pb, 0.0)
 }
 
-/// HS81 problem 2; f* = 4.9412293 at x* = (1.2243707, 1.5) as printed. [S08] notes that
+/// HS81 problem 2; f* = 4.9412293 at x* = (1.2243707, 1.5) as printed. \[S08\] notes that
 /// this value belongs to the local minimiser x ≈ (−1.2244, 1.5), and that the global
 /// one, f = 0.0504261879 at x1 ≈ +1.2244, is not reached from the standard start.
 pub fn hs002() -> Built {
@@ -541,7 +540,7 @@ pub fn hs019() -> Built {
 }
 
 /// HS81 problem 20; f* = 40.19873 = 83.5 − 25√3, printed with x* = (0.5, √3/2), where f
-/// is in fact 81.5 − 25√3 = 38.19873 ([S08] corrects f*). 40.19873 is the local
+/// is in fact 81.5 − 25√3 = 38.19873 (\[S08\] corrects f*). 40.19873 is the local
 /// minimiser (−0.5, √3/2), which is where the standard start (−2, 1) leads (IPOPT too).
 pub fn hs020() -> Built {
     let mut pb = Problem::new();
@@ -899,8 +898,8 @@ pub fn hs081() -> Built {
     )
 }
 
-/// HS81 problem 106 (heat exchanger design); f* = 7049.24802 [S08] (printed 7049.330923
-/// in [HS81]).
+/// HS81 problem 106 (heat exchanger design); f* = 7049.24802 \[S08\] (printed 7049.330923
+/// in \[HS81\]).
 pub fn hs106() -> Built {
     let mut pb = Problem::new();
     let (x, [x1, x2, x3, x4, x5, x6, x7, x8]) = vars(
@@ -989,7 +988,7 @@ pub fn hs114() -> Built {
     case(pb, -1768.80696)
 }
 
-/// HS81 problem 116 (3-stage membrane separation); f* = 97.5874731. [HS81] prints
+/// HS81 problem 116 (3-stage membrane separation); f* = 97.5874731. \[HS81\] prints
 /// f* = 97.588409 with an x* at which f = x11 + x12 + x13 = 97.58743 (to its printed
 /// digits): the printed f* is off in the 5th digit. 97.5874731 is f at the same x* to
 /// full precision (IPOPT with tol 1e-13).

@@ -10,13 +10,10 @@
 //! to the published digits (outrata31: 1e-4) —
 //! and complementarity residual ≤ 1e-8 — or its listed known failure (the failure is
 //! asserted, so a change of behaviour fails the test).
-use symnlp::nlp;
-
 use nlp::{solve_mpcc, MpccBackend, MpccOptions, MpccSolution};
 
-#[path = "mpcc/problems.rs"]
-#[macro_use]
-mod problems;
+use testkit::mpcc as problems;
+use testkit::mpcc_names;
 
 use problems::Case;
 
@@ -68,7 +65,7 @@ macro_rules! mpcc_tests {
 mpcc_names!(mpcc_tests);
 
 /// One JSON line per case and back end (for docs/performance.md):
-/// `cargo test --release --test mpcc -- --ignored --nocapture mpcc_summary`.
+/// `cargo test --release -p nlp --test mpcc -- --ignored --nocapture mpcc_summary`.
 #[test]
 #[ignore = "report: run with --release --ignored --nocapture"]
 fn mpcc_summary() {

@@ -1,18 +1,19 @@
-//! What the two Hock–Schittkowski test files share: the list of problems (one `#[test]`
+//! What the Hock–Schittkowski test files share: the list of problems (one `#[test]`
 //! each), one timed solve of a problem, the success criteria, the JSON report and the
-//! summary. `tests/hs.rs` runs the interior-point method, `tests/sqp_hs.rs` the SQP.
+//! summary. `nlp/tests/hs.rs` runs the interior-point method, `nlp/tests/sqp_hs.rs` the
+//! SQP.
 use std::time::Instant;
 
-use symnlp::nlp::{Compiled, Solution, SolveError, Status};
+use nlp::{Compiled, Solution, SolveError, Status};
 
-use crate::problems::Built;
+use super::problems::{self, Built};
 
 /// Calls macro `$then!` with every problem name of the suite, in order: the one list
-/// of problems, shared by `hs_suite!` (one `#[test]` each) and `hs_list!` (the list
-/// only, for `tests/golden.rs`).
+/// of problems, shared by [`SUITE`] and `hs_suite!` (one `#[test]` each).
+#[macro_export]
 macro_rules! hs_names {
-    ($then:ident) => {
-        $then! {
+    ($($then:tt)+) => {
+        $($then)+! {
             // bounds only
             hs001, hs002, hs003, hs004, hs005, hs025, hs038, hs045, hs110,
             // equality constraints
@@ -28,41 +29,32 @@ macro_rules! hs_names {
     };
 }
 
-/// Generates `SUITE` (every problem with its name, in order) and one `#[test]` per
-/// problem calling the test file's `check(name, build)`.
-#[allow(unused_macros)]
+/// One `#[test]` per problem of the suite (in a module `solve`), each calling the test
+/// file's `check(name, build)`; the list itself is [`SUITE`].
+#[macro_export]
 macro_rules! hs_suite {
     () => {
-        hs_names!(hs_suite);
+        $crate::hs_names!($crate::hs_suite);
     };
     ($($name:ident),* $(,)?) => {
-        /// Every problem of the suite with its name, in order.
-        pub const SUITE: &[harness::Entry] =
-            &[$((stringify!($name), problems::$name)),*];
-
         mod solve {
             $(
                 #[test]
                 fn $name() {
-                    super::check(stringify!($name), super::problems::$name);
+                    super::check(stringify!($name), $crate::hs::problems::$name);
                 }
             )*
         }
     };
 }
 
-/// Generates `SUITE` only (no tests).
-#[allow(unused_macros)]
 macro_rules! hs_list {
-    () => {
-        hs_names!(hs_list);
-    };
     ($($name:ident),* $(,)?) => {
         /// Every problem of the suite with its name, in order.
-        pub const SUITE: &[harness::Entry] =
-            &[$((stringify!($name), problems::$name)),*];
+        pub const SUITE: &[Entry] = &[$((stringify!($name), problems::$name)),*];
     };
 }
+hs_names!(hs_list);
 
 /// A problem of the suite: its name and its builder.
 pub type Entry = (&'static str, fn() -> Built);
@@ -201,7 +193,7 @@ impl Run {
 
 /// Runs every problem of `suite` (each in a fresh thread, as each `#[test]` runs: symx's
 /// expression arena is per thread; a problem built after others solves bit-identically,
-/// see `tests/reproducible.rs`, but a fresh thread keeps the arena small), prints one
+/// see `nlp/tests/reproducible.rs`, but a fresh thread keeps the arena small), prints one
 /// JSON line per problem on stdout and a summary on stderr.
 pub fn summary(suite: &[Entry], run_one: fn(&'static str, fn() -> Built) -> Run) {
     let mut iterations = Vec::new();

@@ -16,19 +16,13 @@
 //! objective and time, for the comparison with IPOPT in docs/performance.md:
 //!
 //! ```text
-//! cargo test --release --test hs -- --ignored --nocapture hs_summary
+//! cargo test --release -p nlp --test hs -- --ignored --nocapture hs_summary
 //! ```
-use symnlp::nlp;
-
 use nlp::ipm::Ipm;
 use nlp::{CommonOptions, IpmOptions};
 
-#[path = "hs/problems.rs"]
-mod problems;
-
-#[path = "hs/harness.rs"]
-#[macro_use]
-mod harness;
+use testkit::hs::{harness, problems, SUITE};
+use testkit::hs_suite;
 
 use harness::Run;
 use problems::Built;
@@ -74,7 +68,7 @@ fn hs_summary() {
 /// variable `HS` (comma-separated), for diagnosing a failure:
 ///
 /// ```text
-/// HS=hs013,hs061 cargo test --release --test hs -- --ignored --nocapture hs_log
+/// HS=hs013,hs061 cargo test --release -p nlp --test hs -- --ignored --nocapture hs_log
 /// ```
 #[test]
 #[ignore = "diagnostics: run with HS=<names> --release --ignored --nocapture"]

@@ -8,14 +8,11 @@
 //! closed loops (`STEPS=<n>` for another length):
 //!
 //! ```text
-//! cargo test --release --test sqp_mpc -- --ignored --nocapture cart_pole_loop_report
+//! cargo test --release -p nlp --test sqp_mpc -- --ignored --nocapture cart_pole_loop_report
 //! ```
-use symnlp::nlp;
-
 use nlp::{Ipm, Solution, Solver, Sqp, Status};
 
-#[path = "mpc/cart_pole.rs"]
-mod cart_pole;
+use testkit::cart_pole_mpc as cart_pole;
 
 use cart_pole::NX;
 

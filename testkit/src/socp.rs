@@ -1,6 +1,5 @@
-//! The SOCP test problems (their optima are derived in `tests/socp.rs`), shared with
+//! The SOCP test problems (their optima are derived in `nlp/tests/socp.rs`), shared with
 //! `tests/golden.rs`.
-use symnlp::{nlp, symx};
 
 use nlp::{Problem, Relation};
 use symx::Expr;

@@ -8,22 +8,11 @@
 //! change between runs (docs/solvers.md, "Reproducibility").
 use std::ops::ControlFlow;
 
-use symnlp::nlp;
-
 use nlp::{Ipm, IpmOptions, IterationView, Solution, SolveError, Sqp, SqpOptions};
 
-#[path = "hs/problems.rs"]
-#[allow(dead_code)]
-mod problems;
-
-#[path = "hs/harness.rs"]
-#[macro_use]
-#[allow(dead_code, unused_macros)]
-mod harness;
+use testkit::hs::{problems, SUITE};
 
 use problems::Built;
-
-hs_list!();
 
 /// Bit patterns of everything a solve produced, iterate by iterate.
 #[derive(Debug, PartialEq, Eq)]

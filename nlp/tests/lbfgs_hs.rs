@@ -8,30 +8,20 @@
 //! `tests/hs.rs` (status, published optimum to 1e-6, violation ≤ 1e-4).
 //!
 //! ```text
-//! cargo test --release --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary \
+//! cargo test --release -p nlp --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_summary \
 //!     > benches/reference/results/hs_lbfgs_symnlp.jsonl
-//! OPT=mu_strategy=monotone cargo test --release --test lbfgs_hs -- --ignored --nocapture \
+//! OPT=mu_strategy=monotone cargo test --release -p nlp --test lbfgs_hs -- --ignored --nocapture \
 //!     hs_lbfgs_summary > benches/reference/results/hs_lbfgs_monotone_symnlp.jsonl
 //! ```
 use std::collections::HashMap;
 
-use symnlp::nlp;
-
 use nlp::ipm::Ipm;
 use nlp::{IpmHessian, IpmOptions, NamedOptions};
 
-#[path = "hs/problems.rs"]
-mod problems;
-
-#[path = "hs/harness.rs"]
-#[macro_use]
-#[allow(dead_code)]
-mod harness;
+use testkit::hs::{harness, problems, SUITE};
 
 use harness::Run;
 use problems::Built;
-
-hs_list!();
 
 fn lm_options() -> IpmOptions {
     IpmOptions {
@@ -66,7 +56,7 @@ fn lm_options_with_env() -> IpmOptions {
 fn ipopt_results() -> HashMap<String, (bool, usize)> {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/benches/reference/results/hs_lbfgs_ipopt.jsonl"
+        "/../benches/reference/results/hs_lbfgs_ipopt.jsonl"
     );
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
     text.lines()
@@ -164,7 +154,7 @@ fn hs_lbfgs_summary() {
 /// with IPOPT's log (`print_level` 5):
 ///
 /// ```text
-/// HS=hs034 cargo test --release --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_log
+/// HS=hs034 cargo test --release -p nlp --test lbfgs_hs -- --ignored --nocapture hs_lbfgs_log
 /// ```
 #[test]
 #[ignore = "diagnostics: run with HS=<names> --release --ignored --nocapture"]

@@ -7,9 +7,9 @@
 //! `benches/reference/sqp_compare.py` builds the identical NLP for CasADi.
 #![allow(dead_code)]
 
+use nlp::{Compiled, Constraint, Problem, Relation, Solution};
 use std::f64::consts::PI;
-use symnlp::nlp::{Compiled, Constraint, Problem, Relation, Solution};
-use symnlp::symx::{Expr, Matrix};
+use symx::{Expr, Matrix};
 
 pub const NX: usize = 4;
 pub const NU: usize = 1;

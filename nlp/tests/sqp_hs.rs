@@ -6,19 +6,12 @@
 //! `sqp_hs_summary` (ignored) prints one JSON line per problem for docs/performance.md:
 //!
 //! ```text
-//! cargo test --release --test sqp_hs -- --ignored --nocapture sqp_hs_summary
+//! cargo test --release -p nlp --test sqp_hs -- --ignored --nocapture sqp_hs_summary
 //! ```
-use symnlp::nlp;
-
 use nlp::{CommonOptions, Sqp, SqpOptions, Status};
 
-#[path = "hs/problems.rs"]
-#[allow(dead_code)]
-mod problems;
-
-#[path = "hs/harness.rs"]
-#[macro_use]
-mod harness;
+use testkit::hs::{harness, problems, SUITE};
+use testkit::hs_suite;
 
 use harness::Run;
 use problems::Built;

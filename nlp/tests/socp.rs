@@ -3,12 +3,9 @@
 //! smooth form `√(‖v‖² + ε²) − t ≤ ε` (ε = 1e-8, an outer approximation: ‖v‖ − t ≤ ε);
 //! the SQP hands affine cones to clarabel as exact second-order cones and linearises the
 //! smooth row of the others.
-use symnlp::nlp;
-
 use nlp::{Ipm, IpmOptions, NumericNlp, Problem, Solution, Sqp, SqpOptions, Status};
 
-#[path = "socp/problems.rs"]
-mod problems;
+use testkit::socp as problems;
 
 /// Tolerance on the cone residual max(0, ‖v‖ − t) at a solution: the smoothing ε of the
 /// interior-point form plus solver tolerances.

@@ -1,5 +1,5 @@
 //! Random expression trees for the symx property tests (shared by symx/tests/ad.rs,
-//! symx/tests/sparsity.rs and symx/tests/symx_expr.rs through `#[path]`).
+//! symx/tests/sparsity.rs and symx/tests/symx_expr.rs).
 //!
 //! A [`Tree`] is built both as a symx expression ([`Tree::build`]) and evaluated by an
 //! independent plain-`f64` interpreter ([`Tree::eval`]) that also reports how close the
