@@ -18,7 +18,7 @@ use crate::ipm::core::{barrier_value, Buffers, Core, Layout, Outcome, Setup, Sha
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::numeric::NumericNlp;
-use crate::options::MuStrategy;
+use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::Status;
 
 struct Resto<'a> {
@@ -211,69 +211,22 @@ impl IpmProblem for Resto<'_> {
 /// Runs a restoration phase from the outer core's current iterate. On success the outer
 /// core continues from the restored point; otherwise the final outcome is returned.
 pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Outcome> {
-    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let (n, m) = (core.layout().n, core.layout().m);
     let opts = core.options().clone();
     let mu = core.mu().max(inf_norm(&core.iterate().c));
     let rho = opts.resto_penalty_parameter;
     let (pv, nv) = initial_p_n(&core.iterate().c, mu, rho);
-    let xr: Vec<f64> = core.iterate().w[..n].to_vec();
-    let dr2: Vec<f64> = xr
-        .iter()
-        .map(|x| (1.0f64).min(1.0 / x.abs()).powi(2))
-        .collect();
-    // Patterns.
-    let jac_o = core.problem().jac_g_sparsity().clone();
-    let nnz_j_orig = jac_o.row_idx().len();
-    let (jac, hess, hmap, hdiag) = resto_patterns(&jac_o, core.problem().hess_l_sparsity(), n, m);
-    let hbuf_len = core.problem().hess_l_sparsity().row_idx().len();
-    let ([x_l, x_u], [g_l, g_u]) = resto_bounds(core.layout());
-    let mut x0 = xr.clone();
-    x0.extend_from_slice(&pv);
-    x0.extend_from_slice(&nv);
     // Full inner iterate: w = [x, p, n, s].
-    let mut w = x0.clone();
+    let mut w = core.iterate().w[..n].to_vec();
+    w.extend_from_slice(&pv);
+    w.extend_from_slice(&nv);
     w.extend_from_slice(&core.iterate().w[n..]);
     let [zl, zu] = resto_bound_multipliers(core, &pv, &nv, mu, rho);
-    let theta_max = core.theta_max();
     // IPOPT's first 'r' row reports the failed line search of the outer iteration
     // (alpha_pr, 'R', ls).
     let resto_start = core.take_resto_start();
-    let resto = Resto {
-        n,
-        m,
-        rho,
-        zeta: opts.resto_proximity_weight * mu.sqrt(),
-        dr2,
-        xr,
-        jac,
-        nnz_j_orig,
-        hess,
-        hmap,
-        hdiag,
-        x_l,
-        x_u,
-        g_l,
-        g_u,
-        x0,
-        hbuf: vec![0.0; hbuf_len],
-        slack_of_row: core.layout().slack_of_row.clone(),
-        g_eq: core.layout().g_eq.clone(),
-        wl: core.layout().wl.clone(),
-        wu: core.layout().wu.clone(),
-        has_l: core.layout().has_l.clone(),
-        has_u: core.layout().has_u.clone(),
-        kappa_d: opts.kappa_d,
-        mu_outer: core.mu(),
-        filter: core.filter().clone(),
-        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.iterate().c))
-            .max(opts.tol.min(opts.constr_viol_tol)),
-        theta_max,
-        gbuf: vec![0.0; m],
-        wbuf: vec![0.0; n + ni],
-        outer_scaling: core.scaling().clone(),
-        outer: core.problem_mut(),
-    };
-    let mut resto = resto;
+    let x0 = w[..n + 2 * m].to_vec();
+    let mut resto = resto_problem(core, &opts, x0, mu);
     let unscaled = Scaling::unscaled(m);
     let setup = Setup {
         mu_init: mu,
@@ -301,6 +254,63 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
     drop(inner);
     drop(resto);
     continue_after(core, outcome, &w_o, opts.constr_viol_tol)
+}
+
+/// The restoration problem around the outer core's current iterate, starting at
+/// `x0 = [x, p, n]` with barrier parameter `mu`; it evaluates through the outer problem.
+fn resto_problem<'a>(
+    core: &'a mut Core<'_>,
+    opts: &IpmOptions,
+    x0: Vec<f64>,
+    mu: f64,
+) -> Resto<'a> {
+    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let xr: Vec<f64> = x0[..n].to_vec();
+    let dr2: Vec<f64> = xr
+        .iter()
+        .map(|x| (1.0f64).min(1.0 / x.abs()).powi(2))
+        .collect();
+    let jac_o = core.problem().jac_g_sparsity().clone();
+    let nnz_j_orig = jac_o.row_idx().len();
+    let (jac, hess, hmap, hdiag) = resto_patterns(&jac_o, core.problem().hess_l_sparsity(), n, m);
+    let hbuf_len = core.problem().hess_l_sparsity().row_idx().len();
+    let ([x_l, x_u], [g_l, g_u]) = resto_bounds(core.layout());
+    let lay = core.layout();
+    Resto {
+        n,
+        m,
+        rho: opts.resto_penalty_parameter,
+        zeta: opts.resto_proximity_weight * mu.sqrt(),
+        dr2,
+        xr,
+        jac,
+        nnz_j_orig,
+        hess,
+        hmap,
+        hdiag,
+        x_l,
+        x_u,
+        g_l,
+        g_u,
+        x0,
+        hbuf: vec![0.0; hbuf_len],
+        slack_of_row: lay.slack_of_row.clone(),
+        g_eq: lay.g_eq.clone(),
+        wl: lay.wl.clone(),
+        wu: lay.wu.clone(),
+        has_l: lay.has_l.clone(),
+        has_u: lay.has_u.clone(),
+        kappa_d: opts.kappa_d,
+        mu_outer: core.mu(),
+        filter: core.filter().clone(),
+        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.iterate().c))
+            .max(opts.tol.min(opts.constr_viol_tol)),
+        theta_max: core.theta_max(),
+        gbuf: vec![0.0; m],
+        wbuf: vec![0.0; n + ni],
+        outer_scaling: core.scaling().clone(),
+        outer: core.problem_mut(),
+    }
 }
 
 /// The inner core's solve from `start`, and its final point mapped back to the outer
