@@ -322,7 +322,9 @@ fn run_inner(
     n: usize,
     m: usize,
 ) -> (Outcome, Vec<f64>) {
-    let outcome = inner.run(shared, start);
+    // The inner core never restores (it is the restoration phase); `restore` stands
+    // for the argument.
+    let outcome = inner.run(shared, start, restore);
     let w_inner = &inner.iterate().w;
     let mut w_o = w_inner[..n].to_vec();
     w_o.extend_from_slice(&w_inner[n + 2 * m..]);

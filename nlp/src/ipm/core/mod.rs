@@ -17,7 +17,6 @@ use crate::ipm::barrier::{mu_floor, tau};
 use crate::ipm::error::CoreError;
 use crate::ipm::filter::{Acceptance, Filter};
 use crate::ipm::reduced::IpmProblem;
-use crate::ipm::restoration;
 use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::{IterationRecord, Stats, Status};
 
@@ -48,6 +47,12 @@ pub(crate) struct Shared<'c> {
     /// The user's iteration callback, called by `record`.
     pub observer: Option<Observer<'c>>,
 }
+
+/// A restoration phase run from a core's current iterate: `Ok` to continue from the
+/// restored point, else the solve's final outcome. [`Core::run`] takes it as an argument
+/// (`ipm::restoration::restore`) because the restoration phase drives a core itself:
+/// the core does not depend on it.
+pub(crate) type Restorer = fn(&mut Core<'_>, &mut Shared) -> Result<(), Outcome>;
 
 /// What one iteration of [`Core::run`] leads to.
 enum Iteration {
@@ -462,8 +467,13 @@ impl<'p> Core<'p> {
 
     /// Solves from `start`: each iteration updates the barrier, factorises, solves for
     /// the direction and takes a tiny or line-searched step; a failed step starts a
-    /// restoration phase.
-    pub(crate) fn run(&mut self, shared: &mut Shared, start: Start<'_>) -> Outcome {
+    /// restoration phase (`restore`).
+    pub(crate) fn run(
+        &mut self,
+        shared: &mut Shared,
+        start: Start<'_>,
+        restore: Restorer,
+    ) -> Outcome {
         if let Err(e) = self.initialize(start) {
             return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
         }
@@ -490,7 +500,7 @@ impl<'p> Core<'p> {
                     Iteration::Restore(why) => why,
                 }
             };
-            if let Some(out) = self.restoration_phase(shared, why) {
+            if let Some(out) = self.restoration_phase(shared, why, restore) {
                 return out;
             }
         }
@@ -596,7 +606,12 @@ impl<'p> Core<'p> {
     /// A restoration phase started because of `why`; `None` when the solve continues
     /// from the restored point, else the final outcome (also when no restoration phase
     /// can run: inside one, or without constraints).
-    fn restoration_phase(&mut self, shared: &mut Shared, why: &str) -> Option<Outcome> {
+    fn restoration_phase(
+        &mut self,
+        shared: &mut Shared,
+        why: &str,
+        restore: Restorer,
+    ) -> Option<Outcome> {
         if self.setup_in_resto {
             return Some(self.outcome(
                 Status::RestorationFailed,
@@ -627,7 +642,7 @@ impl<'p> Core<'p> {
             let phi = self.barrier(&self.it.w, self.it.f, self.mu);
             self.accept.augment(&mut self.filter, theta, phi);
         }
-        match restoration::restore(self, shared) {
+        match restore(self, shared) {
             Ok(()) => {
                 self.count.soft_resto = None;
                 self.pert.delta_w_last = 0.0;
