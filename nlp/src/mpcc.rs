@@ -410,6 +410,150 @@ fn ok(s: Status) -> bool {
     matches!(s, Status::SolveSucceeded | Status::SolvedToAcceptableLevel)
 }
 
+/// Whether the user's callback stopped the phase that returned `sol`.
+fn stopped(sol: &Solution) -> bool {
+    sol.status == Status::UserRequestedStop
+}
+
+/// The phases run so far, each recorded with its complementarity residual.
+struct Phases<'p> {
+    problem: &'p Problem,
+    biactive_tol: f64,
+    list: Vec<MpccPhase>,
+}
+
+impl Phases<'_> {
+    /// Records the phase of `kind` (penalty π `penalty`) that returned `sol`; its
+    /// complementarity report.
+    fn record(
+        &mut self,
+        kind: &'static str,
+        penalty: f64,
+        sol: &Solution,
+    ) -> Result<ComplementarityReport, MpccError> {
+        let rep = self
+            .problem
+            .complementarity_report(&sol.x, self.biactive_tol)?;
+        self.list.push(MpccPhase {
+            kind,
+            penalty,
+            status: sol.status,
+            iterations: sol.stats.iterations,
+            objective: sol.objective,
+            residual: rep.residual,
+        });
+        Ok(rep)
+    }
+
+    /// The callback's label of the next phase.
+    fn label(&self, kind: &'static str, penalty: f64) -> PhaseLabel {
+        PhaseLabel {
+            index: self.list.len(),
+            kind,
+            penalty,
+        }
+    }
+}
+
+/// The SQP back end's one main phase (products as constraints): its solution and
+/// whether it spent the budget.
+fn sqp_phase(
+    problem: &Problem,
+    budget: &mut Budget<'_>,
+    phases: &mut Phases<'_>,
+    callback: Option<&mut IterationCallback<'_>>,
+) -> Result<(Solution, bool), MpccError> {
+    let mut c = problem.compile()?;
+    let solver = budget.first_solver();
+    let phase = phases.label("sqp", 0.0);
+    let sol = run(solver.as_ref(), &mut c, None, callback, phase)?;
+    phases.record("sqp", 0.0, &sol)?;
+    budget.used += sol.stats.iterations;
+    let spent = budget.spent_by(&sol);
+    Ok((sol, spent))
+}
+
+/// The IPM back end's penalty phases: f + π·Σ aᵢbᵢ with π a parameter (one
+/// compilation for every π), raised until the complementarity residual is at most
+/// `switch_tol`, π would pass `penalty_max`, or the budget is spent. The last phase's
+/// solution and whether it spent the budget.
+fn penalty_phases(
+    problem: &Problem,
+    budget: &mut Budget<'_>,
+    phases: &mut Phases<'_>,
+    mut callback: Option<&mut IterationCallback<'_>>,
+) -> Result<(Solution, bool), MpccError> {
+    let o = budget.options;
+    let f = problem.objective();
+    let mut pb = problem.mpcc_copy(f, false);
+    let pi_param = pb.parameter(PENALTY_PARAMETER, 1)?[0];
+    let mut obj = f;
+    for (_, a, b) in problem.complementarity_pairs() {
+        obj += pi_param * (*a * *b);
+    }
+    pb.minimize(obj);
+    let mut pi = o.penalty_init;
+    pb.set_value(PENALTY_PARAMETER, &[pi])?;
+    let mut c = pb.compile()?;
+    let mut x: Option<Vec<f64>> = None;
+    let mut last: Option<Solution> = None;
+    loop {
+        let solver = match &last {
+            None => budget.first_solver(),
+            Some(_) => match budget.solver() {
+                Some(solver) => solver,
+                None => return Ok((last.take().expect("matched Some"), true)),
+            },
+        };
+        c.set_value(PENALTY_PARAMETER, &[pi])?;
+        let phase = phases.label("penalty", pi);
+        let cb = callback.as_deref_mut();
+        let sol = run(solver.as_ref(), &mut c, x.as_deref(), cb, phase)?;
+        let rep = phases.record("penalty", pi, &sol)?;
+        budget.used += sol.stats.iterations;
+        x = Some(sol.x.clone());
+        if budget.spent_by(&sol) {
+            return Ok((sol, true));
+        }
+        if stopped(&sol)
+            || (ok(sol.status) && rep.residual <= o.switch_tol)
+            || pi * o.penalty_increase > o.penalty_max
+        {
+            return Ok((sol, false));
+        }
+        pi *= o.penalty_increase;
+        last = Some(sol);
+    }
+}
+
+/// The exact final phase from `x`: every pair's branch fixed (the side smaller at `x`
+/// set to zero) and the problem solved again.
+fn final_phase(
+    problem: &Problem,
+    solver: &dyn Solver,
+    x: &[f64],
+    callback: Option<&mut IterationCallback<'_>>,
+    phases: &mut Phases<'_>,
+) -> Result<Solution, MpccError> {
+    let pairs = problem.complementarity_pairs();
+    let sides: Vec<Expr> = pairs.iter().flat_map(|(_, a, b)| [*a, *b]).collect();
+    let vals = problem.evaluate(&sides, x)?;
+    let mut pb = problem.mpcc_copy(problem.objective(), false);
+    for (k, (name, a, b)) in pairs.iter().enumerate() {
+        let side = if vals[2 * k] <= vals[2 * k + 1] {
+            *a
+        } else {
+            *b
+        };
+        pb.subject_to_named(&format!("{name}.branch"), side.eq(0.0))?;
+    }
+    let mut c = pb.compile()?;
+    let phase = phases.label("final", 0.0);
+    let sol = run(solver, &mut c, Some(x), callback, phase)?;
+    phases.record("final", 0.0, &sol)?;
+    Ok(sol)
+}
+
 /// Solves `problem` (with its complementarity pairs) by `backend`; see the module docs.
 pub fn solve_mpcc(
     problem: &Problem,
@@ -447,133 +591,34 @@ fn solve(
         start: Instant::now(),
         used: 0,
     };
-    let f = problem.objective();
-    let pairs = problem.complementarity_pairs().to_vec();
-    let mut phases: Vec<MpccPhase> = Vec::new();
-    let mut spent = false;
-    let record = |phases: &mut Vec<MpccPhase>,
-                  kind: &'static str,
-                  penalty: f64,
-                  sol: &Solution|
-     -> Result<ComplementarityReport, MpccError> {
-        let rep = problem.complementarity_report(&sol.x, o.biactive_tol)?;
-        phases.push(MpccPhase {
-            kind,
-            penalty,
-            status: sol.status,
-            iterations: sol.stats.iterations,
-            objective: sol.objective,
-            residual: rep.residual,
-        });
-        Ok(rep)
+    let mut phases = Phases {
+        problem,
+        biactive_tol: o.biactive_tol,
+        list: Vec::new(),
     };
-    let label = |phases: &Vec<MpccPhase>, kind: &'static str, penalty: f64| PhaseLabel {
-        index: phases.len(),
-        kind,
-        penalty,
-    };
-    let stopped = |sol: &Solution| sol.status == Status::UserRequestedStop;
     // ---- main phase(s) ----
-    let mut best = match backend {
-        MpccBackend::Sqp => {
-            let mut c = problem.compile()?;
-            let solver = budget.first_solver();
-            let phase = label(&phases, "sqp", 0.0);
-            let sol = run(
-                solver.as_ref(),
-                &mut c,
-                None,
-                callback.as_deref_mut(),
-                phase,
-            )?;
-            record(&mut phases, "sqp", 0.0, &sol)?;
-            budget.used += sol.stats.iterations;
-            spent |= budget.spent_by(&sol);
-            sol
-        }
-        MpccBackend::Ipm => {
-            // f + π·Σ aᵢbᵢ with π a parameter: one compilation for every π.
-            let mut pb = problem.mpcc_copy(f, false);
-            let pi_param = pb.parameter(PENALTY_PARAMETER, 1)?[0];
-            let mut obj = f;
-            for (_, a, b) in &pairs {
-                obj += pi_param * (*a * *b);
-            }
-            pb.minimize(obj);
-            let mut pi = o.penalty_init;
-            pb.set_value(PENALTY_PARAMETER, &[pi])?;
-            let mut c = pb.compile()?;
-            let mut x: Option<Vec<f64>> = None;
-            let mut last: Option<Solution> = None;
-            loop {
-                let solver = match &last {
-                    None => budget.first_solver(),
-                    Some(_) => match budget.solver() {
-                        Some(solver) => solver,
-                        None => {
-                            spent = true;
-                            break last.take().expect("matched Some");
-                        }
-                    },
-                };
-                c.set_value(PENALTY_PARAMETER, &[pi])?;
-                let phase = label(&phases, "penalty", pi);
-                let cb = callback.as_deref_mut();
-                let sol = run(solver.as_ref(), &mut c, x.as_deref(), cb, phase)?;
-                let rep = record(&mut phases, "penalty", pi, &sol)?;
-                budget.used += sol.stats.iterations;
-                x = Some(sol.x.clone());
-                if budget.spent_by(&sol) {
-                    spent = true;
-                    break sol;
-                }
-                if stopped(&sol)
-                    || (ok(sol.status) && rep.residual <= o.switch_tol)
-                    || pi * o.penalty_increase > o.penalty_max
-                {
-                    break sol;
-                }
-                pi *= o.penalty_increase;
-                last = Some(sol);
-            }
-        }
+    let cb = callback.as_deref_mut();
+    let (mut best, mut spent) = match backend {
+        MpccBackend::Sqp => sqp_phase(problem, &mut budget, &mut phases, cb)?,
+        MpccBackend::Ipm => penalty_phases(problem, &mut budget, &mut phases, cb)?,
     };
     // The objective of the original problem at the returned point.
-    let f_at = |x: &[f64]| -> Result<f64, MpccError> { Ok(problem.evaluate(&[f], x)?[0]) };
-    best.objective = f_at(&best.x)?;
-    let main_phase = phases.len() - 1;
+    best.objective = problem.evaluate(&[problem.objective()], &best.x)?[0];
+    let main_phase = phases.list.len() - 1;
     let mut rescue = None;
     // ---- exact final phase ----
-    if o.exact_final_phase && !pairs.is_empty() && !stopped(&best) {
+    if o.exact_final_phase && !problem.complementarity_pairs().is_empty() && !stopped(&best) {
         match budget.solver() {
             None => spent = true,
             Some(solver) => {
-                let vals = problem.evaluate(
-                    &pairs
-                        .iter()
-                        .flat_map(|(_, a, b)| [*a, *b])
-                        .collect::<Vec<Expr>>(),
-                    &best.x,
-                )?;
-                let mut pb = problem.mpcc_copy(f, false);
-                for (k, (name, a, b)) in pairs.iter().enumerate() {
-                    let side = if vals[2 * k] <= vals[2 * k + 1] {
-                        *a
-                    } else {
-                        *b
-                    };
-                    pb.subject_to_named(&format!("{name}.branch"), side.eq(0.0))?;
-                }
-                let mut c = pb.compile()?;
-                let phase = label(&phases, "final", 0.0);
-                let sol = run(solver.as_ref(), &mut c, Some(&best.x), callback, phase)?;
-                record(&mut phases, "final", 0.0, &sol)?;
+                let sol = final_phase(problem, solver.as_ref(), &best.x, callback, &mut phases)?;
                 budget.used += sol.stats.iterations;
-                if ok(sol.status) && !ok(phases[main_phase].status) {
+                let failed_status = phases.list[main_phase].status;
+                if ok(sol.status) && !ok(failed_status) {
                     rescue = Some(Rescue {
                         failed_phase: main_phase,
-                        failed_status: phases[main_phase].status,
-                        rescued_by: phases.len() - 1,
+                        failed_status,
+                        rescued_by: phases.list.len() - 1,
                     });
                 }
                 if ok(sol.status) || stopped(&sol) {
@@ -584,6 +629,7 @@ fn solve(
             }
         }
     }
+    let phases = phases.list;
     let report = problem.complementarity_report(&best.x, o.biactive_tol)?;
     Ok(MpccSolution {
         iterations: budget.used,

@@ -487,6 +487,26 @@ fn bad(field: &'static str, reason: impl Into<String>) -> SolveError {
     }
 }
 
+/// `[(name, value)]` for the named `f64` fields of an options struct.
+macro_rules! named_fields {
+    ($s:expr; $($f:ident),* $(,)?) => {
+        [$((stringify!($f), $s.$f)),*]
+    };
+}
+
+/// The first field whose value breaks `rule` (`ok` false, NaN included) as an
+/// error "must be {rule}, got {value}".
+fn check_each(
+    fields: &[(&'static str, f64)],
+    rule: &str,
+    ok: impl Fn(f64) -> bool,
+) -> Result<(), SolveError> {
+    match fields.iter().find(|&&(_, v)| !ok(v)) {
+        Some(&(field, v)) => Err(bad(field, format!("must be {rule}, got {v}"))),
+        None => Ok(()),
+    }
+}
+
 impl IpmOptions {
     /// The residual ratio above which a solve counts as singular
     /// (`residual_ratio_singular`, by default `residual_ratio_max`).
@@ -523,28 +543,16 @@ impl IpmOptions {
 
     /// Every number that must be positive, non-negative or in (0, 1).
     fn check_ranges(&self) -> Result<(), SolveError> {
-        macro_rules! positive {
-            ($($f:ident),*) => {$(
-                if !(self.$f > 0.0) || !self.$f.is_finite() {
-                    return Err(bad(stringify!($f), format!("must be finite and > 0, got {}", self.$f)));
-                }
-            )*};
-        }
-        macro_rules! nonneg {
-            ($($f:ident),*) => {$(
-                if !(self.$f >= 0.0) || !self.$f.is_finite() {
-                    return Err(bad(stringify!($f), format!("must be finite and >= 0, got {}", self.$f)));
-                }
-            )*};
-        }
-        macro_rules! open_unit {
-            ($($f:ident),*) => {$(
-                if !(self.$f > 0.0 && self.$f < 1.0) {
-                    return Err(bad(stringify!($f), format!("must be in (0, 1), got {}", self.$f)));
-                }
-            )*};
-        }
-        positive!(
+        self.check_positive()?;
+        self.check_nonnegative()?;
+        self.check_open_unit()?;
+        self.check_section_tolerances()
+    }
+
+    /// The numbers that must be finite and > 0.
+    fn check_positive(&self) -> Result<(), SolveError> {
+        let fields = named_fields!(
+            self;
             mu_init,
             mu_max,
             sigma_max,
@@ -576,7 +584,13 @@ impl IpmOptions {
             limited_memory_init_val_max,
             limited_memory_init_val_min
         );
-        nonneg!(
+        check_each(&fields, "finite and > 0", |v| v > 0.0 && v.is_finite())
+    }
+
+    /// The numbers that must be finite and >= 0.
+    fn check_nonnegative(&self) -> Result<(), SolveError> {
+        let fields = named_fields!(
+            self;
             bound_push,
             bound_frac,
             slack_bound_push,
@@ -596,7 +610,13 @@ impl IpmOptions {
             kkt_static_hessian_regularization,
             resto_proximity_weight
         );
-        open_unit!(
+        check_each(&fields, "finite and >= 0", |v| v >= 0.0 && v.is_finite())
+    }
+
+    /// The numbers that must lie in the open interval (0, 1).
+    fn check_open_unit(&self) -> Result<(), SolveError> {
+        let fields = named_fields!(
+            self;
             mu_linear_decrease_factor,
             tau_min,
             adaptive_mu_kkterror_red_fact,
@@ -610,6 +630,11 @@ impl IpmOptions {
             perturb_dec_fact,
             required_infeasibility_reduction
         );
+        check_each(&fields, "in (0, 1)", |v| v > 0.0 && v < 1.0)
+    }
+
+    /// The quality function's section-search tolerances, in [0, 1).
+    fn check_section_tolerances(&self) -> Result<(), SolveError> {
         if !(0.0..1.0).contains(&self.quality_function_section_sigma_tol) {
             return Err(bad(
                 "quality_function_section_sigma_tol",

@@ -200,58 +200,13 @@ impl ParametricSensitivity {
     pub fn compute(&mut self, sol: &Solution, p: &[f64]) -> Result<Sensitivity, SensitivityError> {
         self.check(sol, p)?;
         let (n, m) = (self.n, self.m);
-        let eval = |f: &Function| -> Result<Vec<f64>, SensitivityError> {
-            Ok(f.call(&[&sol.x, p, &sol.lambda])?.swap_remove(0))
-        };
-        let (h, j, lxp, gp) = (
-            eval(&self.hess.0)?,
-            eval(&self.jac.0)?,
-            eval(&self.lxp.0)?,
-            eval(&self.gp.0)?,
-        );
+        let [h, j, lxp, gp] = self.derivatives(sol, p)?;
         let bound = self.active_bounds(sol);
         let row = self.active_rows(sol);
-        // K with identity blocks for the bound-active variables and the inactive rows.
-        let mut h_mod = h.clone();
-        for_each_entry(&self.hess.1, |k, r, c| {
-            if bound[r].is_some() || bound[c].is_some() {
-                h_mod[k] = 0.0;
-            }
-        });
-        let mut j_mod = j.clone();
-        for_each_entry(&self.jac.1, |k, r, c| {
-            if !row[r] || bound[c].is_some() {
-                j_mod[k] = 0.0;
-            }
-        });
+        let (h_mod, j_mod) = self.reduced_kkt_values(&h, &j, &bound, &row);
         let (inertia, delta_x) = self.factorize(&h_mod, &j_mod, &bound, &row)?;
-        let expected = Inertia {
-            positive: n,
-            negative: m,
-            zero: 0,
-        };
-        if inertia != expected {
-            return Err(SensitivityError::Inertia {
-                positive: inertia.positive,
-                negative: inertia.negative,
-                zero: inertia.zero,
-                n,
-                m,
-            });
-        }
-        // The factor is of K + diag(δ_x on F, −δ_c on active rows); refinement solves the
-        // exact system (shift −δ_x and +δ_c).
-        let mut shift = vec![0.0; n + m];
-        for (s, b) in shift[..n].iter_mut().zip(&bound) {
-            if b.is_none() {
-                *s = -delta_x;
-            }
-        }
-        for (s, &a) in shift[n..].iter_mut().zip(&row) {
-            if a {
-                *s = DELTA_C;
-            }
-        }
+        check_inertia(inertia, n, m)?;
+        let shift = refinement_shift(delta_x, &bound, &row);
         let lxp_cols = dense_columns(&self.lxp.1, &lxp, self.np);
         let gp_cols = dense_columns(&self.gp.1, &gp, self.np);
         let mut out = Sensitivity {
@@ -265,41 +220,84 @@ impl ParametricSensitivity {
             residual: 0.0,
         };
         for (lxp_j, gp_j) in lxp_cols.iter().zip(&gp_cols) {
-            let mut rhs = vec![0.0; n + m];
-            for i in 0..n {
-                if bound[i].is_none() {
-                    rhs[i] = -lxp_j[i];
-                }
-            }
-            for i in 0..m {
-                if row[i] {
-                    rhs[n + i] = -gp_j[i];
-                }
-            }
+            let mut rhs = parameter_rhs(lxp_j, gp_j, &bound, &row);
             let residual = self.kkt.solve_shifted(&mut rhs, Some(&shift))?;
             if residual.is_nan() || residual > 1e-8 {
                 return Err(SensitivityError::Inaccurate(residual));
             }
             out.residual = out.residual.max(residual);
             let (dxj, dlj) = rhs.split_at(n);
-            // Bound multipliers from the stationarity rows of the active bounds.
-            let mut net = lxp_j.clone(); // d(z_U − z_L) = −(H dx + Jᵀ dλ + ∇²ₓₚL)
-            symmetric_product(&self.hess.1, &h, dxj, &mut net);
-            for_each_entry(&self.jac.1, |k, r, c| net[c] += j[k] * dlj[r]);
-            let (mut dzl, mut dzu) = (vec![0.0; n], vec![0.0; n]);
-            for i in 0..n {
-                match bound[i] {
-                    Some(Side::Lower) => dzl[i] = net[i],
-                    Some(Side::Upper) => dzu[i] = -net[i],
-                    None => {}
-                }
-            }
+            let (dzl, dzu) = self.bound_multiplier_steps(lxp_j, &h, &j, dxj, dlj, &bound);
             out.dx_dp.push(dxj.to_vec());
             out.dlambda_dp.push(dlj.to_vec());
             out.dz_l_dp.push(dzl);
             out.dz_u_dp.push(dzu);
         }
         Ok(out)
+    }
+
+    /// The values at `(sol.x, p, sol.lambda)` of the Lagrangian's Hessian, the
+    /// constraints' Jacobian, `∇²ₓₚL` and `∂g/∂p`.
+    fn derivatives(&self, sol: &Solution, p: &[f64]) -> Result<[Vec<f64>; 4], SensitivityError> {
+        let eval = |f: &Function| -> Result<Vec<f64>, SensitivityError> {
+            Ok(f.call(&[&sol.x, p, &sol.lambda])?.swap_remove(0))
+        };
+        Ok([
+            eval(&self.hess.0)?,
+            eval(&self.jac.0)?,
+            eval(&self.lxp.0)?,
+            eval(&self.gp.0)?,
+        ])
+    }
+
+    /// The Hessian and Jacobian values of K with identity blocks for the bound-active
+    /// variables and the inactive rows: their couplings are zeroed.
+    fn reduced_kkt_values(
+        &self,
+        h: &[f64],
+        j: &[f64],
+        bound: &[Option<Side>],
+        row: &[bool],
+    ) -> (Vec<f64>, Vec<f64>) {
+        let mut h_mod = h.to_vec();
+        for_each_entry(&self.hess.1, |k, r, c| {
+            if bound[r].is_some() || bound[c].is_some() {
+                h_mod[k] = 0.0;
+            }
+        });
+        let mut j_mod = j.to_vec();
+        for_each_entry(&self.jac.1, |k, r, c| {
+            if !row[r] || bound[c].is_some() {
+                j_mod[k] = 0.0;
+            }
+        });
+        (h_mod, j_mod)
+    }
+
+    /// The steps of `(z_L, z_U)` from the stationarity rows of the active bounds:
+    /// `d(z_U − z_L) = −(H dx + Jᵀ dλ + ∇²ₓₚL)`.
+    fn bound_multiplier_steps(
+        &self,
+        lxp_j: &[f64],
+        h: &[f64],
+        j: &[f64],
+        dxj: &[f64],
+        dlj: &[f64],
+        bound: &[Option<Side>],
+    ) -> (Vec<f64>, Vec<f64>) {
+        let n = self.n;
+        let mut net = lxp_j.to_vec();
+        symmetric_product(&self.hess.1, h, dxj, &mut net);
+        for_each_entry(&self.jac.1, |k, r, c| net[c] += j[k] * dlj[r]);
+        let (mut dzl, mut dzu) = (vec![0.0; n], vec![0.0; n]);
+        for i in 0..n {
+            match bound[i] {
+                Some(Side::Lower) => dzl[i] = net[i],
+                Some(Side::Upper) => dzu[i] = -net[i],
+                None => {}
+            }
+        }
+        (dzl, dzu)
     }
 
     /// Factorises the modified KKT matrix; when an exact zero pivot occurs (a variable
@@ -417,6 +415,62 @@ impl ParametricSensitivity {
 enum Side {
     Lower,
     Upper,
+}
+
+/// Checks that the reduced KKT matrix has the inertia `(n, m, 0)` of a strict local
+/// minimiser satisfying LICQ.
+fn check_inertia(inertia: Inertia, n: usize, m: usize) -> Result<(), SensitivityError> {
+    let expected = Inertia {
+        positive: n,
+        negative: m,
+        zero: 0,
+    };
+    if inertia != expected {
+        return Err(SensitivityError::Inertia {
+            positive: inertia.positive,
+            negative: inertia.negative,
+            zero: inertia.zero,
+            n,
+            m,
+        });
+    }
+    Ok(())
+}
+
+/// The factor is of K + diag(δ_x on F, −δ_c on active rows); refinement solves the
+/// exact system with this shift (−δ_x on the free variables, +δ_c on active rows).
+fn refinement_shift(delta_x: f64, bound: &[Option<Side>], row: &[bool]) -> Vec<f64> {
+    let n = bound.len();
+    let mut shift = vec![0.0; n + row.len()];
+    for (s, b) in shift[..n].iter_mut().zip(bound) {
+        if b.is_none() {
+            *s = -delta_x;
+        }
+    }
+    for (s, &a) in shift[n..].iter_mut().zip(row) {
+        if a {
+            *s = DELTA_C;
+        }
+    }
+    shift
+}
+
+/// The right-hand side `−(∇²ₓₚL, ∂g/∂p)` of one parameter's column, zero on the
+/// bound-active variables and the inactive rows.
+fn parameter_rhs(lxp_j: &[f64], gp_j: &[f64], bound: &[Option<Side>], row: &[bool]) -> Vec<f64> {
+    let n = bound.len();
+    let mut rhs = vec![0.0; n + row.len()];
+    for i in 0..n {
+        if bound[i].is_none() {
+            rhs[i] = -lxp_j[i];
+        }
+    }
+    for i in 0..row.len() {
+        if row[i] {
+            rhs[n + i] = -gp_j[i];
+        }
+    }
+    rhs
 }
 
 /// Calls `f(storage index, row, column)` for every stored entry of a CSC pattern.

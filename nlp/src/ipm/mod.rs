@@ -240,7 +240,7 @@ fn iterate(
     let ended = match Core::new(red, opts, &setup, buffers) {
         Err(e) => at_start(Status::InternalError, e.to_string()),
         Ok(mut core) => {
-            let out = core.run(shared, start);
+            let out = core.run(shared, start, restoration::restore);
             *kept = Some((structure, core.into_buffers()));
             Ended::Iterated(out)
         }

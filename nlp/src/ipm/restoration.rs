@@ -14,11 +14,11 @@
 use faer::sparse::SymbolicSparseColMat;
 
 use crate::frontend::scaled::Scaling;
-use crate::ipm::core::{barrier_value, Buffers, Core, Outcome, Setup, Shared, Start};
+use crate::ipm::core::{barrier_value, Buffers, Core, Layout, Outcome, Setup, Shared, Start};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::numeric::NumericNlp;
-use crate::options::MuStrategy;
+use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::Status;
 
 struct Resto<'a> {
@@ -211,75 +211,75 @@ impl IpmProblem for Resto<'_> {
 /// Runs a restoration phase from the outer core's current iterate. On success the outer
 /// core continues from the restored point; otherwise the final outcome is returned.
 pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Outcome> {
-    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let (n, m) = (core.layout().n, core.layout().m);
     let opts = core.options().clone();
     let mu = core.mu().max(inf_norm(&core.iterate().c));
     let rho = opts.resto_penalty_parameter;
-    // Initial p, n (IPOPT's closed form: c − p + n = 0, complementarity μ).
-    let mut pv = vec![0.0; m];
-    let mut nv = vec![0.0; m];
-    for i in 0..m {
-        let c = core.iterate().c[i];
-        let a = (mu - rho * c) / (2.0 * rho);
-        let nn = a + (a * a + mu * c / (2.0 * rho)).sqrt();
-        nv[i] = nn.max(1e-300);
-        pv[i] = (c + nn).max(1e-300);
-    }
-    let xr: Vec<f64> = core.iterate().w[..n].to_vec();
+    let (pv, nv) = initial_p_n(&core.iterate().c, mu, rho);
+    // Full inner iterate: w = [x, p, n, s].
+    let mut w = core.iterate().w[..n].to_vec();
+    w.extend_from_slice(&pv);
+    w.extend_from_slice(&nv);
+    w.extend_from_slice(&core.iterate().w[n..]);
+    let [zl, zu] = resto_bound_multipliers(core, &pv, &nv, mu, rho);
+    // IPOPT's first 'r' row reports the failed line search of the outer iteration
+    // (alpha_pr, 'R', ls).
+    let resto_start = core.take_resto_start();
+    let x0 = w[..n + 2 * m].to_vec();
+    let mut resto = resto_problem(core, &opts, x0, mu);
+    let unscaled = Scaling::unscaled(m);
+    let setup = Setup {
+        mu_init: mu,
+        bound_relax_factor: 0.0,
+        in_resto: true,
+        scaling: &unscaled,
+        mu_strategy: MuStrategy::Monotone,
+    };
+    let mut inner_opts = opts.clone();
+    inner_opts.acceptable_iter = 0;
+    inner_opts.start_with_resto = false;
+    let mut inner = match Core::new(&mut resto, &inner_opts, &setup, Buffers::default()) {
+        Ok(c) => c,
+        Err(e) => return Err(core.outcome(Status::RestorationFailed, e.to_string(), false)),
+    };
+    inner.set_resto_start(resto_start);
+    let y0 = vec![0.0; m];
+    let start = Start::Exact {
+        w: &w,
+        y: &y0,
+        zl: &zl,
+        zu: &zu,
+    };
+    let (outcome, w_o) = run_inner(&mut inner, shared, start, n, m);
+    drop(inner);
+    drop(resto);
+    continue_after(core, outcome, &w_o, opts.constr_viol_tol)
+}
+
+/// The restoration problem around the outer core's current iterate, starting at
+/// `x0 = [x, p, n]` with barrier parameter `mu`; it evaluates through the outer problem.
+fn resto_problem<'a>(
+    core: &'a mut Core<'_>,
+    opts: &IpmOptions,
+    x0: Vec<f64>,
+    mu: f64,
+) -> Resto<'a> {
+    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let xr: Vec<f64> = x0[..n].to_vec();
     let dr2: Vec<f64> = xr
         .iter()
         .map(|x| (1.0f64).min(1.0 / x.abs()).powi(2))
         .collect();
-    // Patterns.
     let jac_o = core.problem().jac_g_sparsity().clone();
     let nnz_j_orig = jac_o.row_idx().len();
     let (jac, hess, hmap, hdiag) = resto_patterns(&jac_o, core.problem().hess_l_sparsity(), n, m);
     let hbuf_len = core.problem().hess_l_sparsity().row_idx().len();
-    let mut x_l = vec![0.0; n + 2 * m];
-    let mut x_u = vec![f64::INFINITY; n + 2 * m];
-    x_l[..n].copy_from_slice(&core.layout().wl[..n]);
-    x_u[..n].copy_from_slice(&core.layout().wu[..n]);
-    let mut g_l = vec![0.0; m];
-    let mut g_u = vec![0.0; m];
-    for i in 0..m {
-        let k = core.layout().slack_of_row[i];
-        if k == usize::MAX {
-            g_l[i] = core.layout().g_eq[i];
-            g_u[i] = core.layout().g_eq[i];
-        } else {
-            g_l[i] = core.layout().wl[n + k];
-            g_u[i] = core.layout().wu[n + k];
-        }
-    }
-    let mut x0 = xr.clone();
-    x0.extend_from_slice(&pv);
-    x0.extend_from_slice(&nv);
-    // Full inner iterate: w = [x, p, n, s].
-    let nwi = n + 2 * m + ni;
-    let mut w = x0.clone();
-    w.extend_from_slice(&core.iterate().w[n..]);
-    let mut zl = vec![0.0; nwi];
-    let mut zu = vec![0.0; nwi];
-    for j in 0..n {
-        zl[j] = core.iterate().zl[j].min(rho);
-        zu[j] = core.iterate().zu[j].min(rho);
-    }
-    for i in 0..m {
-        zl[n + i] = mu / pv[i];
-        zl[n + m + i] = mu / nv[i];
-    }
-    for k in 0..ni {
-        zl[n + 2 * m + k] = core.iterate().zl[n + k].min(rho);
-        zu[n + 2 * m + k] = core.iterate().zu[n + k].min(rho);
-    }
-    let theta_max = core.theta_max();
-    // IPOPT's first 'r' row reports the failed line search of the outer iteration
-    // (alpha_pr, 'R', ls).
-    let resto_start = core.take_resto_start();
-    let resto = Resto {
+    let ([x_l, x_u], [g_l, g_u]) = resto_bounds(core.layout());
+    let lay = core.layout();
+    Resto {
         n,
         m,
-        rho,
+        rho: opts.resto_penalty_parameter,
         zeta: opts.resto_proximity_weight * mu.sqrt(),
         dr2,
         xr,
@@ -294,59 +294,108 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         g_u,
         x0,
         hbuf: vec![0.0; hbuf_len],
-        slack_of_row: core.layout().slack_of_row.clone(),
-        g_eq: core.layout().g_eq.clone(),
-        wl: core.layout().wl.clone(),
-        wu: core.layout().wu.clone(),
-        has_l: core.layout().has_l.clone(),
-        has_u: core.layout().has_u.clone(),
+        slack_of_row: lay.slack_of_row.clone(),
+        g_eq: lay.g_eq.clone(),
+        wl: lay.wl.clone(),
+        wu: lay.wu.clone(),
+        has_l: lay.has_l.clone(),
+        has_u: lay.has_u.clone(),
         kappa_d: opts.kappa_d,
         mu_outer: core.mu(),
         filter: core.filter().clone(),
         inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.iterate().c))
             .max(opts.tol.min(opts.constr_viol_tol)),
-        theta_max,
+        theta_max: core.theta_max(),
         gbuf: vec![0.0; m],
         wbuf: vec![0.0; n + ni],
         outer_scaling: core.scaling().clone(),
         outer: core.problem_mut(),
-    };
-    let mut resto = resto;
-    let unscaled = Scaling::unscaled(m);
-    let setup = Setup {
-        mu_init: mu,
-        bound_relax_factor: 0.0,
-        in_resto: true,
-        scaling: &unscaled,
-        mu_strategy: MuStrategy::Monotone,
-    };
-    let (outcome, w_o) = {
-        let mut inner_opts = opts.clone();
-        inner_opts.acceptable_iter = 0;
-        inner_opts.start_with_resto = false;
-        let mut inner = match Core::new(&mut resto, &inner_opts, &setup, Buffers::default()) {
-            Ok(c) => c,
-            Err(e) => return Err(core.outcome(Status::RestorationFailed, e.to_string(), false)),
-        };
-        inner.set_resto_start(resto_start);
-        let y0 = vec![0.0; m];
-        let outcome = inner.run(
-            shared,
-            Start::Exact {
-                w: &w,
-                y: &y0,
-                zl: &zl,
-                zu: &zu,
-            },
-        );
-        // Map the inner point back: x = w[..n], s = w[n+2m..].
-        let w_inner = &inner.iterate().w;
-        let mut w_o = w_inner[..n].to_vec();
-        w_o.extend_from_slice(&w_inner[n + 2 * m..]);
-        (outcome, w_o)
-    };
-    drop(resto);
-    continue_after(core, outcome, &w_o, opts.constr_viol_tol)
+    }
+}
+
+/// The inner core's solve from `start`, and its final point mapped back to the outer
+/// variables: `x = w[..n]`, `s = w[n+2m..]`.
+fn run_inner(
+    inner: &mut Core<'_>,
+    shared: &mut Shared,
+    start: Start<'_>,
+    n: usize,
+    m: usize,
+) -> (Outcome, Vec<f64>) {
+    // The inner core never restores (it is the restoration phase); `restore` stands
+    // for the argument.
+    let outcome = inner.run(shared, start, restore);
+    let w_inner = &inner.iterate().w;
+    let mut w_o = w_inner[..n].to_vec();
+    w_o.extend_from_slice(&w_inner[n + 2 * m..]);
+    (outcome, w_o)
+}
+
+/// The initial elastic variables `p, n` for constraint values `c`: IPOPT's closed
+/// form of `c − p + n = 0` with complementarity `μ` and penalty `ρ`.
+fn initial_p_n(c: &[f64], mu: f64, rho: f64) -> (Vec<f64>, Vec<f64>) {
+    let m = c.len();
+    let mut pv = vec![0.0; m];
+    let mut nv = vec![0.0; m];
+    for i in 0..m {
+        let c = c[i];
+        let a = (mu - rho * c) / (2.0 * rho);
+        let nn = a + (a * a + mu * c / (2.0 * rho)).sqrt();
+        nv[i] = nn.max(1e-300);
+        pv[i] = (c + nn).max(1e-300);
+    }
+    (pv, nv)
+}
+
+/// The restoration problem's variable bounds `[x_l, x_u]` (x's own, `p, n ≥ 0`) and
+/// constraint bounds `[g_l, g_u]` (the equality value, or the slack's bounds).
+fn resto_bounds(lay: &Layout) -> ([Vec<f64>; 2], [Vec<f64>; 2]) {
+    let (n, m) = (lay.n, lay.m);
+    let mut x_l = vec![0.0; n + 2 * m];
+    let mut x_u = vec![f64::INFINITY; n + 2 * m];
+    x_l[..n].copy_from_slice(&lay.wl[..n]);
+    x_u[..n].copy_from_slice(&lay.wu[..n]);
+    let mut g_l = vec![0.0; m];
+    let mut g_u = vec![0.0; m];
+    for i in 0..m {
+        let k = lay.slack_of_row[i];
+        if k == usize::MAX {
+            g_l[i] = lay.g_eq[i];
+            g_u[i] = lay.g_eq[i];
+        } else {
+            g_l[i] = lay.wl[n + k];
+            g_u[i] = lay.wu[n + k];
+        }
+    }
+    ([x_l, x_u], [g_l, g_u])
+}
+
+/// The inner start's bound multipliers `[z_L, z_U]` on `w = [x, p, n, s]`: the outer
+/// ones capped at `ρ` for x and s, `μ/p` and `μ/n` for the elastic variables.
+fn resto_bound_multipliers(
+    core: &Core<'_>,
+    pv: &[f64],
+    nv: &[f64],
+    mu: f64,
+    rho: f64,
+) -> [Vec<f64>; 2] {
+    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let nwi = n + 2 * m + ni;
+    let mut zl = vec![0.0; nwi];
+    let mut zu = vec![0.0; nwi];
+    for j in 0..n {
+        zl[j] = core.iterate().zl[j].min(rho);
+        zu[j] = core.iterate().zu[j].min(rho);
+    }
+    for i in 0..m {
+        zl[n + i] = mu / pv[i];
+        zl[n + m + i] = mu / nv[i];
+    }
+    for k in 0..ni {
+        zl[n + 2 * m + k] = core.iterate().zl[n + k].min(rho);
+        zu[n + 2 * m + k] = core.iterate().zu[n + k].min(rho);
+    }
+    [zl, zu]
 }
 
 /// The outer core after a restoration phase that ended with `outcome` at the point `w_o`

@@ -33,6 +33,98 @@ pub(super) struct Simplicial {
     pub pshift: Vec<f64>,
 }
 
+/// The permuted upper triangle of `pattern` under the inverse permutation `inv`, and
+/// the position in it of each entry of `pattern`. Original entry (r, c), r ≤ c, goes
+/// to (min, max) of (inv[r], inv[c]).
+fn permuted_upper(
+    pattern: &SymbolicSparseColMat<usize>,
+    inv: &[usize],
+) -> (SymbolicSparseColMat<usize>, Vec<usize>) {
+    let dim = pattern.ncols();
+    let cp = pattern.col_ptr();
+    let ri = pattern.row_idx();
+    let nnz = ri.len();
+    let mut count = vec![0usize; dim + 1];
+    let mut target = Vec::with_capacity(nnz);
+    for c in 0..dim {
+        for &r in &ri[cp[c]..cp[c + 1]] {
+            let (a, b) = (inv[r], inv[c]);
+            let (row, col) = if a <= b { (a, b) } else { (b, a) };
+            target.push((row, col));
+            count[col + 1] += 1;
+        }
+    }
+    for j in 0..dim {
+        count[j + 1] += count[j];
+    }
+    let col_ptr = count.clone();
+    let mut next = count;
+    let mut row_idx = vec![0usize; nnz];
+    let mut pos = vec![0usize; nnz];
+    // Fill column by column; then sort each column's rows, carrying `pos` along.
+    for (p, &(row, col)) in target.iter().enumerate() {
+        let q = next[col];
+        next[col] += 1;
+        row_idx[q] = row;
+        pos[p] = q;
+    }
+    let mut order: Vec<usize> = Vec::new();
+    let mut where_new = vec![0usize; nnz];
+    let mut sorted_rows = vec![0usize; nnz];
+    for j in 0..dim {
+        let (a, b) = (col_ptr[j], col_ptr[j + 1]);
+        order.clear();
+        order.extend(a..b);
+        order.sort_unstable_by_key(|&q| row_idx[q]);
+        for (t, &q) in order.iter().enumerate() {
+            where_new[q] = a + t;
+            sorted_rows[a + t] = row_idx[q];
+        }
+    }
+    for p in pos.iter_mut() {
+        *p = where_new[*p];
+    }
+    let ppat = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, sorted_rows);
+    (ppat, pos)
+}
+
+/// The rows of L (`row_ptr`, the column and the position in L of each entry below the
+/// diagonal), from L's column pattern; `None` if a column does not start at its
+/// diagonal or has an entry above it.
+fn rows_of_l(
+    l_col_ptr: &[usize],
+    l_row_idx: &[usize],
+) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>)> {
+    let dim = l_col_ptr.len() - 1;
+    let mut row_ptr = vec![0usize; dim + 1];
+    for j in 0..dim {
+        if l_row_idx[l_col_ptr[j]] != j {
+            return None;
+        }
+        for &r in &l_row_idx[l_col_ptr[j] + 1..l_col_ptr[j + 1]] {
+            if r <= j {
+                return None;
+            }
+            row_ptr[r + 1] += 1;
+        }
+    }
+    for k in 0..dim {
+        row_ptr[k + 1] += row_ptr[k];
+    }
+    let mut fill = row_ptr.clone();
+    let mut row_col = vec![0usize; row_ptr[dim]];
+    let mut row_pos = vec![0usize; row_ptr[dim]];
+    for j in 0..dim {
+        for p in l_col_ptr[j] + 1..l_col_ptr[j + 1] {
+            let r = l_row_idx[p];
+            row_col[fill[r]] = j;
+            row_pos[fill[r]] = p;
+            fill[r] += 1;
+        }
+    }
+    Some((row_ptr, row_col, row_pos))
+}
+
 impl Simplicial {
     /// Builds the permuted upper pattern of K and the map from positions in `pattern`
     /// (the original upper triangle) to positions in the permuted one. `None` if faer's
@@ -53,52 +145,7 @@ impl Simplicial {
             }
             None => ((0..dim).collect(), (0..dim).collect()),
         };
-        // Permuted upper triangle: original entry (r, c), r ≤ c, goes to
-        // (min, max) of (inv[r], inv[c]).
-        let cp = pattern.col_ptr();
-        let ri = pattern.row_idx();
-        let nnz = ri.len();
-        let mut count = vec![0usize; dim + 1];
-        let mut target = Vec::with_capacity(nnz);
-        for c in 0..dim {
-            for &r in &ri[cp[c]..cp[c + 1]] {
-                let (a, b) = (inv[r], inv[c]);
-                let (row, col) = if a <= b { (a, b) } else { (b, a) };
-                target.push((row, col));
-                count[col + 1] += 1;
-            }
-        }
-        for j in 0..dim {
-            count[j + 1] += count[j];
-        }
-        let col_ptr = count.clone();
-        let mut next = count;
-        let mut row_idx = vec![0usize; nnz];
-        let mut pos = vec![0usize; nnz];
-        // Fill column by column; then sort each column's rows, carrying `pos` along.
-        for (p, &(row, col)) in target.iter().enumerate() {
-            let q = next[col];
-            next[col] += 1;
-            row_idx[q] = row;
-            pos[p] = q;
-        }
-        let mut order: Vec<usize> = Vec::new();
-        let mut where_new = vec![0usize; nnz];
-        let mut sorted_rows = vec![0usize; nnz];
-        for j in 0..dim {
-            let (a, b) = (col_ptr[j], col_ptr[j + 1]);
-            order.clear();
-            order.extend(a..b);
-            order.sort_unstable_by_key(|&q| row_idx[q]);
-            for (t, &q) in order.iter().enumerate() {
-                where_new[q] = a + t;
-                sorted_rows[a + t] = row_idx[q];
-            }
-        }
-        for p in pos.iter_mut() {
-            *p = where_new[*p];
-        }
-        let ppat = SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, sorted_rows);
+        let (ppat, pos) = permuted_upper(pattern, &inv);
         let l_col_ptr = s.col_ptr().to_vec();
         let l_row_idx = s.row_idx().to_vec();
         if l_col_ptr.len() != dim + 1
@@ -107,35 +154,7 @@ impl Simplicial {
         {
             return None;
         }
-        // Rows of L.
-        let mut row_ptr = vec![0usize; dim + 1];
-        for j in 0..dim {
-            if l_row_idx[l_col_ptr[j]] != j {
-                return None;
-            }
-            for &r in &l_row_idx[l_col_ptr[j] + 1..l_col_ptr[j + 1]] {
-                if r <= j {
-                    return None;
-                }
-                row_ptr[r + 1] += 1;
-            }
-        }
-        for k in 0..dim {
-            row_ptr[k + 1] += row_ptr[k];
-        }
-        let mut fill = row_ptr.clone();
-        let mut row_col = vec![0usize; row_ptr[dim]];
-        let mut row_pos = vec![0usize; row_ptr[dim]];
-        for j in 0..dim {
-            for p in l_col_ptr[j] + 1..l_col_ptr[j + 1] {
-                let r = l_row_idx[p];
-                row_col[fill[r]] = j;
-                row_pos[fill[r]] = p;
-                fill[r] += 1;
-            }
-        }
-        // Every off-diagonal entry (i, k), i < k, of the permuted K must be an entry
-        // L_ki of the factor.
+        let (row_ptr, row_col, row_pos) = rows_of_l(&l_col_ptr, &l_row_idx)?;
         let simp = Simplicial {
             fwd,
             l_col_ptr,
@@ -147,15 +166,25 @@ impl Simplicial {
             x: vec![0.0; dim],
             pshift: vec![0.0; dim],
         };
+        if !simp.covers(&ppat) {
+            return None;
+        }
+        Some((simp, ppat, pos))
+    }
+
+    /// Whether every off-diagonal entry (i, k), i < k, of the permuted K `ppat` is an
+    /// entry L_ki of the factor.
+    fn covers(&self, ppat: &SymbolicSparseColMat<usize>) -> bool {
+        let dim = self.fwd.len();
         for k in 0..dim {
-            let cols = &simp.row_col[simp.row_ptr[k]..simp.row_ptr[k + 1]];
+            let cols = &self.row_col[self.row_ptr[k]..self.row_ptr[k + 1]];
             for &i in ppat.row_idx_of_col_raw(k) {
                 if i < k && cols.binary_search(&i).is_err() {
-                    return None;
+                    return false;
                 }
             }
         }
-        Some((simp, ppat, pos))
+        true
     }
 
     /// Numeric LDLᵀ of the permuted upper triangle (`col_ptr`, `row_idx`, `values`) into

@@ -13,6 +13,7 @@ use super::all_finite;
 use super::perturbation::Perturbation;
 use super::Core;
 use super::Shared;
+use crate::kkt::KktError;
 
 /// A primal-dual direction.
 #[derive(Default)]
@@ -42,6 +43,16 @@ impl Core<'_> {
     /// primal residual c by the given vector. Writes into (dw, dy, dzl, dzu) or the SOC
     /// buffers.
     pub(super) fn solve_direction(&mut self, shared: &mut Shared, mu_t: f64, soc: bool) -> bool {
+        self.assemble_direction_rhs(mu_t, soc);
+        if !self.solve_kkt_rhs(shared, soc) {
+            return false;
+        }
+        self.recover_direction(mu_t, soc)
+    }
+
+    /// The reduced KKT right-hand side for complementarity target `mu_t` (slack rows
+    /// condensed into the constraint rows), with `c_soc` for `c` if `soc`.
+    fn assemble_direction_rhs(&mut self, mu_t: f64, soc: bool) {
         let (n, m) = (self.lay.n, self.lay.m);
         let mut work = std::mem::take(&mut self.kw.work_nw);
         self.at_times(&self.it.jac, &self.it.y, &mut work);
@@ -78,6 +89,12 @@ impl Core<'_> {
                 -ci + self.kw.rhs_s[k] / self.kw.ds[k]
             };
         }
+    }
+
+    /// Solves the assembled system in place, refined against the system without the
+    /// static regularisation; a (numerically) singular system is retried with a better
+    /// factor, then regularised. False when no usable solution was found.
+    fn solve_kkt_rhs(&mut self, shared: &mut Shared, soc: bool) -> bool {
         // Refine against the system without the static regularisation.
         let mut t = Instant::now();
         self.kw.rhs_copy.copy_from_slice(&self.kw.rhs);
@@ -104,44 +121,9 @@ impl Core<'_> {
             // iterations in a row, at any point of the solve, put catenary_999's δ_c on
             // in 1281 of 1307 iterations, IPOPT's in none of 70).
             shared.stats.factor_seconds += t.elapsed().as_secs_f64();
-            self.pert.singular_iters += 1;
-            if self.pert.singular_iters >= 3 && !self.pert.jac_determined {
-                self.pert.jac_degenerate = true;
-            }
-            self.pert.delta_c = Perturbation::delta_cd(&self.opts, self.mu);
-            let dw = self.pert.delta_w;
-            let ok = matches!(self.factor_kkt(shared, dw, self.pert.delta_c),
-                Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
-            if !ok {
-                // Should not happen (δ_c does not change the inertia); fall back to
-                // the statically regularised system as it is.
-                self.pert.delta_c = 0.0;
-                if self.factor_kkt(shared, dw, self.pert.delta_c).is_err() {
-                    return false;
-                }
-            }
-            let t = Instant::now();
-            self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
-            res = self.kw.solve_rhs();
-            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
-            let mut dw = self.pert.delta_w;
-            while ok && !matches!(res, Ok(r) if r <= singular_ratio) {
-                // Still singular (singular reduced Hessian): IPOPT increases δ_w.
-                dw = self.pert.next_delta_w(&self.opts, dw);
-                if dw > self.opts.max_hessian_perturbation {
-                    return false;
-                }
-                match self.factor_kkt(shared, dw, self.pert.delta_c) {
-                    Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
-                    Ok(_) => continue,
-                    Err(_) => continue,
-                }
-                self.pert.delta_w = dw;
-                self.pert.delta_w_last = dw;
-                let t = Instant::now();
-                self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
-                res = self.kw.solve_rhs();
-                shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+            match self.solve_regularised(shared) {
+                Some(r) => res = r,
+                None => return false,
             }
         } else {
             shared.stats.factor_seconds += t.elapsed().as_secs_f64();
@@ -150,9 +132,60 @@ impl Core<'_> {
                 self.pert.jac_determined = true;
             }
         }
-        if res.is_err() {
-            return false;
+        res.is_ok()
+    }
+
+    /// IPOPT's regularised step for a singular system: refactorises with `δ_c`, then
+    /// raises `δ_w` while the solve stays singular. `None` when no factor is usable.
+    fn solve_regularised(&mut self, shared: &mut Shared) -> Option<Result<f64, KktError>> {
+        let (n, m) = (self.lay.n, self.lay.m);
+        let singular_ratio = self.opts.singular_residual_ratio();
+        self.pert.singular_iters += 1;
+        if self.pert.singular_iters >= 3 && !self.pert.jac_determined {
+            self.pert.jac_degenerate = true;
         }
+        self.pert.delta_c = Perturbation::delta_cd(&self.opts, self.mu);
+        let dw = self.pert.delta_w;
+        let ok = matches!(self.factor_kkt(shared, dw, self.pert.delta_c),
+                Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
+        if !ok {
+            // Should not happen (δ_c does not change the inertia); fall back to
+            // the statically regularised system as it is.
+            self.pert.delta_c = 0.0;
+            if self.factor_kkt(shared, dw, self.pert.delta_c).is_err() {
+                return None;
+            }
+        }
+        let t = Instant::now();
+        self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
+        let mut res = self.kw.solve_rhs();
+        shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+        let mut dw = self.pert.delta_w;
+        while ok && !matches!(res, Ok(r) if r <= singular_ratio) {
+            // Still singular (singular reduced Hessian): IPOPT increases δ_w.
+            dw = self.pert.next_delta_w(&self.opts, dw);
+            if dw > self.opts.max_hessian_perturbation {
+                return None;
+            }
+            match self.factor_kkt(shared, dw, self.pert.delta_c) {
+                Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
+                Ok(_) => continue,
+                Err(_) => continue,
+            }
+            self.pert.delta_w = dw;
+            self.pert.delta_w_last = dw;
+            let t = Instant::now();
+            self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
+            res = self.kw.solve_rhs();
+            shared.stats.factor_seconds += t.elapsed().as_secs_f64();
+        }
+        Some(res)
+    }
+
+    /// The full direction from the solved reduced system: slack steps, then the bound
+    /// multipliers' steps. False when it is not finite.
+    fn recover_direction(&mut self, mu_t: f64, soc: bool) -> bool {
+        let n = self.lay.n;
         let (dw, dy, dzl, dzu) = if soc {
             (
                 &mut self.dir_soc.dw,

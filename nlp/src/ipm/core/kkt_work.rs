@@ -145,6 +145,17 @@ impl KktWork {
     }
 }
 
+/// The static regularisation of the equality rows in the least-squares multiplier
+/// system, 1e-2 × the step's: the Schur complement there is J Jᵀ, whose smallest
+/// eigenvalue on a long chain is far below its diagonal (≈ (π/N)² × it), so a
+/// regularisation relative to the diagonal perturbs the smooth part of y and can trip
+/// the singularity test (y = 0). Measured: 1× fails the hanging chain with 50 000 links
+/// (rows scaled up to gradient 0.8 by nlp_scaling_min_gradient; not solved in 40 s),
+/// 1e-2× solves it in 8 iterations; 1e-6× (chosen before the row scaling, for the
+/// unscaled 5000-link chain) changed hs027 from 54 to 77 iterations through round-off
+/// alone (the path of hs027 is long and sensitive).
+const LS_EQ_REG: f64 = 1e-2;
+
 impl Core<'_> {
     // ------------------------------------------------------------------ linear algebra
 
@@ -387,99 +398,27 @@ impl Core<'_> {
         let xreg = self.opts.kkt_static_hessian_regularization;
         self.kw.kdx.iter_mut().for_each(|v| *v = 1.0 + xreg);
         self.update_eq_reg();
-        // The static regularisation of the equality rows, 1e-2 × the step's: the
-        // Schur complement here is J Jᵀ, whose smallest eigenvalue on a long chain is
-        // far below its diagonal (≈ (π/N)² × it), so a regularisation relative to the
-        // diagonal perturbs the smooth part of y and can trip the singularity test
-        // below (y = 0). Measured: 1× fails the hanging chain with 50 000 links (rows
-        // scaled up to gradient 0.8 by nlp_scaling_min_gradient; not solved in 40 s),
-        // 1e-2× solves it in 8 iterations; 1e-6× (chosen before the row scaling, for the
-        // unscaled 5000-link chain) changed hs027 from 54 to 77 iterations through
-        // round-off alone (the path of hs027 is long and sensitive).
-        let ls_reg = 1e-2;
         for i in 0..m {
             self.kw.kdc[i] = if self.lay.slack_of_row[i] == usize::MAX {
-                ls_reg * self.kw.eq_reg[i]
+                LS_EQ_REG * self.kw.eq_reg[i]
             } else {
                 1.0
             };
         }
-        // rhs: [−(∇f − z_L + z_U)_x ; −(rhs_s/1) contribution]; with W = I, Σ_s = 1.
-        for j in 0..n {
-            self.kw.rhs[j] = -(self.it.grad[j] - self.it.zl[j] + self.it.zu[j]);
-        }
-        for i in 0..m {
-            let k = self.lay.slack_of_row[i];
-            self.kw.rhs[n + i] = if k == usize::MAX {
-                0.0
-            } else {
-                // s-row: ds − y_i = r_s := z_L − z_U; row i: J dx − ds = 0
-                // ⇒ J dx − y_i = r_s.
-                self.it.zl[n + k] - self.it.zu[n + k]
-            };
-        }
-        // IPOPT computes these multipliers with an unregularised factorisation and sets
-        // them to zero when the linear solver reports the system singular (a
-        // rank-deficient Jacobian of the equality rows). The static regularisation δ_s
-        // hides that singularity from faer, so detect it from the determinant instead:
-        // det K(δ) = det(−δI − J Jᵀ) on the equality rows, and multiplying δ by 10 multiplies
-        // |det K| by about 10 per (numerically) zero singular value of J.
-        let n_eq = self
-            .lay
-            .slack_of_row
-            .iter()
-            .filter(|&&k| k == usize::MAX)
-            .count();
-        let mut singular = false;
-        if n_eq > 0 && self.opts.kkt_static_regularization > 0.0 {
-            for i in 0..m {
-                if self.lay.slack_of_row[i] == usize::MAX {
-                    self.kw.kdc[i] = 10.0 * ls_reg * self.kw.eq_reg[i];
-                }
-            }
-            if self
-                .kw
-                .kkt
-                .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
-                .is_ok()
-            {
-                let ld10 = self.kw.kkt.log_abs_det();
-                for i in 0..m {
-                    if self.lay.slack_of_row[i] == usize::MAX {
-                        self.kw.kdc[i] = ls_reg * self.kw.eq_reg[i];
-                    }
-                }
-                if self
-                    .kw
-                    .kkt
-                    .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
-                    .is_ok()
-                {
-                    singular = (ld10 - self.kw.kkt.log_abs_det()) / std::f64::consts::LN_10 > 0.5;
-                }
-            }
-            for i in 0..m {
-                if self.lay.slack_of_row[i] == usize::MAX {
-                    self.kw.kdc[i] = ls_reg * self.kw.eq_reg[i];
-                }
-            }
-        }
+        self.least_squares_rhs();
+        let singular = self.equality_rows_singular();
         for j in 0..n {
             self.kw.shift[j] = -xreg;
         }
         for i in 0..m {
             self.kw.shift[n + i] = if self.lay.slack_of_row[i] == usize::MAX {
-                ls_reg * self.kw.eq_reg[i]
+                LS_EQ_REG * self.kw.eq_reg[i]
             } else {
                 0.0
             };
         }
         let ok = !singular
-            && self
-                .kw
-                .kkt
-                .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
-                .is_ok()
+            && self.factorize_least_squares()
             && self
                 .kw
                 .kkt
@@ -494,5 +433,72 @@ impl Core<'_> {
         }
         self.it.y.iter_mut().for_each(|v| *v = 0.0);
         false
+    }
+
+    /// The least-squares system's right-hand side (W = I, Σ_s = 1):
+    /// `[−(∇f − z_L + z_U)_x ; z_L − z_U of the row's slack, or 0]`.
+    fn least_squares_rhs(&mut self) {
+        let (n, m) = (self.lay.n, self.lay.m);
+        for j in 0..n {
+            self.kw.rhs[j] = -(self.it.grad[j] - self.it.zl[j] + self.it.zu[j]);
+        }
+        for i in 0..m {
+            let k = self.lay.slack_of_row[i];
+            self.kw.rhs[n + i] = if k == usize::MAX {
+                0.0
+            } else {
+                // s-row: ds − y_i = r_s := z_L − z_U; row i: J dx − ds = 0
+                // ⇒ J dx − y_i = r_s.
+                self.it.zl[n + k] - self.it.zu[n + k]
+            };
+        }
+    }
+
+    /// Whether the equality rows' Jacobian is (numerically) rank-deficient. IPOPT
+    /// computes the least-squares multipliers with an unregularised factorisation and
+    /// sets them to zero when the linear solver reports the system singular. The static
+    /// regularisation δ_s hides that singularity from faer, so detect it from the
+    /// determinant instead: det K(δ) = det(−δI − J Jᵀ) on the equality rows, and
+    /// multiplying δ by 10 multiplies |det K| by about 10 per (numerically) zero
+    /// singular value of J. Leaves `kdc` as it found it.
+    fn equality_rows_singular(&mut self) -> bool {
+        let n_eq = self
+            .lay
+            .slack_of_row
+            .iter()
+            .filter(|&&k| k == usize::MAX)
+            .count();
+        if n_eq == 0 || !(self.opts.kkt_static_regularization > 0.0) {
+            return false;
+        }
+        let mut singular = false;
+        self.set_equality_kdc(10.0 * LS_EQ_REG);
+        if self.factorize_least_squares() {
+            let ld10 = self.kw.kkt.log_abs_det();
+            self.set_equality_kdc(LS_EQ_REG);
+            if self.factorize_least_squares() {
+                singular = (ld10 - self.kw.kkt.log_abs_det()) / std::f64::consts::LN_10 > 0.5;
+            }
+        }
+        self.set_equality_kdc(LS_EQ_REG);
+        singular
+    }
+
+    /// `kdc = scale · eq_reg` on the equality rows.
+    fn set_equality_kdc(&mut self, scale: f64) {
+        for i in 0..self.lay.m {
+            if self.lay.slack_of_row[i] == usize::MAX {
+                self.kw.kdc[i] = scale * self.kw.eq_reg[i];
+            }
+        }
+    }
+
+    /// Factorises the least-squares system `[I J'; J −kdc]` (with `kdx` on the
+    /// diagonal); true on success.
+    fn factorize_least_squares(&mut self) -> bool {
+        self.kw
+            .kkt
+            .factorize(&self.kw.hzero, &self.kw.kdx, &self.it.jac, &self.kw.kdc)
+            .is_ok()
     }
 }

@@ -17,7 +17,6 @@ use crate::ipm::barrier::{mu_floor, tau};
 use crate::ipm::error::CoreError;
 use crate::ipm::filter::{Acceptance, Filter};
 use crate::ipm::reduced::IpmProblem;
-use crate::ipm::restoration;
 use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::{IterationRecord, Stats, Status};
 
@@ -47,6 +46,22 @@ pub(crate) struct Shared<'c> {
     pub iter: usize,
     /// The user's iteration callback, called by `record`.
     pub observer: Option<Observer<'c>>,
+}
+
+/// A restoration phase run from a core's current iterate: `Ok` to continue from the
+/// restored point, else the solve's final outcome. [`Core::run`] takes it as an argument
+/// (`ipm::restoration::restore`) because the restoration phase drives a core itself:
+/// the core does not depend on it.
+pub(crate) type Restorer = fn(&mut Core<'_>, &mut Shared) -> Result<(), Outcome>;
+
+/// What one iteration of [`Core::run`] leads to.
+enum Iteration {
+    /// A step was taken: go on with the next iteration.
+    Continue,
+    /// The solve ended.
+    Finished(Outcome),
+    /// No step was taken, for the given reason: a restoration phase starts.
+    Restore(&'static str),
 }
 
 /// How to start the iteration.
@@ -450,7 +465,15 @@ impl<'p> Core<'p> {
         Ok(e0)
     }
 
-    pub(crate) fn run(&mut self, shared: &mut Shared, start: Start<'_>) -> Outcome {
+    /// Solves from `start`: each iteration updates the barrier, factorises, solves for
+    /// the direction and takes a tiny or line-searched step; a failed step starts a
+    /// restoration phase (`restore`).
+    pub(crate) fn run(
+        &mut self,
+        shared: &mut Shared,
+        start: Start<'_>,
+        restore: Restorer,
+    ) -> Outcome {
         if let Err(e) = self.initialize(start) {
             return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
         }
@@ -462,132 +485,171 @@ impl<'p> Core<'p> {
         let mut pending_resto = self.opts.start_with_resto && !self.setup_in_resto;
         let max_resto_iter_end = shared.iter + self.opts.max_resto_iter;
         loop {
-            // Why the restoration phase below starts (or, where it cannot, the solve ends).
-            let mut why = "line search failed";
             self.count.filter_has_current = false;
             let e0 = match self.stop_test(shared, max_resto_iter_end) {
                 Ok(e0) => e0,
                 Err(out) => return out,
             };
+            // Why the restoration phase below starts (or, where it cannot, the solve ends).
+            let why = if std::mem::take(&mut pending_resto) {
+                "line search failed"
+            } else {
+                match self.iterate_once(shared, e0) {
+                    Iteration::Continue => continue,
+                    Iteration::Finished(out) => return out,
+                    Iteration::Restore(why) => why,
+                }
+            };
+            if let Some(out) = self.restoration_phase(shared, why, restore) {
+                return out;
+            }
+        }
+    }
 
-            if !pending_resto {
-                // ---------------- barrier update (monotone) and factorisation
-                if self.mu_strategy == MuStrategy::Monotone {
-                    self.update_mu_monotone(self.count.tiny_count > 0);
-                }
-                let factor_ok = self.factorize_with_inertia_correction(shared);
-                if factor_ok && self.mu_strategy == MuStrategy::Adaptive {
-                    self.update_mu_adaptive(shared, e0);
-                }
-                let dir_ok = factor_ok && self.solve_direction(shared, self.mu, false);
-                if dir_ok {
-                    shared.iter += 1;
-                    let d_norm = inf_norm(&self.dir.dw);
-                    // Tiny step test.
-                    let rel = (0..self.lay.nw)
-                        .map(|j| self.dir.dw[j].abs() / (1.0 + self.it.w[j].abs()))
-                        .fold(0.0, f64::max);
-                    let tiny = rel < self.opts.tiny_step_tol
-                        && inf_norm(&self.dir.dy)
-                            < self.opts.tiny_step_y_tol * (1.0 + inf_norm(&self.it.y));
-                    if tiny && self.take_full_step() {
-                        self.count.soft_resto = None;
-                        self.count.tiny_count += 1;
-                        let (_, eu) = self.errors(0.0, false);
-                        self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
-                        if self.count.tiny_count >= 2
-                            && self.mu <= mu_floor(&self.opts, self.scaling.obj) * (1.0 + 1e-12)
-                        {
-                            return self.outcome(Status::SearchDirectionBecomesTooSmall, "", false);
-                        }
-                        continue;
-                    }
-                    self.count.tiny_count = 0;
-                    match self.search_step(shared) {
-                        LineSearch::Accepted {
-                            alpha_pr,
-                            alpha_du,
-                            kind,
-                            trials,
-                        } => {
-                            let (_, eu) = self.errors(0.0, false);
-                            let ch = kind.log_char();
-                            self.record(shared, d_norm, alpha_du, alpha_pr, ch, trials, eu[0]);
-                            if self.setup_in_resto && self.nlp.restoration_accepts(&self.it.w) {
-                                return self.outcome(Status::SolveSucceeded, "", false);
-                            }
-                            if !self.tiny_alpha_stall(alpha_pr) {
-                                continue;
-                            }
-                            // Treated as a failed line search (the step is kept): the
-                            // restoration's first row shows α_pr 0, 'R', ls 0.
-                            self.resto_start = Some((0.0, 0));
-                            why = "tiny_alpha_max_iter steps in a row with alpha_pr < tiny_alpha";
-                        }
-                        LineSearch::Failed { alpha_pr, trials } => {
-                            // The restoration phase's first row reports the failed line
-                            // search (IPOPT: "12r", alpha_pr 'R', and its ls count, one
-                            // more than the trial steps).
-                            shared.iter -= 1;
-                            self.resto_start = Some((alpha_pr, trials + 1));
-                        }
-                    }
-                } else if self.setup_in_resto {
-                    return self.outcome(
-                        Status::ErrorInStepComputation,
-                        "inertia correction failed in restoration",
-                        false,
-                    );
-                }
-                if !dir_ok && !factor_ok && self.lay.m == 0 {
-                    return self.outcome(
-                        Status::ErrorInStepComputation,
-                        "inertia correction failed",
-                        false,
-                    );
-                }
-            }
-            pending_resto = false;
-            // ---------------- line search failed (or step failed): restoration
-            if self.setup_in_resto {
-                return self.outcome(
-                    Status::RestorationFailed,
-                    format!("{why} in restoration"),
-                    false,
-                );
-            }
-            if self.lay.m == 0 {
-                let status = if self.termination.last_was_acceptable() {
-                    Status::SolvedToAcceptableLevel
-                } else {
-                    Status::SearchDirectionBecomesTooSmall
-                };
-                return self.outcome(
-                    status,
-                    format!("{why} for a problem without constraints"),
-                    false,
-                );
-            }
-            self.count.resto_calls += 1;
-            // The restoration phase's first row takes the next iteration number (IPOPT's
-            // count: the iteration whose line search failed is that row).
+    /// One iteration: barrier update, factorisation, direction, then a tiny step or a
+    /// line search.
+    fn iterate_once(&mut self, shared: &mut Shared, e0: f64) -> Iteration {
+        if self.mu_strategy == MuStrategy::Monotone {
+            self.update_mu_monotone(self.count.tiny_count > 0);
+        }
+        let factor_ok = self.factorize_with_inertia_correction(shared);
+        if factor_ok && self.mu_strategy == MuStrategy::Adaptive {
+            self.update_mu_adaptive(shared, e0);
+        }
+        if factor_ok && self.solve_direction(shared, self.mu, false) {
             shared.iter += 1;
-            // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9)
-            // unless the soft restoration attempt did.
-            if !std::mem::take(&mut self.count.filter_has_current) {
-                let theta = one_norm(&self.it.c);
-                let phi = self.barrier(&self.it.w, self.it.f, self.mu);
-                self.accept.augment(&mut self.filter, theta, phi);
+            let d_norm = inf_norm(&self.dir.dw);
+            if let Some(done) = self.try_tiny_step(shared, d_norm) {
+                return done;
             }
-            match restoration::restore(self, shared) {
-                Ok(()) => {
-                    self.count.soft_resto = None;
-                    self.pert.delta_w_last = 0.0;
-                    self.count.tiny_count = 0;
-                    continue;
+            self.count.tiny_count = 0;
+            return self.step_by_line_search(shared, d_norm);
+        }
+        if self.setup_in_resto {
+            return Iteration::Finished(self.outcome(
+                Status::ErrorInStepComputation,
+                "inertia correction failed in restoration",
+                false,
+            ));
+        }
+        if !factor_ok && self.lay.m == 0 {
+            return Iteration::Finished(self.outcome(
+                Status::ErrorInStepComputation,
+                "inertia correction failed",
+                false,
+            ));
+        }
+        Iteration::Restore("line search failed")
+    }
+
+    /// Takes the full step when the direction is tiny relative to the iterate; `None`
+    /// when it is not tiny (or the full step could not be taken).
+    fn try_tiny_step(&mut self, shared: &mut Shared, d_norm: f64) -> Option<Iteration> {
+        let rel = (0..self.lay.nw)
+            .map(|j| self.dir.dw[j].abs() / (1.0 + self.it.w[j].abs()))
+            .fold(0.0, f64::max);
+        let tiny = rel < self.opts.tiny_step_tol
+            && inf_norm(&self.dir.dy) < self.opts.tiny_step_y_tol * (1.0 + inf_norm(&self.it.y));
+        if !(tiny && self.take_full_step()) {
+            return None;
+        }
+        self.count.soft_resto = None;
+        self.count.tiny_count += 1;
+        let (_, eu) = self.errors(0.0, false);
+        self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
+        if self.count.tiny_count >= 2
+            && self.mu <= mu_floor(&self.opts, self.scaling.obj) * (1.0 + 1e-12)
+        {
+            return Some(Iteration::Finished(self.outcome(
+                Status::SearchDirectionBecomesTooSmall,
+                "",
+                false,
+            )));
+        }
+        Some(Iteration::Continue)
+    }
+
+    /// The line search along the direction and its record.
+    fn step_by_line_search(&mut self, shared: &mut Shared, d_norm: f64) -> Iteration {
+        match self.search_step(shared) {
+            LineSearch::Accepted {
+                alpha_pr,
+                alpha_du,
+                kind,
+                trials,
+            } => {
+                let (_, eu) = self.errors(0.0, false);
+                let ch = kind.log_char();
+                self.record(shared, d_norm, alpha_du, alpha_pr, ch, trials, eu[0]);
+                if self.setup_in_resto && self.nlp.restoration_accepts(&self.it.w) {
+                    return Iteration::Finished(self.outcome(Status::SolveSucceeded, "", false));
                 }
-                Err(out) => return out,
+                if !self.tiny_alpha_stall(alpha_pr) {
+                    return Iteration::Continue;
+                }
+                // Treated as a failed line search (the step is kept): the
+                // restoration's first row shows α_pr 0, 'R', ls 0.
+                self.resto_start = Some((0.0, 0));
+                Iteration::Restore("tiny_alpha_max_iter steps in a row with alpha_pr < tiny_alpha")
             }
+            LineSearch::Failed { alpha_pr, trials } => {
+                // The restoration phase's first row reports the failed line search
+                // (IPOPT: "12r", alpha_pr 'R', and its ls count, one more than the
+                // trial steps).
+                shared.iter -= 1;
+                self.resto_start = Some((alpha_pr, trials + 1));
+                Iteration::Restore("line search failed")
+            }
+        }
+    }
+
+    /// A restoration phase started because of `why`; `None` when the solve continues
+    /// from the restored point, else the final outcome (also when no restoration phase
+    /// can run: inside one, or without constraints).
+    fn restoration_phase(
+        &mut self,
+        shared: &mut Shared,
+        why: &str,
+        restore: Restorer,
+    ) -> Option<Outcome> {
+        if self.setup_in_resto {
+            return Some(self.outcome(
+                Status::RestorationFailed,
+                format!("{why} in restoration"),
+                false,
+            ));
+        }
+        if self.lay.m == 0 {
+            let status = if self.termination.last_was_acceptable() {
+                Status::SolvedToAcceptableLevel
+            } else {
+                Status::SearchDirectionBecomesTooSmall
+            };
+            return Some(self.outcome(
+                status,
+                format!("{why} for a problem without constraints"),
+                false,
+            ));
+        }
+        self.count.resto_calls += 1;
+        // The restoration phase's first row takes the next iteration number (IPOPT's
+        // count: the iteration whose line search failed is that row).
+        shared.iter += 1;
+        // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9)
+        // unless the soft restoration attempt did.
+        if !std::mem::take(&mut self.count.filter_has_current) {
+            let theta = one_norm(&self.it.c);
+            let phi = self.barrier(&self.it.w, self.it.f, self.mu);
+            self.accept.augment(&mut self.filter, theta, phi);
+        }
+        match restore(self, shared) {
+            Ok(()) => {
+                self.count.soft_resto = None;
+                self.pert.delta_w_last = 0.0;
+                self.count.tiny_count = 0;
+                None
+            }
+            Err(out) => Some(out),
         }
     }
 
