@@ -1,7 +1,7 @@
 //! The Goddard rocket of COPS 3.0 (Dolan, Moré, Munson, ANL/MCS-TM-246, 2004, problem 10)
 //! with the `Ocp` helper: maximise the final height, trapezoidal collocation with the
 //! thrust at the nodes, free final time, N = 100. The symnlp half of the first program of
-//! docs/casadi.md; the CasADi half is `benches/reference/goddard_rocket_casadi.py`. Both
+//! docs/casadi.md; the CasADi half is `python/examples/casadi/goddard_rocket.py`. Both
 //! print h(T) = 1.0128320 (COPS: 1.01283); `nlp/tests/ocp_transcriptions.rs` checks it.
 //!
 //! Run: `cargo run --release --example goddard_rocket`
