@@ -9,7 +9,9 @@ use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholeskyRaw};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par, Side, Spec};
 
-use super::{Inertia, Kkt, KktError};
+use super::error::KktError;
+use super::inertia::Inertia;
+use super::system::Kkt;
 
 impl Kkt {
     /// Assembles and factorises K; returns its inertia. `h_vals`/`j_vals` are in the

@@ -17,8 +17,10 @@
 
 use faer::{Mat, Side};
 
+use super::error::KktError;
+use super::inertia::Inertia;
 use super::refine::{refine, Refinable, RefineLimits};
-use super::{Inertia, Kkt, KktError};
+use super::system::Kkt;
 
 /// Eigenvalues below this × the largest magnitude in their matrix count as zero (the
 /// small matrices are formed from sums of products of O(n) vectors, so their entries

@@ -1,7 +1,8 @@
 //! Solves with the factor of K and residual-checked iterative refinement, also of the
 //! shifted system K + diag(shift) (to remove a static regularisation from a step).
 
-use super::{Kkt, KktError};
+use super::error::KktError;
+use super::system::Kkt;
 
 /// Residual ratio below which refinement stops even while it still improves.
 pub(super) const REFINEMENT_FLOOR: f64 = 1e-14;

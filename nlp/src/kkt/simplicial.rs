@@ -6,7 +6,8 @@
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::SymbolicSparseColMat;
 
-use super::{Inertia, KktError};
+use super::error::KktError;
+use super::inertia::Inertia;
 
 /// Simplicial LDLᵀ of the AMD-permuted K (up-looking, Davis's LDL), on the pattern of L
 /// from faer's symbolic analysis. The rows of L (for each k, the columns j < k with
