@@ -59,26 +59,31 @@ pub struct CommonOptions {
 
 impl Default for CommonOptions {
     fn default() -> Self {
-        CommonOptions {
-            tol: 1e-8,
-            s_max: 100.0,
-            max_iter: 3000,
-            max_wall_time: 1e20,
-            dual_inf_tol: 1.0,
-            constr_viol_tol: 1e-4,
-            compl_inf_tol: 1e-4,
-            acceptable_tol: 1e-6,
-            acceptable_iter: 15,
-            acceptable_dual_inf_tol: 1e10,
-            acceptable_constr_viol_tol: 1e-2,
-            acceptable_compl_inf_tol: 1e-2,
-            acceptable_obj_change_tol: 1e20,
-            diverging_iterates_tol: 1e20,
-            nlp_scaling_max_gradient: 100.0,
-            nlp_scaling_min_value: 1e-8,
-            print_level: 0,
-        }
+        Self::DEFAULTS
     }
+}
+
+impl CommonOptions {
+    /// IPOPT's defaults, as a constant (the back ends' option defaults start from it).
+    pub(crate) const DEFAULTS: CommonOptions = CommonOptions {
+        tol: 1e-8,
+        s_max: 100.0,
+        max_iter: 3000,
+        max_wall_time: 1e20,
+        dual_inf_tol: 1.0,
+        constr_viol_tol: 1e-4,
+        compl_inf_tol: 1e-4,
+        acceptable_tol: 1e-6,
+        acceptable_iter: 15,
+        acceptable_dual_inf_tol: 1e10,
+        acceptable_constr_viol_tol: 1e-2,
+        acceptable_compl_inf_tol: 1e-2,
+        acceptable_obj_change_tol: 1e20,
+        diverging_iterates_tol: 1e20,
+        nlp_scaling_max_gradient: 100.0,
+        nlp_scaling_min_value: 1e-8,
+        print_level: 0,
+    };
 }
 
 impl CommonOptions {
