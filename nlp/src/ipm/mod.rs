@@ -4,7 +4,7 @@
 //! Layout: `reduced` (fixed variables and unbounded rows removed, on the front end's
 //! scaled problem `frontend/scaled.rs`),
 //! `core` (iteration, KKT step with inertia correction, line search with second-order
-//! corrections), `filter`, `barrier` (μ updates), `restoration` (ℓ1 restoration
+//! corrections), `filter`, `mu_update` (μ and τ), `restoration` (ℓ1 restoration
 //! phase solved by the same core), `workspace` (what an `Ipm` keeps between solves).
 
 #![allow(clippy::needless_range_loop)]
@@ -13,9 +13,11 @@ pub(crate) mod barrier;
 mod core;
 mod error;
 pub(crate) mod filter;
+pub(crate) mod mu_update;
 pub(crate) mod quality;
 pub(crate) mod reduced;
 mod restoration;
+mod termination;
 mod workspace;
 
 use std::time::Instant;

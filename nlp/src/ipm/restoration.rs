@@ -14,7 +14,8 @@
 use faer::sparse::SymbolicSparseColMat;
 
 use crate::frontend::scaled::Scaling;
-use crate::ipm::core::{barrier_value, Buffers, Core, Layout, Outcome, Setup, Shared, Start};
+use crate::ipm::barrier::barrier_value;
+use crate::ipm::core::{Buffers, Core, Layout, Outcome, Setup, Shared, Start};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::numeric::NumericNlp;

@@ -7,14 +7,14 @@
     clippy::too_many_arguments
 )]
 
-use super::first_non_finite;
-use super::one_norm;
+use super::vectors::first_non_finite;
+use super::vectors::one_norm;
 use super::Core;
 use super::Start;
-use crate::ipm::barrier::tau;
 use crate::ipm::error::At;
 use crate::ipm::error::CoreError;
 use crate::ipm::filter::Acceptance;
+use crate::ipm::mu_update::tau;
 
 impl Core<'_> {
     // ------------------------------------------------------------------ initialisation
@@ -147,7 +147,7 @@ impl Core<'_> {
     /// multipliers are the least-squares estimate if `constr_mult_reset_threshold` > 0 and
     /// it is no larger than that, else 0.
     pub(crate) fn restart_from(&mut self, w: &[f64]) -> Result<(), CoreError> {
-        let (mu, nw) = (self.mu, self.lay.nw);
+        let (mu, nw) = (self.mu_update.mu(), self.lay.nw);
         let mut dzl = vec![0.0; nw];
         let mut dzu = vec![0.0; nw];
         for j in 0..nw {

@@ -6,57 +6,10 @@
     clippy::too_many_arguments
 )]
 
-use super::one_norm;
+use super::step_kind::{LineSearch, StepKind};
+use super::vectors::one_norm;
 use super::Core;
 use super::Shared;
-
-/// How the step of an accepted trial point was made (the log's character after
-/// alpha_pr: lower case for the plain step, upper case for a second-order correction).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum StepKind {
-    /// f-type: the switching and Armijo conditions hold; the filter is not augmented.
-    FType { soc: bool },
-    /// h-type: the filter was augmented.
-    HType { soc: bool },
-    /// A soft restoration step (IPOPT's 's'; 'S' when it is acceptable to the filter,
-    /// which ends the soft restoration phase).
-    Soft { original: bool },
-}
-
-impl StepKind {
-    pub(super) fn new(ftype: bool, soc: bool) -> StepKind {
-        if ftype {
-            StepKind::FType { soc }
-        } else {
-            StepKind::HType { soc }
-        }
-    }
-
-    pub(super) fn log_char(self) -> char {
-        match self {
-            StepKind::FType { soc: false } => 'f',
-            StepKind::HType { soc: false } => 'h',
-            StepKind::FType { soc: true } => 'F',
-            StepKind::HType { soc: true } => 'H',
-            StepKind::Soft { original: false } => 's',
-            StepKind::Soft { original: true } => 'S',
-        }
-    }
-}
-
-/// The outcome of [`Core::line_search`]; `trials` counts the trial step sizes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum LineSearch {
-    /// A trial point was accepted (and is now the iterate).
-    Accepted {
-        alpha_pr: f64,
-        alpha_du: f64,
-        kind: StepKind,
-        trials: usize,
-    },
-    /// Every step size down to α_min was rejected; `alpha_pr` is the last one tried.
-    Failed { alpha_pr: f64, trials: usize },
-}
 
 /// The current point's merit values the trial points are judged against.
 struct Merit {
@@ -76,10 +29,10 @@ impl Core<'_> {
     pub(super) fn line_search(&mut self, shared: &mut Shared) -> LineSearch {
         let here = Merit {
             theta: one_norm(&self.it.c),
-            phi: self.barrier(&self.it.w, self.it.f, self.mu),
+            phi: self.barrier(&self.it.w, self.it.f, self.mu_update.mu()),
             gpd: self.barrier_dir_deriv(&self.dir.dw),
         };
-        let alpha_max = self.max_step_primal(&self.dir.dw, self.tau);
+        let alpha_max = self.max_step_primal(&self.dir.dw, self.mu_update.tau());
         let alpha_min = self.accept.alpha_min(here.theta, here.gpd);
         let mut alpha = alpha_max;
         let mut ls = 0usize;
@@ -97,7 +50,7 @@ impl Core<'_> {
             }
             if self.eval_trial_fc() {
                 let theta_t = one_norm(&self.trial.c);
-                let phi_t = self.barrier(&self.trial.w, self.trial.f, self.mu);
+                let phi_t = self.barrier(&self.trial.w, self.trial.f, self.mu_update.mu());
                 if self.is_acceptable(&here, alpha, (theta_t, phi_t)) {
                     let trial = self.accept_if_smooth(&here, alpha, alpha, phi_t, false, ls);
                     if let Some(accepted) = trial {
@@ -144,10 +97,10 @@ impl Core<'_> {
             for i in 0..self.lay.m {
                 self.c_soc[i] = a_soc * self.c_soc[i] + self.trial.c[i];
             }
-            if !self.solve_direction(shared, self.mu, true) {
+            if !self.solve_direction(shared, self.mu_update.mu(), true) {
                 break;
             }
-            a_soc = self.max_step_primal(&self.dir_soc.dw, self.tau);
+            a_soc = self.max_step_primal(&self.dir_soc.dw, self.mu_update.tau());
             for j in 0..self.lay.nw {
                 self.trial.w[j] = self.it.w[j] + a_soc * self.dir_soc.dw[j];
             }
@@ -155,7 +108,7 @@ impl Core<'_> {
                 break;
             }
             let th = one_norm(&self.trial.c);
-            let ph = self.barrier(&self.trial.w, self.trial.f, self.mu);
+            let ph = self.barrier(&self.trial.w, self.trial.f, self.mu_update.mu());
             if self.is_acceptable(here, alpha, (th, ph)) {
                 return self.accept_if_smooth(here, alpha, a_soc, ph, true, trials);
             }
@@ -198,7 +151,7 @@ impl Core<'_> {
             phi_t,
         );
         let dir = if soc { &self.dir_soc } else { &self.dir };
-        let alpha_du = self.max_step_dual(&dir.dzl, &dir.dzu, self.tau);
+        let alpha_du = self.max_step_dual(&dir.dzl, &dir.dzu, self.mu_update.tau());
         self.take_dual_step(alpha_du, soc);
         self.accept_trial();
         Some(LineSearch::Accepted {
@@ -212,7 +165,7 @@ impl Core<'_> {
     /// z ← z + α_du·dz with the κ_Σ safeguard at the trial point (w_t).
     pub(super) fn take_dual_step(&mut self, alpha_du: f64, soc: bool) {
         let ks = self.opts.kappa_sigma;
-        let mu = self.mu;
+        let mu = self.mu_update.mu();
         for j in 0..self.lay.nw {
             let (dl, du) = if soc {
                 (self.dir_soc.dzl[j], self.dir_soc.dzu[j])
@@ -234,7 +187,7 @@ impl Core<'_> {
 
     /// Full step without line search (tiny steps).
     pub(super) fn take_full_step(&mut self) -> bool {
-        let alpha = self.max_step_primal(&self.dir.dw, self.tau);
+        let alpha = self.max_step_primal(&self.dir.dw, self.mu_update.tau());
         for j in 0..self.lay.nw {
             self.trial.w[j] = self.it.w[j] + alpha * self.dir.dw[j];
         }
@@ -244,7 +197,7 @@ impl Core<'_> {
         if !self.eval_trial_fc() || !self.eval_trial_derivs() {
             return false;
         }
-        let alpha_du = self.max_step_dual(&self.dir.dzl, &self.dir.dzu, self.tau);
+        let alpha_du = self.max_step_dual(&self.dir.dzl, &self.dir.dzu, self.mu_update.tau());
         self.take_dual_step(alpha_du, false);
         self.accept_trial();
         true

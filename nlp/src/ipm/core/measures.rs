@@ -6,10 +6,10 @@
     clippy::too_many_arguments
 )]
 
-use super::barrier_value;
-use super::inf_norm;
-use super::one_norm;
+use super::vectors::inf_norm;
 use super::Core;
+use crate::ipm::barrier::barrier_value;
+use crate::ipm::termination::scaled_error;
 
 impl Core<'_> {
     // ------------------------------------------------------------------ error measures
@@ -61,34 +61,20 @@ impl Core<'_> {
         )
     }
 
-    /// IPOPT's scaled optimality error E_μ.
+    /// IPOPT's scaled optimality error E_μ (`crate::ipm::termination::scaled_error`)
+    /// and the unscaled parts.
     pub(super) fn nlp_error(&mut self, mu_t: f64, damping: bool) -> (f64, [f64; 3]) {
         let (e, eu) = self.errors(mu_t, damping);
-        let s_max = self.opts.s_max;
-        let mut nz = 0usize;
-        let mut zsum = 0.0;
-        for j in 0..self.lay.nw {
-            if self.lay.has_l[j] {
-                nz += 1;
-                zsum += self.it.zl[j].abs();
-            }
-            if self.lay.has_u[j] {
-                nz += 1;
-                zsum += self.it.zu[j].abs();
-            }
-        }
-        let ysum = one_norm(&self.it.y);
-        let sd = if self.lay.m + nz > 0 {
-            (s_max.max((ysum + zsum) / (self.lay.m + nz) as f64)) / s_max
-        } else {
-            1.0
-        };
-        let sc = if nz > 0 {
-            (s_max.max(zsum / nz as f64)) / s_max
-        } else {
-            1.0
-        };
-        ((e[0] / sd).max(e[1]).max(e[2] / sc), eu)
+        let it = &self.it;
+        let lay = &self.lay;
+        let e0 = scaled_error(
+            e,
+            &it.y,
+            (&it.zl, &lay.has_l),
+            (&it.zu, &lay.has_u),
+            self.opts.s_max,
+        );
+        (e0, eu)
     }
 
     pub(super) fn avg_compl(&self, w: &[f64], zl: &[f64], zu: &[f64]) -> (f64, f64) {
@@ -132,7 +118,7 @@ impl Core<'_> {
     }
 
     pub(super) fn barrier_dir_deriv(&self, dw: &[f64]) -> f64 {
-        let mu = self.mu;
+        let mu = self.mu_update.mu();
         let kd = self.opts.kappa_d * mu;
         let mut d = 0.0;
         for j in 0..self.lay.nw {

@@ -12,32 +12,41 @@ use std::time::Instant;
 
 use crate::callback::Observer;
 use crate::frontend::scaled::Scaling;
-use crate::frontend::{KktResiduals, Termination};
-use crate::ipm::barrier::{mu_floor, tau};
+use crate::frontend::KktResiduals;
 use crate::ipm::error::CoreError;
 use crate::ipm::filter::{Acceptance, Filter};
+use crate::ipm::mu_update::MuUpdate;
 use crate::ipm::reduced::IpmProblem;
+use crate::ipm::termination::StopTest;
 use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::{IterationRecord, Stats, Status};
 
 mod buffers;
 mod direction;
+mod evaluation;
+mod factorization;
 mod init;
 mod iterate;
 mod kkt_work;
+mod layout;
 mod line_search;
 mod measures;
-mod mu;
+mod mu_oracles;
+mod newton_step;
 mod perturbation;
 mod soft_resto;
+mod step_kind;
+mod vectors;
 
 pub(crate) use buffers::Buffers;
 use direction::Direction;
 pub(crate) use iterate::Iterate;
 use iterate::Trial;
 use kkt_work::KktWork;
-use line_search::LineSearch;
+pub(crate) use layout::Layout;
 use perturbation::Perturbation;
+use step_kind::LineSearch;
+use vectors::{inf_norm, one_norm};
 
 /// State shared by the outer loop and nested restoration loops.
 pub(crate) struct Shared<'c> {
@@ -105,27 +114,6 @@ pub(crate) struct Outcome {
     pub resto_converged: bool,
 }
 
-/// How the primal vector w = [x; s] is laid out and bounded: fixed for a run.
-#[derive(Clone, Default)]
-pub(crate) struct Layout {
-    pub(crate) n: usize,
-    pub(crate) m: usize,
-    /// Number of inequality rows (slacks).
-    pub(crate) ni: usize,
-    /// n + ni.
-    pub(crate) nw: usize,
-    /// row → slack index (usize::MAX for equality rows).
-    pub(crate) slack_of_row: Vec<usize>,
-    /// slack index → row.
-    pub(crate) row_of_slack: Vec<usize>,
-    /// Right-hand side of equality rows.
-    pub(crate) g_eq: Vec<f64>,
-    pub(crate) wl: Vec<f64>,
-    pub(crate) wu: Vec<f64>,
-    pub(crate) has_l: Vec<bool>,
-    pub(crate) has_u: Vec<bool>,
-}
-
 /// Counters of the main loop.
 #[derive(Default)]
 struct Counters {
@@ -162,81 +150,26 @@ pub(crate) struct Core<'p> {
     kw: KktWork,
     pert: Perturbation,
     count: Counters,
-    // barrier and globalisation state
-    mu: f64,
-    tau: f64,
+    /// The barrier parameter μ, τ and the adaptive rule's state.
+    mu_update: MuUpdate,
     filter: Filter,
     /// The line search's acceptance rules (θ_min, θ_max set by `initialize`).
     accept: Acceptance,
-    free_mode: bool,
-    kkt_refs: Vec<f64>,
-    /// Scratch of the quality-function μ oracle (reused every free-mode iteration).
-    quality_pairs: crate::ipm::quality::Pairs,
     /// Scratch: the problem's starting point (see `Core::initialize`).
     x_start: Vec<f64>,
     /// Scratch: the multipliers before a least-squares re-estimate (`recalc_y`).
     y_saved: Vec<f64>,
     /// Scratch of `Layout::fill`, returned with the buffers.
     bounds: [Vec<f64>; 4],
-    /// The convergence test's state (acceptable streak, previous objective).
-    termination: Termination,
+    /// The termination test (acceptable streak, previous objective, limits).
+    termination: StopTest,
     setup_in_resto: bool,
     /// IPOPT's `recalc_y` in effect (see `Core::recalc_multipliers`).
     recalc_y: bool,
     scaling: Scaling,
-    mu_strategy: MuStrategy,
     /// The outer iteration's failed line search (alpha_pr, ls) that starts a restoration
     /// phase; shown in the restoration's first log row as IPOPT does ("12r … 4.8e-7R 22").
     resto_start: Option<(f64, usize)>,
-}
-
-fn inf_norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |a, &b| a.max(b.abs()))
-}
-
-fn one_norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x.abs()).sum()
-}
-
-fn all_finite(v: &[f64]) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
-
-fn first_non_finite(v: &[f64]) -> Option<usize> {
-    v.iter().position(|x| !x.is_finite())
-}
-
-/// φ_μ(w) = f − μ Σ ln(slack) + κ_d μ Σ slack (one-sided bounds only).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn barrier_value(
-    w: &[f64],
-    f: f64,
-    mu: f64,
-    kappa_d: f64,
-    wl: &[f64],
-    wu: &[f64],
-    has_l: &[bool],
-    has_u: &[bool],
-) -> f64 {
-    let kd = kappa_d * mu;
-    let mut phi = f;
-    for j in 0..w.len() {
-        if has_l[j] {
-            let s = w[j] - wl[j];
-            phi -= mu * s.ln();
-            if !has_u[j] {
-                phi += kd * s;
-            }
-        }
-        if has_u[j] {
-            let s = wu[j] - w[j];
-            phi -= mu * s.ln();
-            if !has_l[j] {
-                phi += kd * s;
-            }
-        }
-    }
-    phi
 }
 
 impl<'p> Core<'p> {
@@ -278,17 +211,20 @@ impl<'p> Core<'p> {
             kw: kw.expect("Buffers::prepare builds the KKT work"),
             pert: Perturbation::default(),
             count: Counters::default(),
-            mu: setup.mu_init,
-            tau: tau(setup.mu_init, opts),
+            mu_update: MuUpdate::new(
+                setup.mu_init,
+                setup.mu_strategy,
+                opts,
+                scaling.obj,
+                kkt_refs,
+                quality_pairs,
+            ),
             filter,
             accept: Acceptance::default(),
-            free_mode: setup.mu_strategy == MuStrategy::Adaptive,
-            kkt_refs,
-            quality_pairs,
             x_start,
             y_saved,
             bounds,
-            termination: Termination::default(),
+            termination: StopTest::new(opts, setup.in_resto),
             setup_in_resto: setup.in_resto,
             recalc_y: !setup.in_resto
                 && m > 0
@@ -296,7 +232,6 @@ impl<'p> Core<'p> {
                     .recalc_y
                     .unwrap_or(opts.hessian_approximation == crate::IpmHessian::LimitedMemory),
             scaling,
-            mu_strategy: setup.mu_strategy,
             resto_start: None,
         })
     }
@@ -304,6 +239,7 @@ impl<'p> Core<'p> {
     /// The vectors of this run (its final iterate among them), for a later run on a
     /// problem with the same structure.
     pub(crate) fn into_buffers(self) -> Buffers {
+        let (kkt_refs, quality_pairs) = self.mu_update.into_scratch();
         Buffers {
             lay: self.lay,
             it: self.it,
@@ -313,8 +249,8 @@ impl<'p> Core<'p> {
             c_soc: self.c_soc,
             kw: Some(self.kw),
             filter: self.filter,
-            kkt_refs: self.kkt_refs,
-            quality_pairs: self.quality_pairs,
+            kkt_refs,
+            quality_pairs,
             scaling: self.scaling,
             x_start: self.x_start,
             y_saved: self.y_saved,
@@ -350,7 +286,7 @@ impl<'p> Core<'p> {
             objective,
             inf_pr,
             inf_du: dual,
-            mu: self.mu,
+            mu: self.mu_update.mu(),
             d_norm,
             regularization: self.pert.delta_w,
             jacobian_regularization: self.pert.delta_c,
@@ -419,7 +355,7 @@ impl<'p> Core<'p> {
     /// restoration problem's own convergence) and the limits. Ok carries the scaled
     /// optimality error E_0 for the adaptive μ update.
     #[allow(clippy::result_large_err)]
-    fn stop_test(&mut self, shared: &Shared, max_resto_iter_end: usize) -> Result<f64, Outcome> {
+    fn stop_test(&mut self, shared: &Shared) -> Result<f64, Outcome> {
         // The iteration callback (called by `record`) asked to stop (IPOPT tests
         // this before convergence).
         if shared.observer.as_ref().is_some_and(|o| o.stopped()) {
@@ -429,38 +365,20 @@ impl<'p> Core<'p> {
                 false,
             ));
         }
-        // ---------------- convergence
         let (e0, eu) = self.nlp_error(0.0, false);
-        if !self.setup_in_resto {
-            let e = KktResiduals {
-                overall: e0,
-                dual: eu[0],
-                primal: eu[1],
-                compl: eu[2],
-            };
-            if let Some(status) = self.termination.check(&e, self.it.f, &self.opts.common) {
-                return Err(self.outcome(status, "", false));
-            }
-        } else if e0 <= self.opts.tol {
-            return Err(self.outcome(
-                Status::SolveSucceeded,
-                "restoration problem converged",
-                true,
-            ));
-        } else {
-            self.termination.set_last_objective(self.it.f);
-        }
-        if shared.iter >= self.opts.max_iter {
-            return Err(self.outcome(Status::MaximumIterationsExceeded, "", false));
-        }
-        if self.setup_in_resto && shared.iter >= max_resto_iter_end {
-            return Err(self.outcome(Status::MaximumIterationsExceeded, "max_resto_iter", false));
-        }
-        if shared.start.elapsed().as_secs_f64() > self.opts.max_wall_time {
-            return Err(self.outcome(Status::MaximumWallTimeExceeded, "", false));
-        }
-        if inf_norm(&self.it.w) > self.opts.diverging_iterates_tol {
-            return Err(self.outcome(Status::DivergingIterates, "", false));
+        let e = KktResiduals {
+            overall: e0,
+            dual: eu[0],
+            primal: eu[1],
+            compl: eu[2],
+        };
+        let now = (
+            shared.iter,
+            shared.start.elapsed().as_secs_f64(),
+            inf_norm(&self.it.w),
+        );
+        if let Some(stop) = self.termination.check(&e, self.it.f, &self.opts, now) {
+            return Err(self.outcome(stop.status, stop.message, stop.resto_converged));
         }
         Ok(e0)
     }
@@ -483,10 +401,10 @@ impl<'p> Core<'p> {
             None => self.record(shared, 0.0, 0.0, 0.0, ' ', 0, eu[0]),
         }
         let mut pending_resto = self.opts.start_with_resto && !self.setup_in_resto;
-        let max_resto_iter_end = shared.iter + self.opts.max_resto_iter;
+        self.termination.start(shared.iter);
         loop {
             self.count.filter_has_current = false;
-            let e0 = match self.stop_test(shared, max_resto_iter_end) {
+            let e0 = match self.stop_test(shared) {
                 Ok(e0) => e0,
                 Err(out) => return out,
             };
@@ -509,14 +427,14 @@ impl<'p> Core<'p> {
     /// One iteration: barrier update, factorisation, direction, then a tiny step or a
     /// line search.
     fn iterate_once(&mut self, shared: &mut Shared, e0: f64) -> Iteration {
-        if self.mu_strategy == MuStrategy::Monotone {
+        if self.mu_update.strategy() == MuStrategy::Monotone {
             self.update_mu_monotone(self.count.tiny_count > 0);
         }
         let factor_ok = self.factorize_with_inertia_correction(shared);
-        if factor_ok && self.mu_strategy == MuStrategy::Adaptive {
+        if factor_ok && self.mu_update.strategy() == MuStrategy::Adaptive {
             self.update_mu_adaptive(shared, e0);
         }
-        if factor_ok && self.solve_direction(shared, self.mu, false) {
+        if factor_ok && self.solve_direction(shared, self.mu_update.mu(), false) {
             shared.iter += 1;
             let d_norm = inf_norm(&self.dir.dw);
             if let Some(done) = self.try_tiny_step(shared, d_norm) {
@@ -557,9 +475,7 @@ impl<'p> Core<'p> {
         self.count.tiny_count += 1;
         let (_, eu) = self.errors(0.0, false);
         self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
-        if self.count.tiny_count >= 2
-            && self.mu <= mu_floor(&self.opts, self.scaling.obj) * (1.0 + 1e-12)
-        {
+        if self.count.tiny_count >= 2 && self.mu_update.at_floor() {
             return Some(Iteration::Finished(self.outcome(
                 Status::SearchDirectionBecomesTooSmall,
                 "",
@@ -639,7 +555,7 @@ impl<'p> Core<'p> {
         // unless the soft restoration attempt did.
         if !std::mem::take(&mut self.count.filter_has_current) {
             let theta = one_norm(&self.it.c);
-            let phi = self.barrier(&self.it.w, self.it.f, self.mu);
+            let phi = self.barrier(&self.it.w, self.it.f, self.mu_update.mu());
             self.accept.augment(&mut self.filter, theta, phi);
         }
         match restore(self, shared) {
@@ -685,7 +601,7 @@ impl<'p> Core<'p> {
 
     /// The current barrier parameter μ.
     pub(crate) fn mu(&self) -> f64 {
-        self.mu
+        self.mu_update.mu()
     }
 
     /// The options of this run.

@@ -1,95 +1,49 @@
-//! The barrier parameter update: monotone (Fiacco–McCormick) and adaptive (free mode with
-//! the LOQO or probing oracle).
+//! The core's side of the μ update ([`MuUpdate`](crate::ipm::mu_update::MuUpdate)):
+//! the errors its rules test and the adaptive oracles' steps, solved with the factorised
+//! KKT matrix.
 
-#![allow(
-    clippy::needless_range_loop,
-    clippy::neg_cmp_op_on_partial_ord,
-    clippy::too_many_arguments
-)]
+#![allow(clippy::needless_range_loop)]
 
 use super::Core;
 use super::Shared;
-use crate::ipm::barrier::loqo_mu;
-use crate::ipm::barrier::monotone_next;
-use crate::ipm::barrier::mu_floor;
-use crate::ipm::barrier::mu_floor_adaptive;
-use crate::ipm::barrier::probing_mu;
-use crate::ipm::barrier::tau;
+use crate::ipm::mu_update::{loqo_mu, probing_mu, AdaptiveMode};
 use crate::ipm::quality;
 use crate::options::MuOracle;
 
 impl Core<'_> {
-    // ------------------------------------------------------------------ barrier update
-
+    /// The monotone rule, testing the barrier problem's error E_μ; `force` after a tiny
+    /// step.
     pub(super) fn update_mu_monotone(&mut self, force: bool) {
-        let floor = mu_floor(&self.opts, self.scaling.obj);
-        let mut first = true;
-        loop {
-            if self.mu <= floor {
-                return;
-            }
-            let (e_mu, _) = self.nlp_error(self.mu, true);
-            if !(force && first) && e_mu > self.opts.barrier_tol_factor * self.mu {
-                return;
-            }
-            first = false;
-            self.mu = monotone_next(self.mu, &self.opts, self.scaling.obj);
-            self.tau = tau(self.mu, &self.opts);
+        let mut part = std::mem::take(&mut self.mu_update);
+        let changed = part.monotone(force, |mu| self.nlp_error(mu, true).0);
+        self.mu_update = part;
+        if changed {
             self.filter.reset();
-            if !self.opts.mu_allow_fast_monotone_decrease {
-                return;
-            }
         }
     }
 
-    /// Adaptive μ (called after the KKT matrix is factorised).
+    /// The adaptive rule (called after the KKT matrix is factorised); `e0` is the
+    /// optimality error at μ = 0.
     pub(super) fn update_mu_adaptive(&mut self, shared: &mut Shared, e0: f64) {
-        // IPOPT's kkt-error globalisation (AdaptiveMuUpdate::CheckSufficientProgress):
-        // progress is sufficient while fewer than `adaptive_mu_kkterror_red_iters`
-        // reference values exist, else when the primal-dual error is below
-        // `adaptive_mu_kkterror_red_fact` times one of them.
-        let red = self.opts.adaptive_mu_kkterror_red_fact;
-        let max_refs = self.opts.adaptive_mu_kkterror_red_iters;
         let err = self.pd_system_error();
-        let sufficient =
-            self.kkt_refs.len() < max_refs || self.kkt_refs.iter().any(|&r| err <= red * r);
-        if self.free_mode && !sufficient {
-            // Switch to the monotone (fixed) mode.
-            self.free_mode = false;
-            let (avg, _) = self.avg_compl(&self.it.w, &self.it.zl, &self.it.zu);
-            self.mu = (self.opts.adaptive_mu_monotone_init_factor * avg)
-                .clamp(mu_floor(&self.opts, self.scaling.obj), self.opts.mu_max);
-            self.tau = tau(self.mu, &self.opts);
-            self.filter.reset();
-            return;
-        }
-        if !self.free_mode && !sufficient {
-            self.update_mu_monotone(false);
-            return;
-        }
-        // Stay in (or return to) free mode; remember this point's error.
-        self.free_mode = true;
-        if self.kkt_refs.len() >= max_refs {
-            self.kkt_refs.remove(0);
-        }
-        self.kkt_refs.push(err);
-        // Free mode: τ = max(τ_min, 1 − E₀) (IPOPT's AdaptiveMuUpdate), then the oracle.
-        self.tau = self.opts.tau_min.max(1.0 - e0);
         let (avg, mn) = self.avg_compl(&self.it.w, &self.it.zl, &self.it.zu);
-        let mut mu = match self.opts.mu_oracle {
-            MuOracle::Loqo => loqo_mu(avg, mn),
-            MuOracle::Probing => self.probing_oracle(shared, avg).unwrap_or(loqo_mu(avg, mn)),
-            MuOracle::QualityFunction => self
-                .quality_function_oracle(shared, avg)
-                .unwrap_or(loqo_mu(avg, mn)),
-        };
-        mu = mu.clamp(
-            mu_floor_adaptive(&self.opts, self.scaling.obj),
-            self.opts.mu_max,
-        );
-        if mu != self.mu {
-            self.mu = mu;
-            self.filter.reset();
+        match self.mu_update.adaptive_mode(err, avg, e0) {
+            AdaptiveMode::SwitchedToFixed => self.filter.reset(),
+            AdaptiveMode::Fixed => self.update_mu_monotone(false),
+            AdaptiveMode::Free => {
+                let mu = match self.mu_update.oracle() {
+                    MuOracle::Loqo => loqo_mu(avg, mn),
+                    MuOracle::Probing => {
+                        self.probing_oracle(shared, avg).unwrap_or(loqo_mu(avg, mn))
+                    }
+                    MuOracle::QualityFunction => self
+                        .quality_function_oracle(shared, avg)
+                        .unwrap_or(loqo_mu(avg, mn)),
+                };
+                if self.mu_update.set_free_mu(mu) {
+                    self.filter.reset();
+                }
+            }
         }
     }
 
@@ -155,7 +109,7 @@ impl Core<'_> {
         }
         // The pairs with their affine step, then (after the solve for μ = avg) their
         // centring step, in the same order.
-        let mut p = std::mem::take(&mut self.quality_pairs);
+        let mut p = std::mem::take(self.mu_update.pairs_mut());
         p.clear();
         for j in 0..self.lay.nw {
             let dw = self.dir.dw[j];
@@ -187,18 +141,10 @@ impl Core<'_> {
                 }
             }
         }
-        let complete = p.ds_cen.len() == p.ds_aff.len();
-        let data = quality::QualityData {
-            pairs: &p,
-            dual: self.grad_lag_norms(),
-            primal: quality::Norms::of(self.it.c.iter().copied()),
-            tau: self.tau,
-        };
-        let settings = quality::QualitySettings::from_options(&self.opts);
-        let mu_min = mu_floor_adaptive(&self.opts, self.scaling.obj);
-        let sigma = complete.then(|| data.choose_sigma(avg, mu_min, self.opts.mu_max, &settings));
-        self.quality_pairs = p;
-        let mu = sigma? * avg;
-        mu.is_finite().then_some(mu)
+        let (dual, primal) = (
+            self.grad_lag_norms(),
+            quality::Norms::of(self.it.c.iter().copied()),
+        );
+        self.mu_update.quality_function_mu(p, dual, primal, avg)
     }
 }

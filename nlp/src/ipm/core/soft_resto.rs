@@ -8,9 +8,9 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use super::line_search::LineSearch;
-use super::line_search::StepKind;
-use super::one_norm;
+use super::step_kind::LineSearch;
+use super::step_kind::StepKind;
+use super::vectors::one_norm;
 use super::Core;
 use super::Shared;
 
@@ -64,8 +64,8 @@ impl Core<'_> {
             return None;
         }
         let alpha = self
-            .max_step_primal(&self.dir.dw, self.tau)
-            .min(self.max_step_dual(&self.dir.dzl, &self.dir.dzu, self.tau));
+            .max_step_primal(&self.dir.dw, self.mu_update.tau())
+            .min(self.max_step_dual(&self.dir.dzl, &self.dir.dzu, self.mu_update.tau()));
         for j in 0..self.lay.nw {
             self.trial.w[j] = self.it.w[j] + alpha * self.dir.dw[j];
         }
@@ -73,9 +73,9 @@ impl Core<'_> {
             return None;
         }
         let theta = one_norm(&self.it.c);
-        let phi = self.barrier(&self.it.w, self.it.f, self.mu);
+        let phi = self.barrier(&self.it.w, self.it.f, self.mu_update.mu());
         let theta_t = one_norm(&self.trial.c);
-        let phi_t = self.barrier(&self.trial.w, self.trial.f, self.mu);
+        let phi_t = self.barrier(&self.trial.w, self.trial.f, self.mu_update.mu());
         // IPOPT tests with step size 0: the switching condition fails, so this is the
         // sufficient-reduction test and the filter.
         let original =
@@ -88,7 +88,11 @@ impl Core<'_> {
             return None;
         }
         // In free (adaptive) mode IPOPT measures the error at μ = 0.
-        let mu_e = if self.free_mode { 0.0 } else { self.mu };
+        let mu_e = if self.mu_update.free_mode() {
+            0.0
+        } else {
+            self.mu_update.mu()
+        };
         let current = self.primal_dual_error(mu_e);
         let saved = (!original).then(|| self.it.clone());
         self.take_dual_step(alpha, false);
@@ -135,7 +139,7 @@ impl Core<'_> {
                 }
                 // IPOPT's PrepareRestoPhaseStart: the filter gets the current point.
                 let theta = one_norm(&self.it.c);
-                let phi = self.barrier(&self.it.w, self.it.f, self.mu);
+                let phi = self.barrier(&self.it.w, self.it.f, self.mu_update.mu());
                 self.accept.augment(&mut self.filter, theta, phi);
                 self.count.filter_has_current = true;
                 (ls, 0)
