@@ -162,6 +162,7 @@ mod sqp_kept_example {
         let p = pb.scalar_parameter("p").unwrap();
         pb.minimize((x[0] - p).sq() + (x[1] - 1.0).sq());
         pb.subject_to((x[0] + x[1]).le(1.5)).unwrap();
+        pb.set_value(&[p], &[0.0]).unwrap();
         let mut c = pb.compile().unwrap();
         let sqp = Sqp::default(); // not `Sqp { options }`: the struct has a private field
         let mut sol = sqp.solve(&mut c).unwrap();
