@@ -150,3 +150,39 @@ mod warm_into_example {
         }
     }
 }
+
+/// docs/solvers.md section 7, "Kept between solves": one `Sqp` along a sequence (each
+/// line of the doc's block is checked to be here).
+mod sqp_kept_example {
+    #[test]
+    fn solvers_md_sqp_kept_example_runs() {
+        use nlp::{Problem, Relation, Sqp};
+        let mut pb = Problem::new();
+        let x = pb.variable("x", 2).unwrap();
+        let p = pb.scalar_parameter("p").unwrap();
+        pb.minimize((x[0] - p).sq() + (x[1] - 1.0).sq());
+        pb.subject_to((x[0] + x[1]).le(1.5)).unwrap();
+        pb.set_value(&[p], &[0.0]).unwrap();
+        let mut c = pb.compile().unwrap();
+        let sqp = Sqp::default(); // not `Sqp { options }`: the struct has a private field
+        let mut sol = sqp.solve(&mut c).unwrap();
+        for k in 1..4 {
+            c.set_value(&[p], &[0.1 * k as f64]).unwrap();
+            sol = sqp.solve_warm(&mut c, &sol).unwrap(); // reuses the KKT analysis and QP layout
+        }
+        assert!(sol.status.is_success());
+        // p = 0.3: x = (0.3, 1) is feasible (1.3 ≤ 1.5), the unconstrained minimiser.
+        assert!((sol.x[0] - 0.3).abs() < 1e-8 && (sol.x[1] - 1.0).abs() < 1e-8);
+    }
+
+    #[test]
+    fn solvers_md_sqp_kept_example_is_the_one_tested_here() {
+        let this = include_str!("solvers_doc.rs");
+        for line in super::doc_block("*Kept between solves*") {
+            assert!(
+                this.contains(line),
+                "docs/solvers.md section 7 line not in the test: {line}"
+            );
+        }
+    }
+}

@@ -106,3 +106,112 @@ fn chain_cold_log() {
     let sol = sqp(5).solve(&mut c).unwrap();
     println!("sqp {} {}", sol.status, sol.objective);
 }
+
+/// The 20-link chain of `python/tests/problems.py` (`build_chain`): masses (x_i, y_i),
+/// min Σ y_i, every link at most 1.25/19 long (an inequality), the ends fixed by
+/// equality rows with parameter values; the guess a straight line between the ends.
+fn chain20() -> Problem {
+    let n = 20;
+    let mut pb = Problem::new();
+    let xs = pb.variable("px", n).unwrap();
+    let ys = pb.variable("py", n).unwrap();
+    let ends = pb.parameter("ends", 4).unwrap();
+    pb.minimize((0..n).fold(Expr::from(0.0), |a, i| a + ys[i]));
+    let seg = 1.25 / (n - 1) as f64;
+    for i in 0..n - 1 {
+        let len2 = (xs[i + 1] - xs[i]).sq() + (ys[i + 1] - ys[i]).sq();
+        pb.subject_to(len2.le(seg * seg)).unwrap();
+    }
+    for (v, k) in [(xs[0], 0), (ys[0], 1), (xs[n - 1], 2), (ys[n - 1], 3)] {
+        pb.subject_to((v - ends[k]).eq(0.0)).unwrap();
+    }
+    let t = |i: usize| i as f64 / (n - 1) as f64;
+    let x0: Vec<f64> = (0..n).map(t).collect();
+    let y0: Vec<f64> = (0..n).map(|i| 1.0 - 0.5 * t(i)).collect();
+    pb.set_initial(&xs, &x0).unwrap();
+    pb.set_initial(&ys, &y0).unwrap();
+    pb.set_value(&ends, &[0.0, 1.0, 1.0, 0.5]).unwrap();
+    pb
+}
+
+/// Found by the Python suite (`python/tests/test_casadi_compare.py`, marked xfail there):
+/// at tol 1e-10 the SQP stops at f = 12.2632967, 1.58e-5 above IPOPT's and the IPM's
+/// 12.2632810. The cause is not the SQP: IPOPT and the IPM relax every bound by
+/// `bound_relax_factor`·max(1, |bound|) = 1e-8 (the links' bound is seg² ≈ 0.0043), so
+/// they solve a problem whose links may be longer, and its optimum is lower by
+/// Σ λ_i·1e-8 ≈ 1577·1e-8 (first-order sensitivity of f* to the bounds). The SQP keeps
+/// the bounds exact. Checked: the SQP agrees with the IPM without the relaxation to 1e-9
+/// relative (both at tol 1e-10 on the scaled KKT error; measured 1e-12), and the default
+/// IPM's gap is the first-order estimate to 2 % (second-order terms are 1e-8 smaller).
+#[test]
+fn chain20_tight_tolerance_reaches_the_exact_optimum() {
+    let mut c = chain20().compile().unwrap();
+    let common = CommonOptions {
+        tol: 1e-10,
+        print_level: std::env::var("SQP_PRINT")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(0),
+        ..CommonOptions::default()
+    };
+    let sqp = Sqp::new(SqpOptions {
+        common: common.clone(),
+        ..SqpOptions::default()
+    });
+    let sol = sqp.solve(&mut c).unwrap();
+    assert_eq!(sol.status, Status::SolveSucceeded, "{}", sol.message);
+    let mut ipm = Ipm::default();
+    ipm.options.common.tol = 1e-10;
+    ipm.options.bound_relax_factor = 0.0;
+    let exact = ipm.solve(&mut c).unwrap();
+    assert_eq!(exact.status, Status::SolveSucceeded, "{}", exact.message);
+    let rel = (sol.objective - exact.objective).abs() / exact.objective.abs();
+    assert!(
+        rel <= 1e-9,
+        "SQP f = {}, IPM without relaxation f = {} (rel. {rel:e})",
+        sol.objective,
+        exact.objective
+    );
+    ipm.options.bound_relax_factor = 1e-8;
+    let relaxed = ipm.solve(&mut c).unwrap();
+    assert_eq!(relaxed.status, Status::SolveSucceeded);
+    let links: f64 = sol.lambda[..19].iter().sum();
+    let predicted = 1e-8 * links;
+    let gap = sol.objective - relaxed.objective;
+    assert!(
+        (gap - predicted).abs() <= 0.02 * predicted,
+        "gap to the relaxed optimum {gap:e}, predicted Σλ·1e-8 = {predicted:e}"
+    );
+}
+
+/// One solver re-used along a warm sequence keeps its KKT matrix and QP layouts between
+/// solves (`nlp/src/sqp/workspace.rs`); nothing numeric is carried over, so every solve
+/// must be bit-identical to the same warm solve by a new solver. The sequence includes
+/// a change of structure (another problem) in the middle, after which the parts are
+/// rebuilt.
+#[test]
+fn warm_sequence_with_kept_parts_is_bit_identical() {
+    let (pb, p) = chain_with_moving_end(40);
+    let mut c = pb.compile().unwrap();
+    let mut other = hanging_chain(30).compile().unwrap();
+    let kept = sqp(0);
+    let mut prev = kept.solve(&mut c).unwrap();
+    assert_eq!(prev.status, Status::SolveSucceeded, "{}", prev.message);
+    for k in 1..=6 {
+        if k == 3 {
+            let a = kept.solve(&mut other).unwrap();
+            let b = sqp(0).solve(&mut other).unwrap();
+            assert_eq!(a.x, b.x, "other structure");
+        }
+        c.set_value(&[p], &[1.0 - 0.03 * k as f64]).unwrap();
+        let a = kept.solve_warm(&mut c, &prev).unwrap();
+        let b = sqp(0).solve_warm(&mut c, &prev).unwrap();
+        assert_eq!(a.status, Status::SolveSucceeded, "step {k}: {}", a.message);
+        assert_eq!(a.stats.iterations, b.stats.iterations, "step {k}");
+        assert_eq!(a.x, b.x, "step {k}");
+        assert_eq!(a.lambda, b.lambda, "step {k}");
+        assert_eq!(a.z_l, b.z_l, "step {k}");
+        assert_eq!(a.z_u, b.z_u, "step {k}");
+        prev = a;
+    }
+}

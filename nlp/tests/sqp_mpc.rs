@@ -174,3 +174,20 @@ fn cart_pole_loop_report() {
     summary("ipm", &closed_loop(&Ipm::default(), steps));
     summary("sqp", &closed_loop(&Sqp::default(), steps));
 }
+
+/// The cold first step of the loop with the SQP's log (`SQP_PRINT`, default 5: the
+/// iteration table, the QP counts and why the active-set method handed QPs to clarabel).
+#[test]
+#[ignore = "diagnostics: cargo test --release -p nlp --test sqp_mpc -- --ignored --nocapture cold_first_step_log"]
+fn cold_first_step_log() {
+    let print_level = std::env::var("SQP_PRINT")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
+    let mut o = nlp::SqpOptions::default();
+    o.common.print_level = print_level;
+    let sqp = Sqp::new(o);
+    let mut c = Controller::new(&sqp);
+    let (sol, secs) = c.step(&[0.0; NX]);
+    println!("{} in {:.1} ms", sol.status, 1e3 * secs);
+}

@@ -24,7 +24,7 @@
 //! rows, or B not convex on W's null space). A solution whose multipliers exceed the ℓ1
 //! penalty ρ is the elastic QP's only for a larger ρ ([`penalty_for`]).
 
-use std::collections::HashSet;
+use std::hash::{DefaultHasher, Hash, Hasher};
 
 use faer::sparse::SymbolicSparseColMat;
 
@@ -35,7 +35,8 @@ use super::polish::{
 use super::qp::{QpData, QpResult};
 use crate::kkt::Kkt;
 
-/// Why the active-set method gave up on a QP (the caller falls back to clarabel).
+/// Why the active-set method gave up on a QP (the caller falls back to clarabel); as
+/// `usize`, the index into `Work::active_set_failures`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Failure {
     /// The KKT matrix or the problem sizes do not fit.
@@ -124,6 +125,13 @@ pub(super) fn fits(w: &WorkingSet, p: &QpData) -> bool {
         && (0..p.x.len()).all(|j| (w.vars[j] == Side::Both) == (p.x_l[j] == p.x_u[j]))
 }
 
+/// A hash of `w` (the same in every run).
+fn hash_of(w: &WorkingSet) -> u64 {
+    let mut h = DefaultHasher::new();
+    w.hash(&mut h);
+    h.finish()
+}
+
 /// Solves the QP of `p` from the working set `start` (see the module documentation).
 /// `jp`, `hp`: the patterns of `p.jac` and `p.hess`; `n_elastic`: the length of the
 /// (zero) elastic part of the result; every factorisation is counted in `n_fact`.
@@ -143,10 +151,11 @@ pub(super) fn solve(
     if kkt.n() != n || kkt.m() != m || !fits(&start, p) {
         return Err(Failure::Shape);
     }
-    let tol = |b: f64| 1e-9 * (1.0 + b.abs());
-    let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let mut w = start;
-    let mut seen: HashSet<WorkingSet> = HashSet::new();
+    // Hashes of the working sets met (a deterministic SipHash; two different sets with
+    // the same hash would only end the method early, never change its result).
+    let mut seen: Vec<u64> = Vec::new();
+    let mut changes: Vec<Change> = Vec::new();
     // After a repeated working set, one change per iteration (the largest violation).
     let mut one_at_a_time = false;
     for iteration in 1..=max_iter {
@@ -158,116 +167,162 @@ pub(super) fn solve(
         let (d, lambda) = step.ok_or(Failure::EqualityQp)?;
         let s = stationarity(p, (jp, hp), &d, &lambda);
         let jd = jac_times(p, jp, &d);
-        let lam_max = lambda.iter().chain(&s).fold(1.0f64, |a, v| a.max(v.abs()));
-        let mult_tol = 1e-8 * lam_max;
-        // Every change as (index: rows then variables, new side, size of the violation).
-        let mut changes: Vec<(usize, Side, f64)> = Vec::new();
-        for i in 0..m {
-            let lin = p.g[i] + jd[i];
-            // The QP's own multiplier (the augmented term's share ρ_a·J_i d removed).
-            let l_qp = lambda[i] - p.row_weight[i] * jd[i];
-            let change = match w.rows[i] {
-                Side::Free if lin > p.g_u[i] + tol(p.g_u[i]) => Some((Side::Upper, lin - p.g_u[i])),
-                Side::Free if lin < p.g_l[i] - tol(p.g_l[i]) => Some((Side::Lower, p.g_l[i] - lin)),
-                Side::Upper if l_qp < -mult_tol => Some((Side::Free, -l_qp)),
-                Side::Lower if l_qp > mult_tol => Some((Side::Free, l_qp)),
-                _ => None,
-            };
-            if let Some((side, v)) = change {
-                changes.push((i, side, v));
-            }
-        }
-        for j in 0..n {
-            let xn = p.x[j] + d[j];
-            // s_j = z_l − z_u: a lower bound needs s_j ≥ 0, an upper one s_j ≤ 0.
-            let change = match w.vars[j] {
-                Side::Free if xn > p.x_u[j] + tol(p.x_u[j]) => Some((Side::Upper, xn - p.x_u[j])),
-                Side::Free if xn < p.x_l[j] - tol(p.x_l[j]) => Some((Side::Lower, p.x_l[j] - xn)),
-                Side::Upper if s[j] > mult_tol => Some((Side::Free, s[j])),
-                Side::Lower if s[j] < -mult_tol => Some((Side::Free, -s[j])),
-                _ => None,
-            };
-            if let Some((side, v)) = change {
-                changes.push((m + j, side, v));
-            }
-        }
-        if !changes.is_empty() {
-            if one_at_a_time {
-                // The largest violation; ties to the first index (deterministic).
-                let k = (0..changes.len()).fold(
-                    0,
-                    |b, k| {
-                        if changes[k].2 > changes[b].2 {
-                            k
-                        } else {
-                            b
-                        }
-                    },
-                );
-                changes = vec![changes[k]];
-            }
-            let mut next = w.clone();
-            for &(k, side, _) in &changes {
-                if k < m {
-                    next.rows[k] = side;
-                } else {
-                    next.vars[k - m] = side;
-                }
-            }
-            seen.insert(std::mem::replace(&mut w, next));
-            if seen.contains(&w) {
-                if one_at_a_time {
-                    return Err(Failure::Cycle);
-                }
-                one_at_a_time = true;
-                seen.clear();
-            }
-            continue;
-        }
-        // A KKT point of the QP if the solve was accurate: free variables stationary,
-        // the rows of W met.
-        let met = |i: usize| {
-            let lin = p.g[i] + jd[i];
-            match w.rows[i] {
-                Side::Free => true,
-                Side::Lower => (lin - p.g_l[i]).abs() <= tol(p.g_l[i]),
-                Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= tol(p.g_u[i]),
-            }
+        let step = Step {
+            d: &d,
+            lambda: &lambda,
+            s: &s,
+            jd: &jd,
         };
-        if (0..n).any(|j| w.vars[j] == Side::Free && s[j].abs() > 1e-8 * grad_max)
-            || !(0..m).all(met)
-        {
-            return Err(Failure::EqualityQp);
+        sign_test(p, &w, &step, &mut changes);
+        if changes.is_empty() {
+            let solved = kkt_point(p, w, step, (iteration, n_elastic))?;
+            return Ok(solved);
         }
-        let z_w: Vec<f64> = (0..m).map(|i| p.row_weight[i] * jd[i]).collect();
-        let lambda_qp: Vec<f64> = (0..m).map(|i| lambda[i] - z_w[i]).collect();
-        let max_multiplier = lambda_qp.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let mut z_l = vec![0.0; n];
-        let mut z_u = vec![0.0; n];
-        for j in 0..n {
-            if w.vars[j] != Side::Free {
-                z_l[j] = s[j].max(0.0);
-                z_u[j] = (-s[j]).max(0.0);
+        if one_at_a_time {
+            keep_largest(&mut changes);
+        }
+        seen.push(hash_of(&w));
+        for &(k, side, _) in &changes {
+            if k < m {
+                w.rows[k] = side;
+            } else {
+                w.vars[k - m] = side;
             }
         }
-        return Ok(Solved {
-            res: QpResult {
-                d,
-                e: vec![0.0; n_elastic],
-                lambda: lambda_qp,
-                z_l,
-                z_u,
-                z_cone: Vec::new(),
-                z_w,
-                status: clarabel::solver::SolverStatus::Solved,
-                iterations: iteration as u32,
-            },
-            working_set: w,
-            iterations: iteration,
-            max_multiplier,
-        });
+        if seen.contains(&hash_of(&w)) {
+            if one_at_a_time {
+                return Err(Failure::Cycle);
+            }
+            one_at_a_time = true;
+            seen.clear();
+        }
     }
     Err(Failure::IterationLimit)
+}
+
+/// A change of the working set: (index, rows then variables; the new side; the size of
+/// the violation).
+type Change = (usize, Side, f64);
+
+/// The equality QP's solution for a working set: the step d, the rows' multipliers λ
+/// (augmented term included), the stationarity residual s = B d + ∇f + Jᵀλ and J d.
+struct Step<'s> {
+    d: &'s [f64],
+    lambda: &'s [f64],
+    s: &'s [f64],
+    jd: &'s [f64],
+}
+
+/// The feasibility tolerance of a constraint with bound `b`.
+fn feas_tol(b: f64) -> f64 {
+    1e-9 * (1.0 + b.abs())
+}
+
+/// The sign test of the primal-dual active-set strategy: into `changes`, every row and
+/// bound outside W the step violates (entering on the violated side) and every one in W
+/// whose multiplier has the wrong sign (leaving).
+fn sign_test(p: &QpData, w: &WorkingSet, st: &Step, changes: &mut Vec<Change>) {
+    let (n, m) = (p.x.len(), p.g.len());
+    let lam_max = st
+        .lambda
+        .iter()
+        .chain(st.s)
+        .fold(1.0f64, |a, v| a.max(v.abs()));
+    let mult_tol = 1e-8 * lam_max;
+    changes.clear();
+    for i in 0..m {
+        let lin = p.g[i] + st.jd[i];
+        // The QP's own multiplier (the augmented term's share ρ_a·J_i d removed).
+        let l_qp = st.lambda[i] - p.row_weight[i] * st.jd[i];
+        let (l, u) = (p.g_l[i], p.g_u[i]);
+        let change = match w.rows[i] {
+            Side::Free if lin > u + feas_tol(u) => Some((Side::Upper, lin - u)),
+            Side::Free if lin < l - feas_tol(l) => Some((Side::Lower, l - lin)),
+            Side::Upper if l_qp < -mult_tol => Some((Side::Free, -l_qp)),
+            Side::Lower if l_qp > mult_tol => Some((Side::Free, l_qp)),
+            _ => None,
+        };
+        if let Some((side, v)) = change {
+            changes.push((i, side, v));
+        }
+    }
+    for j in 0..n {
+        let xn = p.x[j] + st.d[j];
+        let (l, u, s) = (p.x_l[j], p.x_u[j], st.s[j]);
+        // s_j = z_l − z_u: a lower bound needs s_j ≥ 0, an upper one s_j ≤ 0.
+        let change = match w.vars[j] {
+            Side::Free if xn > u + feas_tol(u) => Some((Side::Upper, xn - u)),
+            Side::Free if xn < l - feas_tol(l) => Some((Side::Lower, l - xn)),
+            Side::Upper if s > mult_tol => Some((Side::Free, s)),
+            Side::Lower if s < -mult_tol => Some((Side::Free, -s)),
+            _ => None,
+        };
+        if let Some((side, v)) = change {
+            changes.push((m + j, side, v));
+        }
+    }
+}
+
+/// Keeps only the change of the largest violation (ties to the first index:
+/// deterministic).
+fn keep_largest(changes: &mut Vec<Change>) {
+    let k = (0..changes.len()).fold(0, |b, k| if changes[k].2 > changes[b].2 { k } else { b });
+    changes.swap(0, k);
+    changes.truncate(1);
+}
+
+/// The QP's solution from the step of W that passed the sign test, if the equality QP
+/// was solved accurately (free variables stationary, the rows of W met);
+/// `Err(EqualityQp)` otherwise. `iteration`: the active-set iterations so far;
+/// `n_elastic`: the length of the (zero) elastic part.
+fn kkt_point(
+    p: &QpData,
+    w: WorkingSet,
+    st: Step,
+    (iteration, n_elastic): (usize, usize),
+) -> Result<Solved, Failure> {
+    let (n, m) = (p.x.len(), p.g.len());
+    let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+    let met = |i: usize| {
+        let lin = p.g[i] + st.jd[i];
+        match w.rows[i] {
+            Side::Free => true,
+            Side::Lower => (lin - p.g_l[i]).abs() <= feas_tol(p.g_l[i]),
+            Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= feas_tol(p.g_u[i]),
+        }
+    };
+    if (0..n).any(|j| w.vars[j] == Side::Free && st.s[j].abs() > 1e-8 * grad_max)
+        || !(0..m).all(met)
+    {
+        return Err(Failure::EqualityQp);
+    }
+    let z_w: Vec<f64> = (0..m).map(|i| p.row_weight[i] * st.jd[i]).collect();
+    let lambda_qp: Vec<f64> = (0..m).map(|i| st.lambda[i] - z_w[i]).collect();
+    let max_multiplier = lambda_qp.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let mut z_l = vec![0.0; n];
+    let mut z_u = vec![0.0; n];
+    for j in 0..n {
+        if w.vars[j] != Side::Free {
+            z_l[j] = st.s[j].max(0.0);
+            z_u[j] = (-st.s[j]).max(0.0);
+        }
+    }
+    Ok(Solved {
+        res: QpResult {
+            d: st.d.to_vec(),
+            e: vec![0.0; n_elastic],
+            lambda: lambda_qp,
+            z_l,
+            z_u,
+            z_cone: Vec::new(),
+            z_w,
+            status: clarabel::solver::SolverStatus::Solved,
+            iterations: iteration as u32,
+        },
+        working_set: w,
+        iterations: iteration,
+        max_multiplier,
+    })
 }
 
 #[cfg(test)]
@@ -278,9 +333,13 @@ mod tests {
     //! bounds and fixed variables, feasible by construction; and on degenerate ones
     //! (duplicated rows, a bound duplicating a row), where the method may give up but
     //! must not return a wrong answer.
-    use super::*;
-    use crate::sqp::qp::{Qp, QpStructure};
+    use super::{guess, penalty_for, solve};
+    use crate::kkt::Kkt;
+    use crate::sqp::iterate::Mult;
+    use crate::sqp::polish::WorkingSet;
+    use crate::sqp::qp::{Qp, QpData, QpResult, QpStructure};
     use crate::test_support::{pattern, Rng};
+    use faer::sparse::SymbolicSparseColMat;
 
     struct Case {
         n: usize,

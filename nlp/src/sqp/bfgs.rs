@@ -67,7 +67,7 @@ pub(super) fn bfgs_update(b: &mut [f64], s: &[f64], y: &[f64]) {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::bfgs_update;
     use crate::{HessianApproximation, Problem, Relation, Sqp, SqpOptions, Status};
 
     /// The update keeps B symmetric positive definite and, with θ = 1 (sᵀy ≥ 0.2 sᵀBs),

@@ -59,70 +59,77 @@ pub(super) struct Convexify<'a> {
     pub active_b: &'a [bool],
 }
 
+/// The smallest shift δ for which `test(δ)` holds, by IPOPT's sequence: 0 (when
+/// `allow_zero`), then `first_hessian_shift` or δ_last/3, ×100 at first, ×8 after, up to
+/// `max_hessian_shift`.
+fn shift_search(
+    o: &SqpOptions,
+    delta_last: f64,
+    test: &mut dyn FnMut(f64) -> bool,
+    allow_zero: bool,
+) -> Option<f64> {
+    if allow_zero && test(0.0) {
+        return Some(0.0);
+    }
+    let mut delta = if delta_last == 0.0 {
+        o.first_hessian_shift
+    } else {
+        (delta_last / 3.0).max(o.min_hessian_shift)
+    };
+    let grow = if delta_last == 0.0 { 100.0 } else { 8.0 };
+    while delta <= o.max_hessian_shift {
+        if test(delta) {
+            return Some(delta);
+        }
+        delta *= grow;
+    }
+    None
+}
+
 impl Convexify<'_> {
+    /// Whether B = H + δI + ρ·(J_AᵀJ_A + I_b) is positive definite: the inertia of
+    /// `[H + δI + ρ·I_b, J_Aᵀ; J_A, −I/ρ]` is (n, m) (inactive rows decoupled by a huge
+    /// diagonal). Counts the factorisation in `n_fact`.
+    fn positive_definite(&mut self, delta: f64, rho: f64, n_fact: &mut usize) -> bool {
+        let (n, m) = (self.kkt.n(), self.kkt.m());
+        *n_fact += 1;
+        let active_b = self.active_b;
+        let active_r = self.active_r;
+        let dx: Vec<f64> = (0..n)
+            .map(|j| delta + if active_b[j] { rho } else { 0.0 })
+            .collect();
+        let dc: Vec<f64> = (0..m)
+            .map(|i| {
+                if rho > 0.0 && active_r[i] {
+                    1.0 / rho
+                } else {
+                    1e20
+                }
+            })
+            .collect();
+        matches!(self.kkt.factorize(self.hv, &dx, self.jv, &dc),
+            Ok(i) if i.positive == n && i.negative == m)
+    }
+
     /// The (δ, ρ_a) found, or `None` when no shift up to `max_hessian_shift` works;
     /// counts the factorisations in `n_fact`. δ is the shift the inertia asks for, no
     /// more: the step control's proximal shift is the caller's, applied on top (mixing it
     /// into `delta_last` made one cut step damp the next iterations through the δ/3
     /// memory, see `SqpState::convexify`).
     pub fn run(
-        self,
+        mut self,
         o: &SqpOptions,
         delta_last: f64,
         rho_last: f64,
         n_fact: &mut usize,
     ) -> Option<(f64, f64)> {
-        let Convexify {
-            kkt,
-            hv,
-            jv,
-            active_r,
-            active_b,
-        } = self;
-        let (n, m) = (kkt.n(), kkt.m());
-        let mut test = |delta: f64, rho: f64| -> bool {
-            *n_fact += 1;
-            let dx: Vec<f64> = (0..n)
-                .map(|j| delta + if active_b[j] { rho } else { 0.0 })
-                .collect();
-            let dc: Vec<f64> = (0..m)
-                .map(|i| {
-                    if rho > 0.0 && active_r[i] {
-                        1.0 / rho
-                    } else {
-                        1e20
-                    }
-                })
-                .collect();
-            matches!(kkt.factorize(hv, &dx, jv, &dc), Ok(i) if i.positive == n && i.negative == m)
-        };
-        let any_active = active_r.iter().chain(active_b).any(|&a| a);
-        let rho_max = o.max_augmented_weight;
-        // Smallest shift δ ≥ δ_min for which `ok(δ)` holds, IPOPT's sequence: δ_min (0
-        // when allowed), then first_hessian_shift or δ_last/3, ×100 at first, ×8 after.
-        let shift_search = |test: &mut dyn FnMut(f64) -> bool, allow_zero: bool| {
-            if allow_zero && test(0.0) {
-                return Some(0.0);
-            }
-            let mut delta = if delta_last == 0.0 {
-                o.first_hessian_shift
-            } else {
-                (delta_last / 3.0).max(o.min_hessian_shift)
-            };
-            let grow = if delta_last == 0.0 { 100.0 } else { 8.0 };
-            while delta <= o.max_hessian_shift {
-                if test(delta) {
-                    return Some(delta);
-                }
-                delta *= grow;
-            }
-            None
-        };
-        if rho_last == 0.0 && test(0.0, 0.0) {
+        if rho_last == 0.0 && self.positive_definite(0.0, 0.0, n_fact) {
             return Some((0.0, 0.0));
         }
+        let any_active = self.active_r.iter().chain(self.active_b).any(|&a| a);
         if !any_active {
-            return shift_search(&mut |d| test(d, 0.0), true).map(|d| (d, 0.0));
+            let mut test = |d| self.positive_definite(d, 0.0, n_fact);
+            return shift_search(o, delta_last, &mut test, true).map(|d| (d, 0.0));
         }
         // The cheapest guess first: the last iteration's weight (or a tenth of it).
         let rho0 = if rho_last > 0.0 {
@@ -130,7 +137,7 @@ impl Convexify<'_> {
         } else {
             1.0
         };
-        if test(0.0, rho0) {
+        if self.positive_definite(0.0, rho0, n_fact) {
             return Some((0.0, rho0));
         }
         // δ for the reduced Hessian: the test in the limit ρ_a = rho_max is IPOPT's
@@ -138,12 +145,14 @@ impl Convexify<'_> {
         // i.e. positive definiteness on the null space of the active constraints. A
         // shift of the full-space Hessian (ρ_a = 0) would also pay for curvature across
         // the constraints, which the augmented term supplies for free.
-        let delta = shift_search(&mut |d| test(d, rho_max), true)?;
+        let rho_max = o.max_augmented_weight;
+        let mut test = |d| self.positive_definite(d, rho_max, n_fact);
+        let delta = shift_search(o, delta_last, &mut test, true)?;
         // Then the smallest weight ρ_a (×10 from rho0) that makes B itself positive
         // definite; rho_max passed above.
         let mut rho = if delta == 0.0 { rho0 * 10.0 } else { rho0 };
         while rho < rho_max {
-            if test(delta, rho) {
+            if self.positive_definite(delta, rho, n_fact) {
                 return Some((delta, rho));
             }
             rho *= 10.0;

@@ -7,7 +7,7 @@ use faer::sparse::SymbolicSparseColMat;
 
 use super::geometry::Geometry;
 use super::qp::QpResult;
-use super::state::Shape;
+use super::shape::Shape;
 
 /// Multipliers of the current iterate.
 #[derive(Clone)]

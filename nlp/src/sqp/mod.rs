@@ -33,11 +33,13 @@
 //! is 'S' for an accepted second-order correction, 'f' otherwise.
 
 //!
-//! Layout: `state.rs` (`SqpState`: set-up, stop tests, Hessian convexification,
-//! accepting or rejecting a step), `subproblem.rs` (the QP step with its retry policies
-//! and the elastic mode), `line_search.rs` (merit and line search), `convexify.rs`,
-//! `bfgs.rs`, `iterate.rs` (the iterate and its KKT error), `geometry.rs` (bounds,
-//! cones, violations), `qp.rs` (the clarabel subproblem), `polish.rs`, `stop.rs`;
+//! Layout: `state.rs` (`SqpState`: set-up, stop tests, Hessian convexification),
+//! `subproblem.rs` (the QP step with its retry policies and the elastic mode),
+//! `line_search.rs` (merit and line search), `accept.rs` (accepting or rejecting a step),
+//! `convexify.rs`, `bfgs.rs`, `iterate.rs` (the iterate and its KKT error), `shape.rs`
+//! (sizes and patterns), `geometry.rs` (bounds, cones, violations), `qp.rs` (the
+//! clarabel subproblem), `active_set.rs` (the warm active-set QP), `polish.rs`,
+//! `stop.rs`, `workspace.rs` (what a solver keeps between solves);
 //! `rti.rs`: real-time iterations ([`Rti`]), one iteration per sampling instant split
 //! into a preparation and a feedback, built on the same parts.
 //! Scaling, evaluation counters and the returned `Solution` are the front end's
@@ -45,6 +47,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+mod accept;
 mod active_set;
 mod bfgs;
 mod convexify;
@@ -55,9 +58,11 @@ pub mod options;
 mod polish;
 pub(crate) mod qp;
 pub mod rti;
+mod shape;
 mod state;
 mod stop;
 mod subproblem;
+mod workspace;
 
 use std::time::Instant;
 
@@ -74,13 +79,17 @@ pub use options::{HessianApproximation, SqpOptions};
 pub use rti::{Feedback, Rti, RtiError, RtiResidual};
 use state::SqpState;
 use stop::Stop;
+use workspace::Workspace;
 
 /// The SQP solver: `Sqp::new(opts).solve(&mut nlp)`, the same call shape as
-/// [`Ipm`](crate::Ipm).
+/// [`Ipm`](crate::Ipm). It keeps the KKT matrix (pattern, ordering, symbolic
+/// factorisation) and the QP layouts between solves of problems with the same structure
+/// (see [`Sqp::solve_warm`]); a clone starts without them.
 #[derive(Debug, Clone, Default)]
 pub struct Sqp {
     /// Options.
     pub options: SqpOptions,
+    workspace: Workspace,
 }
 
 impl Solver for Sqp {
@@ -101,7 +110,10 @@ impl Solver for Sqp {
 impl Sqp {
     /// A solver with the given options.
     pub fn new(options: SqpOptions) -> Self {
-        Sqp { options }
+        Sqp {
+            options,
+            workspace: Workspace::default(),
+        }
     }
 }
 
@@ -126,7 +138,7 @@ impl Sqp {
         let v = validate(nlp, warm)?;
         let (n, m) = (nlp.n(), nlp.m());
         let mut observer = callback.map(|cb| Observer::new(cb, n, m, None));
-        let mut s = SqpState::new(o, nlp, v, warm);
+        let mut s = SqpState::new(o, nlp, v, warm, &self.workspace);
         let mut iter = 0usize;
         let stop = match s.setup_kkt() {
             Err(e) => Stop::from(e),
@@ -152,7 +164,14 @@ impl Sqp {
                 "Polished QP solutions: {} of {}",
                 s.work.n_polished, s.work.n_qp
             );
+            let [shape, eq, cycle, limit, penalty] = s.work.active_set_failures;
+            println!(
+                "Active-set QPs: {} solved; handed to clarabel: shape {shape}, equality QP \
+                 {eq}, cycle {cycle}, iteration limit {limit}, penalty {penalty}",
+                s.work.n_active_set
+            );
         }
+        s.keep_parts(&self.workspace);
         Ok(sol)
     }
 }

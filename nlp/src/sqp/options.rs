@@ -198,7 +198,8 @@ impl SqpOptions {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::SqpOptions;
+    use crate::error::SolveError;
 
     #[test]
     fn defaults_validate_and_round_trip() {

@@ -206,27 +206,122 @@ struct ConstraintLayout {
     jrows: Vec<Vec<(usize, usize)>>,
 }
 
+/// The rows of A as they are laid out: their meanings, A's entries as triplets, the next
+/// free elastic column, and the Jacobian's entries by row.
+struct RowsBuilder {
+    rows: Vec<RowKind>,
+    a_trip: Vec<(usize, usize, Src)>,
+    next_e: usize,
+    jrows: Vec<Vec<(usize, usize)>>,
+}
+
+impl RowsBuilder {
+    /// A new row of meaning `kind`; returns its index.
+    fn row(&mut self, kind: RowKind) -> usize {
+        self.rows.push(kind);
+        self.rows.len() - 1
+    }
+
+    /// A new row of meaning `kind` with row i of J times `sign`.
+    fn g_row(&mut self, kind: RowKind, i: usize, sign: f64) -> usize {
+        let r = self.row(kind);
+        for &(c, p) in &self.jrows[i] {
+            self.a_trip.push((r, c, Src::Jac(p, sign)));
+        }
+        r
+    }
+
+    /// A new elastic variable in row r with coefficient `sign`.
+    fn elastic(&mut self, r: usize, sign: f64) {
+        self.a_trip.push((r, self.next_e, Src::Const(sign)));
+        self.next_e += 1;
+    }
+
+    /// A row of variable j's bound: ±d_j.
+    fn bound_row(&mut self, kind: RowKind, j: usize, sign: f64) {
+        let r = self.row(kind);
+        self.a_trip.push((r, j, Src::Const(sign)));
+    }
+
+    /// The zero cone: equality rows (two elastic variables each), fixed variables.
+    fn zero_cone(&mut self, st: &QpStructure) {
+        for i in 0..st.g_l.len() {
+            if !st.skip_rows[i] && st.g_l[i] == st.g_u[i] {
+                let r = self.g_row(RowKind::EqG(i), i, 1.0);
+                self.elastic(r, -1.0);
+                self.elastic(r, 1.0);
+            }
+        }
+        for j in 0..st.x_l.len() {
+            if st.x_l[j] == st.x_u[j] {
+                self.bound_row(RowKind::Fixed(j), j, 1.0);
+            }
+        }
+    }
+
+    /// The inequality sides (one elastic variable each) and bounds of the nonnegative
+    /// cone.
+    fn inequalities(&mut self, st: &QpStructure) {
+        let (g_l, g_u, x_l, x_u) = (st.g_l, st.g_u, st.x_l, st.x_u);
+        for i in 0..g_l.len() {
+            if st.skip_rows[i] || g_l[i] == g_u[i] {
+                continue;
+            }
+            if g_u[i].is_finite() {
+                let r = self.g_row(RowKind::UpperG(i), i, 1.0);
+                self.elastic(r, -1.0);
+            }
+            if g_l[i].is_finite() {
+                let r = self.g_row(RowKind::LowerG(i), i, -1.0);
+                self.elastic(r, -1.0);
+            }
+        }
+        for j in 0..x_l.len() {
+            if x_l[j] == x_u[j] {
+                continue;
+            }
+            if x_u[j].is_finite() {
+                self.bound_row(RowKind::UpperX(j), j, 1.0);
+            }
+            if x_l[j].is_finite() {
+                self.bound_row(RowKind::LowerX(j), j, -1.0);
+            }
+        }
+    }
+
+    /// Second-order cones: s = [t; v] + J_c d + [e_c; 0] ∈ SOC, i.e. A = −J_c,
+    /// b = [t; v]; `cone_e`: the elastic column of each cone (on its t entry).
+    fn second_order_cones(&mut self, st: &QpStructure, cone_e: &[usize]) {
+        let Some(cj) = st.cone_jac else {
+            return;
+        };
+        let mut crows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); cj.nrows()];
+        for c in 0..st.x_l.len() {
+            for p in cj.col_range(c) {
+                crows[cj.row_idx()[p]].push((c, p));
+            }
+        }
+        for (k, &(off, dim)) in st.cone_blocks.iter().enumerate() {
+            for q in 0..dim {
+                let r = self.row(RowKind::Cone(off + q));
+                for &(c, p) in &crows[off + q] {
+                    self.a_trip.push((r, c, Src::ConeJac(p, -1.0)));
+                }
+                if q == 0 {
+                    self.a_trip.push((r, cone_e[k], Src::Const(-1.0)));
+                }
+            }
+        }
+    }
+}
+
 /// Lays out A: equality rows (two elastic variables each) and fixed variables in the zero
 /// cone; inequality sides (one elastic variable each), bounds and elastic
 /// non-negativity in the nonnegative cone; then one second-order cone per affine cone
 /// (with one elastic variable on its t entry). Rows in `skip_rows` (replaced by cones)
 /// are left out.
 fn constraint_layout(st: &QpStructure) -> ConstraintLayout {
-    let QpStructure {
-        jac,
-        x_l,
-        x_u,
-        g_l,
-        g_u,
-        cone_blocks,
-        cone_jac,
-        skip_rows,
-    } = *st;
-    let n = x_l.len();
-    let m = g_l.len();
-    let mut rows = Vec::new();
-    let mut next_e = n;
-    let mut a_trip: Vec<(usize, usize, Src)> = Vec::new();
+    let (n, m, jac) = (st.x_l.len(), st.g_l.len(), st.jac);
     // Rows of g by column: collect J entries per row once.
     let mut jrows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
     for c in 0..n {
@@ -234,101 +329,25 @@ fn constraint_layout(st: &QpStructure) -> ConstraintLayout {
             jrows[jac.row_idx()[p]].push((c, p));
         }
     }
-    let push_g_row = |rows: &mut Vec<RowKind>,
-                      kind: RowKind,
-                      i: usize,
-                      sign: f64,
-                      a: &mut Vec<(usize, usize, Src)>| {
-        let r = rows.len();
-        rows.push(kind);
-        for &(c, p) in &jrows[i] {
-            a.push((r, c, Src::Jac(p, sign)));
-        }
-        r
+    let mut b = RowsBuilder {
+        rows: Vec::new(),
+        a_trip: Vec::new(),
+        next_e: n,
+        jrows,
     };
-    // Zero cone: equality rows (two elastic variables each), fixed variables.
-    for i in 0..m {
-        if skip_rows[i] || g_l[i] != g_u[i] {
-            continue;
-        }
-        let r = push_g_row(&mut rows, RowKind::EqG(i), i, 1.0, &mut a_trip);
-        a_trip.push((r, next_e, Src::Const(-1.0)));
-        a_trip.push((r, next_e + 1, Src::Const(1.0)));
-        next_e += 2;
-    }
-    for j in 0..n {
-        if x_l[j] == x_u[j] {
-            let r = rows.len();
-            rows.push(RowKind::Fixed(j));
-            a_trip.push((r, j, Src::Const(1.0)));
-        }
-    }
-    let n_zero = rows.len();
-    // Nonnegative cone.
-    for i in 0..m {
-        if skip_rows[i] || g_l[i] == g_u[i] {
-            continue;
-        }
-        if g_u[i].is_finite() {
-            let r = push_g_row(&mut rows, RowKind::UpperG(i), i, 1.0, &mut a_trip);
-            a_trip.push((r, next_e, Src::Const(-1.0)));
-            next_e += 1;
-        }
-        if g_l[i].is_finite() {
-            let r = push_g_row(&mut rows, RowKind::LowerG(i), i, -1.0, &mut a_trip);
-            a_trip.push((r, next_e, Src::Const(-1.0)));
-            next_e += 1;
-        }
-    }
-    for j in 0..n {
-        if x_l[j] == x_u[j] {
-            continue;
-        }
-        if x_u[j].is_finite() {
-            let r = rows.len();
-            rows.push(RowKind::UpperX(j));
-            a_trip.push((r, j, Src::Const(1.0)));
-        }
-        if x_l[j].is_finite() {
-            let r = rows.len();
-            rows.push(RowKind::LowerX(j));
-            a_trip.push((r, j, Src::Const(-1.0)));
-        }
-    }
+    b.zero_cone(st);
+    let n_zero = b.rows.len();
+    b.inequalities(st);
     // Cone elastic variables (one per cone, on its t entry) are allocated now so that
     // their non-negativity rows sit in the nonnegative block.
-    let cone_e: Vec<usize> = (0..cone_blocks.len()).map(|k| next_e + k).collect();
-    next_e += cone_blocks.len();
-    for col in n..next_e {
-        let r = rows.len();
-        rows.push(RowKind::Elastic);
-        a_trip.push((r, col, Src::Const(-1.0)));
+    let cone_e: Vec<usize> = (0..st.cone_blocks.len()).map(|k| b.next_e + k).collect();
+    b.next_e += st.cone_blocks.len();
+    for col in n..b.next_e {
+        b.bound_row(RowKind::Elastic, col, -1.0);
     }
-    let n_nonneg = rows.len() - n_zero;
-    // Second-order cones: s = [t; v] + J_c d + [e_c; 0] ∈ SOC, i.e. A = −J_c, b = [t; v].
-    let mut cone_row0 = Vec::new();
-    if let Some(cj) = cone_jac {
-        let mut crows: Vec<Vec<(usize, usize)>> = vec![Vec::new(); cj.nrows()];
-        for c in 0..n {
-            for p in cj.col_range(c) {
-                crows[cj.row_idx()[p]].push((c, p));
-            }
-        }
-        for (k, &(off, dim)) in cone_blocks.iter().enumerate() {
-            cone_row0.push(rows.len());
-            for q in 0..dim {
-                let r = rows.len();
-                rows.push(RowKind::Cone(off + q));
-                for &(c, p) in &crows[off + q] {
-                    a_trip.push((r, c, Src::ConeJac(p, -1.0)));
-                }
-                if q == 0 {
-                    a_trip.push((r, cone_e[k], Src::Const(-1.0)));
-                }
-            }
-        }
-    }
-    let n_e = next_e - n;
+    let n_nonneg = b.rows.len() - n_zero;
+    b.second_order_cones(st, &cone_e);
+    let n_e = b.next_e - n;
     let mut cones = Vec::new();
     if n_zero > 0 {
         cones.push(SupportedConeT::ZeroConeT(n_zero));
@@ -336,18 +355,18 @@ fn constraint_layout(st: &QpStructure) -> ConstraintLayout {
     if n_nonneg > 0 {
         cones.push(SupportedConeT::NonnegativeConeT(n_nonneg));
     }
-    for &(_, dim) in cone_blocks {
+    for &(_, dim) in st.cone_blocks {
         cones.push(SupportedConeT::SecondOrderConeT(dim));
     }
-    let (a_colptr, a_rowval, a_src) = to_csc(n + n_e, a_trip);
+    let (a_colptr, a_rowval, a_src) = to_csc(n + n_e, b.a_trip);
     ConstraintLayout {
-        rows,
+        rows: b.rows,
         n_e,
         cones,
         a_colptr,
         a_rowval,
         a_src,
-        jrows,
+        jrows: b.jrows,
     }
 }
 
@@ -361,22 +380,20 @@ struct PLayout {
     jtj: Vec<(usize, usize, usize, usize)>,
 }
 
-/// Lays out P for n variables and `ncols` QP columns (`jrows`: the Jacobian's entries by
-/// row, for the augmented term; `dense`: a full upper triangle for BFGS).
-fn p_layout(
+/// The entries (column, row), row ≤ column, of P's upper triangle, sorted: B's
+/// (transpose of the lower Hessian pattern, or a full triangle for BFGS) with the
+/// diagonal, plus (augmented-Lagrangian convexification) the pattern of JᵀJ, so that
+/// P = H + δI + ρ_a·(J_AᵀJ_A + I_b) is exactly the matrix `Convexify` certified positive
+/// definite. The pattern of JᵀJ over all rows contains that of any active subset, so it
+/// is fixed.
+fn p_pattern(
     hess: &SymbolicSparseColMat<usize>,
     jrows: &[Vec<(usize, usize)>],
     n: usize,
-    ncols: usize,
     aug: bool,
     dense: bool,
-) -> PLayout {
-    // ---- P: upper triangle of B (transpose of the lower Hessian pattern) + diagonal,
-    // plus (augmented-Lagrangian convexification) the pattern of JᵀJ, so that
-    // P = H + δI + ρ_a·(J_AᵀJ_A + I_b) is exactly the matrix `Convexify` certified
-    // positive definite. The pattern of JᵀJ over all rows contains that of any active
-    // subset, so it is fixed. ----
-    let mut pat: Vec<(usize, usize)> = Vec::new(); // (col, row), row ≤ col
+) -> Vec<(usize, usize)> {
+    let mut pat: Vec<(usize, usize)> = Vec::new();
     if dense {
         for j in 0..n {
             for i in 0..=j {
@@ -403,6 +420,20 @@ fn p_layout(
     }
     pat.sort_unstable();
     pat.dedup();
+    pat
+}
+
+/// Lays out P for n variables and `ncols` QP columns (`jrows`: the Jacobian's entries by
+/// row, for the augmented term; `dense`: a full upper triangle for BFGS).
+fn p_layout(
+    hess: &SymbolicSparseColMat<usize>,
+    jrows: &[Vec<(usize, usize)>],
+    n: usize,
+    ncols: usize,
+    aug: bool,
+    dense: bool,
+) -> PLayout {
+    let pat = p_pattern(hess, jrows, n, aug, dense);
     let mut p_colptr = vec![0usize; ncols + 1];
     for &(c, _) in &pat {
         p_colptr[c + 1] += 1;
@@ -494,6 +525,16 @@ impl Qp {
             jac_copy: Vec::new(),
             weight_copy: vec![0.0; m],
         }
+    }
+
+    /// Forgets the clarabel solver (its equilibration is that of earlier values) and
+    /// takes new limits: the state of a new QP of this layout, for another solve of a
+    /// problem with the same structure (`workspace.rs`).
+    pub fn reset(&mut self, tol: f64, max_iter: u32) {
+        self.solver = None;
+        self.stale = false;
+        self.tol = tol;
+        self.max_iter = max_iter;
     }
 
     /// Number of elastic variables.

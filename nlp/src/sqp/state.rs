@@ -1,24 +1,22 @@
 //! The state of one SQP solve ([`SqpState`]) — problem shape, geometry, the iterate, the
 //! Hessian's convexification, the QP, the penalty and the counters — with its set-up and
-//! the steps of an iteration that are not the QP (`subproblem.rs`) or the line search
-//! (`line_search.rs`): the stop tests, the convexified Hessian, rejecting or accepting a
-//! step.
+//! the steps of an iteration that are not the QP (`subproblem.rs`), the line search
+//! (`line_search.rs`) or accepting and rejecting its step (`accept.rs`): the stop tests
+//! and the convexified Hessian.
 
 #![allow(clippy::needless_range_loop)]
 
 use std::time::Instant;
 
-use faer::sparse::SymbolicSparseColMat;
-
-use super::bfgs::bfgs_update;
 use super::convexify::{active_sets, Convexify};
 use super::geometry::Geometry;
 use super::iterate::{Iterate, Mult};
-use super::line_search::{LineSearch, Trial};
 use super::options::{HessianApproximation, SqpOptions};
 use super::polish::WorkingSet;
-use super::qp::{Qp, QpResult, QpStructure};
+use super::qp::{Qp, QpStructure};
+use super::shape::Shape;
 use super::stop::{StepError, Stop};
+use super::workspace::{Structure, Workspace};
 use crate::callback::Observer;
 use crate::frontend::scaled::ScaledNlp;
 use crate::frontend::user_solution::{user_solution, ConeDuals, UserPoint};
@@ -28,22 +26,6 @@ use crate::kkt::Kkt;
 use crate::numeric::NumericNlp;
 use crate::scaling::gradient_scale;
 use crate::solution::{IterationRecord, Solution, Stats, Status};
-
-/// Sizes and sparsity patterns of the problem, fixed for the solve.
-pub(super) struct Shape {
-    pub n: usize,
-    pub m: usize,
-    /// Length of the stacked cone vector.
-    pub n_cone: usize,
-    pub jp: SymbolicSparseColMat<usize>,
-    pub hp: SymbolicSparseColMat<usize>,
-    /// Pattern of the cone Jacobian (rows: stacked cone entries).
-    pub cp: Option<SymbolicSparseColMat<usize>>,
-    /// (offset, dimension) of each cone in the stacked cone vector.
-    pub block: Vec<(usize, usize)>,
-    /// Dense damped BFGS instead of the exact Hessian.
-    pub dense: bool,
-}
 
 /// The Hessian term B of the QP and how it was convexified.
 pub(super) struct Curvature {
@@ -72,6 +54,10 @@ pub(super) struct Work {
     pub n_polished: usize,
     /// QPs solved by the active-set method (the others by clarabel).
     pub n_active_set: usize,
+    /// QPs the active-set method handed to clarabel, by reason: the shape, a singular
+    /// or non-convex equality QP, a cycle, the iteration limit, multipliers above every
+    /// allowed ρ (printed at `print_level` ≥ 3).
+    pub active_set_failures: [usize; 5],
 }
 
 /// Everything one SQP solve carries from iteration to iteration.
@@ -87,6 +73,11 @@ pub(super) struct SqpState<'a> {
     /// KKT matrix for the convexity test and polishing (`None` with BFGS).
     pub kkt: Option<Kkt>,
     pub qp: Qp,
+    /// The QP of the other kind (with the augmented term when `qp` has none, and the
+    /// reverse), when there is one: kept for the next solve.
+    pub spare_qp: Option<Qp>,
+    /// The structure the kept parts of the workspace were built for (handed back to it).
+    pub kept_structure: Option<Structure>,
     /// The working set of the last QP the active-set method solved (its warm start).
     pub working_set: Option<WorkingSet>,
     /// ℓ1 penalty ρ.
@@ -153,70 +144,83 @@ pub(super) fn new_qp(shape: &Shape, geo: &Geometry, o: &SqpOptions, aug: bool) -
     Qp::new(&shape.hp, &st, aug, shape.dense, o.qp_tol, o.qp_max_iter)
 }
 
-impl<'a> SqpState<'a> {
-    /// Lays out the solve, scales the problem at the (clamped) starting point and
-    /// evaluates it there; `warm` supplies the first multipliers.
-    pub fn new(
-        o: &'a SqpOptions,
-        nlp: &'a mut dyn NumericNlp,
-        v: Validated,
-        warm: Option<&Solution>,
-    ) -> Self {
-        let (n, m) = (nlp.n(), nlp.m());
-        let cones = nlp.affine_cones().to_vec();
-        let n_cone = cones.iter().map(|c| c.offset + c.dim).max().unwrap_or(0);
-        let mut cone_row = vec![false; m];
-        for c in &cones {
-            cone_row[c.row] = true;
+/// The shape and the geometry (unscaled bounds, cones) of `nlp` with the validated
+/// bounds `v`.
+fn layout(nlp: &dyn NumericNlp, v: &Validated, o: &SqpOptions) -> (Shape, Geometry) {
+    let (n, m) = (nlp.n(), nlp.m());
+    let cones = nlp.affine_cones().to_vec();
+    let n_cone = cones.iter().map(|c| c.offset + c.dim).max().unwrap_or(0);
+    let mut cone_row = vec![false; m];
+    for c in &cones {
+        cone_row[c.row] = true;
+    }
+    let shape = Shape {
+        n,
+        m,
+        n_cone,
+        jp: nlp.jac_g_sparsity().clone(),
+        hp: nlp.hess_l_sparsity().clone(),
+        cp: nlp.cone_jac_sparsity().cloned(),
+        block: cones.iter().map(|c| (c.offset, c.dim)).collect(),
+        dense: o.hessian_approximation == HessianApproximation::DampedBfgs,
+    };
+    let geo = Geometry {
+        x_l: v.x_l.clone(),
+        x_u: v.x_u.clone(),
+        g_l: v.g_l.clone(),
+        g_u: v.g_u.clone(),
+        cone_row,
+        cones,
+    };
+    (shape, geo)
+}
+
+/// The first iterate: the scaled problem evaluated at `x`, with the multipliers of
+/// `warm` (scaled) or zeros.
+fn first_iterate(
+    sc: &mut ScaledNlp<'_>,
+    shape: &Shape,
+    x: Vec<f64>,
+    warm: Option<&Solution>,
+) -> Iterate {
+    let (n, m) = (shape.n, shape.m);
+    let mut grad = vec![0.0; n];
+    let mut jv = vec![0.0; shape.jp.row_idx().len()];
+    let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
+    let mut g = vec![0.0; m];
+    let mut cone = vec![0.0; shape.n_cone];
+    let f = sc.f(&x);
+    eval_g(sc, &x, &mut g, &mut cone);
+    sc.grad(&x, &mut grad);
+    eval_jac(sc, &x, &mut jv, &mut cv);
+    let mut mult = Mult::zeros(n, m, shape.n_cone);
+    if let Some(p) = warm {
+        for i in 0..m {
+            mult.lambda[i] = sc.scaling.lambda_from_user(i, p.lambda[i]);
         }
-        let shape = Shape {
-            n,
-            m,
-            n_cone,
-            jp: nlp.jac_g_sparsity().clone(),
-            hp: nlp.hess_l_sparsity().clone(),
-            cp: nlp.cone_jac_sparsity().cloned(),
-            block: cones.iter().map(|c| (c.offset, c.dim)).collect(),
-            dense: o.hessian_approximation == HessianApproximation::DampedBfgs,
-        };
-        let mut geo = Geometry {
-            x_l: v.x_l.clone(),
-            x_u: v.x_u.clone(),
-            g_l: v.g_l.clone(),
-            g_u: v.g_u.clone(),
-            cone_row,
-            cones,
-        };
-        let mut x = v.x0.clone();
         for j in 0..n {
-            x[j] = x[j].clamp(geo.x_l[j], geo.x_u[j]);
+            mult.z_l[j] = sc.scaling.z_from_user(p.z_l[j]);
+            mult.z_u[j] = sc.scaling.z_from_user(p.z_u[j]);
         }
-        let mut sc = ScaledNlp::new(nlp);
-        let mut grad = vec![0.0; n];
-        let mut jv = vec![0.0; shape.jp.row_idx().len()];
-        let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
-        scale(&mut sc, &mut geo, &x, o);
-        let stats = Stats {
-            obj_scaling: sc.scaling.obj,
-            ..Stats::default()
-        };
-        let mut g = vec![0.0; m];
-        let mut cone = vec![0.0; n_cone];
-        let f = sc.f(&x);
-        eval_g(&mut sc, &x, &mut g, &mut cone);
-        sc.grad(&x, &mut grad);
-        eval_jac(&mut sc, &x, &mut jv, &mut cv);
-        let mut mult = Mult::zeros(n, m, n_cone);
-        if let Some(p) = warm {
-            for i in 0..m {
-                mult.lambda[i] = sc.scaling.lambda_from_user(i, p.lambda[i]);
-            }
-            for j in 0..n {
-                mult.z_l[j] = sc.scaling.z_from_user(p.z_l[j]);
-                mult.z_u[j] = sc.scaling.z_from_user(p.z_u[j]);
-            }
-        }
-        let curv = Curvature {
+    }
+    Iterate {
+        x,
+        f,
+        g,
+        cone,
+        grad,
+        jv,
+        cv,
+        mult,
+        have_mult: warm.is_some(),
+    }
+}
+
+impl Curvature {
+    /// No curvature yet: B = I for BFGS, no weights, no shifts.
+    fn new(shape: &Shape) -> Curvature {
+        let n = shape.n;
+        Curvature {
             hv: vec![0.0; shape.hp.row_idx().len()],
             bfgs: if shape.dense {
                 (0..n * n)
@@ -225,64 +229,88 @@ impl<'a> SqpState<'a> {
             } else {
                 vec![]
             },
-            row_weight: vec![0.0; m],
+            row_weight: vec![0.0; shape.m],
             bound_weight: vec![0.0; n],
             rho_a_last: 0.0,
             delta_last: 0.0,
             extra_shift: 0.0,
+        }
+    }
+}
+
+/// The log row of the starting point (objective `objective` in the user's units).
+fn first_record(objective: f64) -> IterationRecord {
+    IterationRecord {
+        iter: 0,
+        restoration: false,
+        objective,
+        inf_pr: 0.0,
+        inf_du: 0.0,
+        mu: 0.0,
+        d_norm: 0.0,
+        regularization: 0.0,
+        jacobian_regularization: 0.0,
+        augmented_weight: 0.0,
+        alpha_du: 0.0,
+        alpha_pr: 0.0,
+        alpha_pr_char: ' ',
+        ls: 0,
+    }
+}
+
+impl<'a> SqpState<'a> {
+    /// Lays out the solve (with the KKT matrix and QPs the workspace `ws` kept for this
+    /// structure), scales the problem at the (clamped) starting point and evaluates it
+    /// there; `warm` supplies the first multipliers.
+    pub fn new(
+        o: &'a SqpOptions,
+        nlp: &'a mut dyn NumericNlp,
+        v: Validated,
+        warm: Option<&Solution>,
+        ws: &Workspace,
+    ) -> Self {
+        let (shape, mut geo) = layout(nlp, &v, o);
+        let x: Vec<f64> = (0..shape.n)
+            .map(|j| v.x0[j].clamp(geo.x_l[j], geo.x_u[j]))
+            .collect();
+        let mut sc = ScaledNlp::new(nlp);
+        scale(&mut sc, &mut geo, &x, o);
+        let stats = Stats {
+            obj_scaling: sc.scaling.obj,
+            ..Stats::default()
         };
-        let record = IterationRecord {
-            iter: 0,
-            restoration: false,
-            objective: sc.scaling.objective_to_user(f),
-            inf_pr: 0.0,
-            inf_du: 0.0,
-            mu: 0.0,
-            d_norm: 0.0,
-            regularization: 0.0,
-            jacobian_regularization: 0.0,
-            augmented_weight: 0.0,
-            alpha_du: 0.0,
-            alpha_pr: 0.0,
-            alpha_pr_char: ' ',
-            ls: 0,
-        };
-        let qp = new_qp(&shape, &geo, o, false);
+        let it = first_iterate(&mut sc, &shape, x, warm);
+        let record = first_record(sc.scaling.objective_to_user(it.f));
+        let kept = ws.take(&shape, &geo, (o.qp_tol, o.qp_max_iter));
+        let qp = kept.plain.unwrap_or_else(|| new_qp(&shape, &geo, o, false));
         SqpState {
             o,
             sc,
             user: v,
-            it: Iterate {
-                x,
-                f,
-                g,
-                cone,
-                grad,
-                jv,
-                cv,
-                mult,
-                have_mult: warm.is_some(),
-            },
-            curv,
-            kkt: None,
+            it,
+            curv: Curvature::new(&shape),
+            kkt: kept.kkt,
             qp,
+            spare_qp: kept.aug,
+            kept_structure: kept.structure,
             working_set: None,
             rho: o.penalty_init,
-            merit_w: vec![0.0; m],
+            merit_w: vec![0.0; shape.m],
             work: Work::default(),
             stats,
             record,
             ls_failures: 0,
-            lgrad: vec![0.0; n],
+            lgrad: vec![0.0; shape.n],
             shape,
             geo,
         }
     }
 
-    /// Sets up the KKT matrix of the convexity test (not with BFGS).
+    /// Sets up the KKT matrix of the convexity test (not with BFGS) unless the workspace
+    /// kept one.
     pub fn setup_kkt(&mut self) -> Result<(), StepError> {
         let s = &self.shape;
-        if !s.dense {
+        if !s.dense && self.kkt.is_none() {
             self.kkt = Some(Kkt::new(s.n, s.m, &s.hp, &s.jp)?);
         }
         Ok(())
@@ -403,82 +431,27 @@ impl<'a> SqpState<'a> {
             *w = if a { rho_a } else { 0.0 };
         }
         if rho_a > 0.0 && !self.qp.has_aug() {
-            self.qp = new_qp(&self.shape, geo, self.o, true);
+            // The spare QP is the augmented one when there is one (kept from an earlier
+            // solve); the plain one becomes the spare.
+            let aug = self
+                .spare_qp
+                .take()
+                .unwrap_or_else(|| new_qp(&self.shape, geo, self.o, true));
+            self.spare_qp = Some(std::mem::replace(&mut self.qp, aug));
         }
         curv.delta_last = delta_inertia;
         Ok(delta_inertia.max(curv.extra_shift))
     }
 
-    /// After a failed line search: stops when the step is negligible or the searches keep
-    /// failing, otherwise shifts the next Hessian and keeps the QP's multipliers.
-    pub fn reject(&mut self, ls: &LineSearch, res: &QpResult, delta: f64) -> Option<Stop> {
-        self.ls_failures += 1;
-        let x = &self.it.x;
-        let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if ls.d_norm <= 1e-14 * (1.0 + x_max) || self.ls_failures > 8 {
-            let it = &self.it;
-            let pr = self.geo.unscaled_max(&self.sc, x, &it.g, &it.cone);
-            let status = if pr > self.o.constr_viol_tol {
-                Status::InfeasibleProblemDetected
-            } else {
-                Status::SearchDirectionBecomesTooSmall
-            };
-            let (pred, d_norm) = (ls.pred, ls.d_norm);
-            return Some(Stop {
-                status,
-                message: format!("line search failed (pred = {pred:.3e}, ‖d‖ = {d_norm:.3e})"),
-            });
-        }
-        // Shorter, more conservative steps next time (a trust-region-like reaction).
-        let c = &mut self.curv;
-        c.extra_shift = (c.extra_shift * 10.0).max(1e-2 * (1.0 + delta));
-        // Multipliers of the QP are still the best estimate.
-        self.it.mult = Mult::from_qp(res);
-        self.it.have_mult = true;
-        None
-    }
-
-    /// Takes the accepted trial point: adapts the proximal shift to the step length,
-    /// evaluates the derivatives there and updates a BFGS matrix.
-    pub fn accept(&mut self, trial: Trial, ls: &LineSearch) -> Result<(), StepError> {
-        self.ls_failures = 0;
-        // Levenberg–Marquardt-like safeguard: a heavily cut step means the model is
-        // poor at this length, so the next step is shortened by a proximal shift
-        // (×10 while the cuts go on); a full step releases it at once. A gradual release
-        // (÷10 per full step) kept the steps short for several iterations after a
-        // single cut; with the inertia's shift no longer inheriting it (`convexify`)
-        // that gradual release made hs116 fail, the immediate one solves it.
-        let c = &mut self.curv;
-        if ls.alpha < 0.1 && !ls.soc_used {
-            c.extra_shift = (c.extra_shift * 10.0).max(1e-1);
-        } else if ls.alpha == 1.0 {
-            c.extra_shift = 0.0;
-        }
-        let (it, shape, cone_row) = (&mut self.it, &self.shape, &self.geo.cone_row);
-        let x_old = std::mem::replace(&mut it.x, trial.x);
-        it.f = trial.f;
-        it.g = trial.g;
-        it.cone = trial.cone;
-        it.mult = Mult::from_qp(&trial.res);
-        it.have_mult = true;
-        // ∇L at the old point with the new multipliers (BFGS only).
-        let mut l_old = vec![0.0; if shape.dense { shape.n } else { 0 }];
-        if shape.dense {
-            it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_old);
-        }
-        self.sc.grad(&it.x, &mut it.grad);
-        eval_jac(&mut self.sc, &it.x, &mut it.jv, &mut it.cv);
-        if it.grad.iter().chain(&it.jv).any(|v| !v.is_finite()) {
-            return Err(StepError::NonFiniteDerivatives);
-        }
-        if shape.dense {
-            let mut l_new = vec![0.0; shape.n];
-            it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_new);
-            let s: Vec<f64> = it.x.iter().zip(&x_old).map(|(a, b)| a - b).collect();
-            let y: Vec<f64> = l_new.iter().zip(&l_old).map(|(a, b)| a - b).collect();
-            bfgs_update(&mut self.curv.bfgs, &s, &y);
-        }
-        Ok(())
+    /// Hands the KKT matrix and the QPs to the workspace for the next solve.
+    pub fn keep_parts(self, ws: &Workspace) {
+        let (shape, geo) = (&self.shape, &self.geo);
+        ws.keep(
+            (shape, geo),
+            self.kept_structure,
+            self.kkt,
+            [Some(self.qp), self.spare_qp],
+        );
     }
 
     /// The solution in the user's units at the iterate, ending with `stop`.

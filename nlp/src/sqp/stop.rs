@@ -73,7 +73,10 @@ impl From<StepError> for Stop {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{StepError, Stop};
+    use crate::kkt::KktError;
+    use crate::solution::Status;
+    use clarabel::solver::SolverStatus;
 
     #[test]
     fn a_kkt_setup_failure_names_its_cause() {

@@ -64,7 +64,13 @@ impl SqpState<'_> {
             false,
         );
         self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
-        let solved = solved.ok()?;
+        let solved = match solved {
+            Ok(s) => s,
+            Err(f) => {
+                self.work.active_set_failures[f as usize] += 1;
+                return None;
+            }
+        };
         // ρ as the elastic mode would raise it (not in a second-order correction, whose
         // merit is that of the step's ρ).
         let increases = if may_raise_penalty {
@@ -73,7 +79,10 @@ impl SqpState<'_> {
             0
         };
         let limits = (o.penalty_increase, increases, o.penalty_max);
-        let rho = active_set::penalty_for(solved.max_multiplier, self.rho, limits)?;
+        let Some(rho) = active_set::penalty_for(solved.max_multiplier, self.rho, limits) else {
+            self.work.active_set_failures[4] += 1;
+            return None;
+        };
         self.rho = rho;
         self.work.n_qp += 1;
         self.work.n_active_set += 1;
@@ -125,21 +134,41 @@ impl SqpState<'_> {
             self.work.factor_seconds += t_qp_loop.elapsed().as_secs_f64();
             return Ok((res, delta));
         }
+        let found = self.clarabel_qp(delta);
+        self.work.factor_seconds += t_qp_loop.elapsed().as_secs_f64();
+        let (res, qp_shift) = found?;
+        // Polish: the exact solution of the equality QP on clarabel's active set (not
+        // with cones or elastic variables in use).
+        let dense = self.shape.dense;
+        let data = qp_data(&self.it, &self.geo, &self.curv, dense, qp_shift, self.rho);
+        let can_polish = o.qp_polish && !dense && self.shape.n_cone == 0;
+        let res = polished(
+            self.kkt.as_mut().filter(|_| can_polish),
+            o,
+            (&data, &self.shape.jp, &self.shape.hp),
+            res,
+            &mut self.work.n_fact,
+            &mut self.work.n_polished,
+        );
+        Ok((res, qp_shift))
+    }
+
+    /// The elastic QP solved by clarabel from shift `delta` on, with the retry policies
+    /// and the elastic mode of the module documentation: the accepted result and the
+    /// shift it was solved with (the curvature's weights and ρ as they were for it).
+    fn clarabel_qp(&mut self, delta: f64) -> Result<(QpResult, f64), StepError> {
+        let o = self.o;
         let dense = self.shape.dense;
         let mut qp_shift = delta;
         let (mut unbounded_retries, mut failed_retries, mut penalty_increases) = (0, 0, 0);
         let mut elastic_prev: Option<(QpResult, f64, f64)> = None;
-        // The accepted QP's result and the data it was solved with (for polishing).
-        let found: Result<(QpResult, QpData), StepError> = loop {
+        loop {
             let data = qp_data(&self.it, &self.geo, &self.curv, dense, qp_shift, self.rho);
             let t_qp = Instant::now();
             let res = self.qp.solve(&data);
             self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
             self.work.n_qp += 1;
-            let res = match res {
-                Ok(r) => r,
-                Err(e) => break Err(e.into()),
-            };
+            let res = res?;
             self.work.qp_iterations += res.iterations as u64;
             match res.status {
                 S::Solved | S::AlmostSolved => {}
@@ -161,7 +190,7 @@ impl SqpState<'_> {
                     qp_shift = (qp_shift * 10.0).max(o.first_hessian_shift);
                     continue;
                 }
-                st => break Err(StepError::QpStatus(st)),
+                st => return Err(StepError::QpStatus(st)),
             }
             let e_max = res.e.iter().fold(0.0f64, |a, v| a.max(*v));
             let e_sum: f64 = res.e.iter().map(|v| v.max(0.0)).sum();
@@ -174,7 +203,7 @@ impl SqpState<'_> {
                     if e_sum > 0.9 * prev_sum {
                         let (prev, _, prev_rho) = elastic_prev.take().expect("checked");
                         self.rho = prev_rho;
-                        break Ok((prev, data));
+                        return Ok((prev, qp_shift));
                     }
                 }
                 if self.rho < o.penalty_max && penalty_increases < MAX_PENALTY_INCREASES {
@@ -184,22 +213,8 @@ impl SqpState<'_> {
                     continue;
                 }
             }
-            break Ok((res, data));
-        };
-        self.work.factor_seconds += t_qp_loop.elapsed().as_secs_f64();
-        let (res, data) = found?;
-        // Polish: the exact solution of the equality QP on clarabel's active set (not
-        // with cones or elastic variables in use).
-        let can_polish = o.qp_polish && !dense && self.shape.n_cone == 0;
-        let res = polished(
-            self.kkt.as_mut().filter(|_| can_polish),
-            o,
-            (&data, &self.shape.jp, &self.shape.hp),
-            res,
-            &mut self.work.n_fact,
-            &mut self.work.n_polished,
-        );
-        Ok((res, qp_shift))
+            return Ok((res, qp_shift));
+        }
     }
 }
 

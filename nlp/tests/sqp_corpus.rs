@@ -1,0 +1,57 @@
+//! The cold SQP against the IPM on the corpus's optimal-control set (issue 19's target:
+//! solved as often as the IPM, total time ≤ 1.5× the IPM's): the smallest instance of
+//! every optimal-control family (`corpus/tests/smallest.rs` checks the IPM there against
+//! IPOPT), both back ends with default options from the instance's own guess. A report,
+//! not an assertion of the target (not met): one JSON line per instance and a total.
+//!
+//! ```text
+//! cargo test --release -p nlp --test sqp_corpus -- --ignored --nocapture
+//! ```
+use std::time::Instant;
+
+use nlp::{Ipm, Solver, Sqp, SqpOptions};
+use testkit::corpus::{self, Kind};
+
+#[test]
+#[ignore = "report (minutes): cargo test --release -p nlp --test sqp_corpus -- --ignored --nocapture"]
+fn cold_ocp_set_sqp_against_ipm() {
+    let max_wall = std::env::var("MAX_WALL")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(60.0);
+    let mut sqp_options = SqpOptions::default();
+    sqp_options.common.max_wall_time = max_wall;
+    let sqp = Sqp::new(sqp_options);
+    let mut ipm = Ipm::default();
+    ipm.options.common.max_wall_time = max_wall;
+    let solvers: [(&str, &dyn Solver); 2] = [("ipm", &ipm), ("sqp", &sqp)];
+    let mut totals = [(0usize, 0.0f64); 2];
+    for family in corpus::families() {
+        if family.kind != Kind::Ocp {
+            continue;
+        }
+        let inst = corpus::Instance {
+            family,
+            size: family.sizes[0],
+        };
+        let mut c = inst.build().unwrap().compile().unwrap();
+        for (k, (name, solver)) in solvers.iter().enumerate() {
+            let t = Instant::now();
+            let sol = solver.solve_dyn(&mut c, None, None).unwrap();
+            let secs = t.elapsed().as_secs_f64();
+            totals[k].0 += usize::from(sol.status.is_success());
+            totals[k].1 += secs;
+            println!(
+                "{{\"instance\":\"{}\",\"solver\":\"{name}\",\"status\":\"{:?}\",\"iterations\":{},\"objective\":{:e},\"seconds\":{secs:.4}}}",
+                inst.name(),
+                sol.status,
+                sol.stats.iterations,
+                sol.objective
+            );
+        }
+    }
+    println!(
+        "total: ipm solved {} in {:.3} s, sqp solved {} in {:.3} s",
+        totals[0].0, totals[0].1, totals[1].0, totals[1].1
+    );
+}
