@@ -164,12 +164,17 @@ pub struct Mpc {
     engine: Engine,
     shift: Shift,
     x0_parameter: String,
+    /// The entries of the initial-state parameter in the parameter vector.
+    x0_entries: std::ops::Range<usize>,
     /// Number of states.
     nx: usize,
     /// Positions of `U[:, 0]` in `x`.
     first_control: Vec<usize>,
     sampling_period: f64,
     previous: Option<Solution>,
+    /// The solution a warm re-solve writes into (then swapped with `previous`): its
+    /// vectors are reused, so that an IPM step allocates nothing in the steady state.
+    next: Solution,
     control: Vec<f64>,
 }
 
@@ -226,6 +231,12 @@ impl Mpc {
             .initial_state_parameter()
             .ok_or(MpcError::NoInitialStateParameter)?
             .to_string();
+        let x0_entries = engine_compiled(&engine)
+            .parameter_blocks()
+            .iter()
+            .find(|b| b.name == x0_parameter)
+            .ok_or(MpcError::NoInitialStateParameter)?
+            .range();
         let t_f = tr.final_time().value().ok_or(MpcError::FreeHorizon)?;
         let u = tr.controls();
         let first_control = if u.nrows() > 0 {
@@ -238,11 +249,13 @@ impl Mpc {
             engine,
             shift: tr.shift_plan()?,
             x0_parameter,
+            x0_entries,
             nx: tr.states().nrows(),
             control: vec![0.0; first_control.len()],
             first_control,
             sampling_period: t_f / tr.intervals() as f64,
             previous: None,
+            next: Solution::empty(),
         })
     }
 
@@ -251,6 +264,10 @@ impl Mpc {
     /// point on the first step. The solution becomes the next step's warm start whatever
     /// its status (the report tells the status). With real-time iterations: prepares (if
     /// [`Mpc::prepare`] has not) and runs the feedback.
+    ///
+    /// A warm step re-solves with [`Solver::solve_warm_into`] into vectors kept from the
+    /// step before and shifts in place: with the [`Ipm`](crate::Ipm), a step that takes no
+    /// more iterations than an earlier one allocates nothing.
     pub fn step(&mut self, x0: &[f64]) -> Result<StepReport, MpcError> {
         let start = Instant::now();
         let nx = self.nx;
@@ -264,17 +281,19 @@ impl Mpc {
         }
         let mut report = match &mut self.engine {
             Engine::Solver { solver, compiled } => {
-                compiled.set_value(self.x0_parameter.as_str(), x0)?;
-                let sol = match self.previous.as_mut() {
+                compiled.set_parameter_range(self.x0_entries.clone(), x0)?;
+                match self.previous.as_mut() {
                     Some(prev) => {
                         self.shift.apply(prev)?;
-                        solver.solve_warm(&mut **compiled, prev)?
+                        solver.solve_warm_into(&mut **compiled, prev, &mut self.next)?;
+                        std::mem::swap(prev, &mut self.next);
+                        solver_report(prev, true)
                     }
-                    None => solver.solve(&mut **compiled)?,
-                };
-                let report = solver_report(&sol, self.previous.is_some());
-                self.previous = Some(sol);
-                report
+                    None => {
+                        let sol = self.previous.insert(solver.solve(&mut **compiled)?);
+                        solver_report(sol, false)
+                    }
+                }
             }
             Engine::Rti { .. } => self.rti_step(x0)?,
         };
@@ -306,7 +325,7 @@ impl Mpc {
                 unreachable!("checked above")
             };
             rti.compiled_mut()
-                .set_value(self.x0_parameter.as_str(), x0)?;
+                .set_parameter_range(self.x0_entries.clone(), x0)?;
             let sol = first.solve(rti.compiled_mut())?;
             rti.initialize(&sol)?;
             *started = true;
@@ -429,6 +448,14 @@ impl Mpc {
             *started = false;
             *prepared = None;
         }
+    }
+}
+
+/// The compiled problem an engine solves.
+fn engine_compiled(engine: &Engine) -> &Compiled {
+    match engine {
+        Engine::Solver { compiled, .. } => compiled,
+        Engine::Rti { rti, .. } => rti.compiled(),
     }
 }
 

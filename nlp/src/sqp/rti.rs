@@ -404,6 +404,11 @@ impl Rti {
         &mut self.compiled
     }
 
+    /// The compiled problem.
+    pub fn compiled(&self) -> &Compiled {
+        &self.compiled
+    }
+
     /// The name of the initial-state parameter.
     pub fn x0_parameter(&self) -> &str {
         &self.x0_parameter
