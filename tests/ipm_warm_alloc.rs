@@ -1,5 +1,5 @@
 //! What an `Ipm` keeps between warm re-solves of the cart-pole MPC
-//! (examples/mpc_cart_pole.rs): the iterates of `Ipm::solve_warm_into` are
+//! (examples/src/mpc_cart_pole.rs): the iterates of `Ipm::solve_warm_into` are
 //! bit-identical to a fresh solver's `solve_warm` at every step of the closed loop, and
 //! once the kept buffers (and the reused `Solution`'s vectors) have grown to the largest
 //! iteration count seen, a re-solve allocates nothing (counted by a counting global
@@ -10,10 +10,7 @@
 //! written out with `Transcription::shift` and `Ipm::solve_warm` (what `Mpc::step` did
 //! before it re-solved into kept vectors), and a step that takes no more iterations
 //! than an earlier one allocates nothing.
-#![allow(dead_code)] // the example's `main` is not called here
-
-#[path = "../examples/mpc_cart_pole.rs"]
-mod mpc_cart_pole;
+use symnlp_examples::mpc_cart_pole;
 
 use symnlp::nlp::mpc::Mpc;
 use symnlp::nlp::ocp::Transcription;

@@ -60,7 +60,9 @@ pub enum MpcError {
 /// What one MPC step did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepReport {
-    /// The solver's status.
+    /// The solver's status; for a real-time iteration
+    /// [`Status::RealTimeIterationTaken`] (its QP solved, its step taken) or
+    /// `ErrorInStepComputation` (no QP method solved its QP).
     pub status: Status,
     /// Solver iterations.
     pub iterations: usize,
@@ -80,6 +82,20 @@ pub struct StepReport {
     /// Whether the solve was warm-started (every step but the first one and the first
     /// one after [`Mpc::reset`]).
     pub warm: bool,
+    /// With real-time iterations, the KKT residual (the largest of
+    /// [`RtiResidual`](crate::sqp::RtiResidual)'s three) of the plan this step linearised
+    /// at, measured by its preparation: how far from converged the iteration is. `None`
+    /// for a solver's step (its status tells).
+    pub residual: Option<f64>,
+}
+
+impl StepReport {
+    /// Whether the step did what it is for: a solver's converged
+    /// ([`Status::is_success`]), a real-time iteration's step was taken
+    /// ([`Status::RealTimeIterationTaken`]).
+    pub fn succeeded(&self) -> bool {
+        self.status.is_success() || self.status == Status::RealTimeIterationTaken
+    }
 }
 
 /// A closed loop run by [`Mpc::run`].
@@ -94,9 +110,10 @@ pub struct ClosedLoop {
 }
 
 impl ClosedLoop {
-    /// Whether every step's status is a success ([`Status::is_success`]).
+    /// Whether every step succeeded ([`StepReport::succeeded`]: a solver's step converged,
+    /// a real-time iteration's step was taken).
     pub fn all_succeeded(&self) -> bool {
-        self.steps.iter().all(|s| s.status.is_success())
+        self.steps.iter().all(StepReport::succeeded)
     }
 
     /// Median and maximum of the steps' wall seconds ([`StepReport::seconds`]); `(0, 0)`
@@ -209,8 +226,9 @@ impl Mpc {
     /// the first step (and the first after [`Mpc::reset`]) is solved to convergence by
     /// `first`, each later one is one preparation ([`Rti::prepare`] at the shifted plan)
     /// and one feedback ([`Rti::feedback`] with the measured state). A step's status is
-    /// the feedback's (`MaximumIterationsExceeded`: one iteration, by design), so judge
-    /// such a loop by its cost, not by [`ClosedLoop::all_succeeded`].
+    /// the feedback's ([`Status::RealTimeIterationTaken`], or `ErrorInStepComputation`
+    /// when its QP failed) and its report carries the KKT residual the preparation
+    /// measured ([`StepReport::residual`]).
     pub fn with_rti(
         tr: &Transcription,
         options: SqpOptions,
@@ -352,6 +370,7 @@ impl Mpc {
             feedback_seconds: fb.seconds,
             objective: rti.plan().objective,
             warm: true,
+            residual: Some(rti.residual().max()),
         })
     }
 
@@ -469,5 +488,6 @@ fn solver_report(sol: &Solution, warm: bool) -> StepReport {
         feedback_seconds: sol.stats.total_seconds,
         objective: sol.objective,
         warm,
+        residual: None,
     }
 }
