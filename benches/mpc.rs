@@ -1,4 +1,4 @@
-//! One warm interior-point re-solve of the cart-pole MPC (examples/mpc_cart_pole.rs,
+//! One warm interior-point re-solve of the cart-pole MPC (examples/src/mpc_cart_pole.rs,
 //! N = 40, 204 variables, 164 rows) after 50 closed-loop steps: the plan shifted and
 //! re-solved warm from the new state — the work of a typical step of the loop.
 //! `mpc_cart_pole_ipm_warm_resolve`: by one `Ipm` across the loop, as `Mpc` does (its KKT
@@ -11,10 +11,7 @@
 //! ```text
 //! cargo bench --bench mpc
 //! ```
-#![allow(dead_code)] // the example's `main` is not called here
-
-#[path = "../examples/mpc_cart_pole.rs"]
-mod mpc_cart_pole;
+use symnlp_examples::mpc_cart_pole;
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};

@@ -11,7 +11,7 @@
 //! - every MPCC case (`mpcc/problems.rs`) through `solve_mpcc` on both back ends, total
 //!   iterations over the phases (`mpcc/<backend>/<name>`);
 //! - the SOCP problems (`socp/problems.rs`) on both back ends (`socp/<backend>/<name>`);
-//! - the race car (examples/race_car.rs, N = 100, IPM) (`race_car/ipm/n100`);
+//! - the race car (examples/src/race_car.rs, N = 100, IPM) (`race_car/ipm/n100`);
 //! - the gap-crossing planner's default scenario (free gait) and its crawl gait, IPM
 //!   (`planner/ipm/free`, `planner/ipm/crawl`).
 //!
@@ -41,9 +41,7 @@ use testkit::mpcc as mpcc_problems;
 use testkit::mpcc_names;
 use testkit::socp as socp_problems;
 
-#[allow(dead_code)] // the example's `main` is not called here
-#[path = "../examples/race_car.rs"]
-mod race_car;
+use symnlp_examples::race_car;
 
 /// Relative tolerance on the objective, relative to max(1, |f|). The iteration count
 /// pins the path; the objective catches an end point that differs at the same count.

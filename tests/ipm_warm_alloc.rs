@@ -1,15 +1,18 @@
 //! What an `Ipm` keeps between warm re-solves of the cart-pole MPC
-//! (examples/mpc_cart_pole.rs): the iterates of `Ipm::solve_warm_into` are
+//! (examples/src/mpc_cart_pole.rs): the iterates of `Ipm::solve_warm_into` are
 //! bit-identical to a fresh solver's `solve_warm` at every step of the closed loop, and
 //! once the kept buffers (and the reused `Solution`'s vectors) have grown to the largest
 //! iteration count seen, a re-solve allocates nothing (counted by a counting global
 //! allocator). The binary has no libtest harness (`harness = false`): the harness's main
 //! thread allocates while a test runs (see symx/tests/map_alloc.rs).
-#![allow(dead_code)] // the example's `main` is not called here
+//!
+//! Then the same through `Mpc::step`: its closed loop is bit-identical to the loop
+//! written out with `Transcription::shift` and `Ipm::solve_warm` (what `Mpc::step` did
+//! before it re-solved into kept vectors), and a step that takes no more iterations
+//! than an earlier one allocates nothing.
+use symnlp_examples::mpc_cart_pole;
 
-#[path = "../examples/mpc_cart_pole.rs"]
-mod mpc_cart_pole;
-
+use symnlp::nlp::mpc::Mpc;
 use symnlp::nlp::ocp::Transcription;
 use symnlp::nlp::{Compiled, Ipm, Solution};
 use testkit::alloc::Counting;
@@ -102,6 +105,58 @@ fn main() {
          allocations per warm re-solve (median): {} kept ({zero_steps} re-solves with 0), {} fresh",
         median(counts.iter().map(|c| c.0).collect()),
         median(counts.iter().map(|c| c.1).collect()),
+    );
+    mpc_steps();
+}
+
+/// `Mpc::step` with the IPM over the closed loop: bit-identical to the loop written out
+/// with a new `Solution` per step, and allocation-free in the steady state.
+fn mpc_steps() {
+    let example = mpc_cart_pole::example();
+    let (tr, mut plant) = example.setup().expect("cart-pole MPC transcription");
+    let mut mpc = Mpc::new(&tr, Box::new(Ipm::default())).expect("controller");
+    // The reference: the step as written before, a fresh `Solution` from `solve_warm`.
+    let mut compiled = tr.compile().expect("compile");
+    let shift = tr.shift_plan().expect("shift plan");
+    let ipm = Ipm::default();
+    let mut reference: Option<Solution> = None;
+    let mut x = example.x_init.clone();
+    let (mut most_iterations, mut zero_steps) = (0, 0);
+    for step in 0..STEPS {
+        let (report, count) = allocations_during(|| mpc.step(&x).expect("MPC step"));
+        compiled.set_value("x0", &x).expect("x0 parameter");
+        let expected = match reference.take() {
+            Some(mut prev) => {
+                shift.apply(&mut prev).expect("shift");
+                ipm.solve_warm(&mut compiled, &prev).expect("warm re-solve")
+            }
+            None => ipm.solve(&mut compiled).expect("first solve"),
+        };
+        assert_identical(mpc.solution().expect("a plan"), &expected, step);
+        assert_eq!(
+            report.status, expected.status,
+            "step {step}: reported status"
+        );
+        let u = first_control(&tr, &expected);
+        assert!(same_bits(mpc.control(), &u), "step {step}: control");
+        // Step 0 solves cold, step 1 is the first into the kept vectors.
+        if step >= 2 && report.iterations <= most_iterations {
+            assert_eq!(count, 0, "step {step}: allocations in Mpc::step");
+            zero_steps += 1;
+        }
+        if step >= 1 {
+            most_iterations = most_iterations.max(report.iterations);
+        }
+        x = plant.step(&x, &u, example.dt).expect("plant");
+        reference = Some(expected);
+    }
+    assert!(
+        zero_steps >= STEPS / 2,
+        "only {zero_steps} allocation-free MPC steps"
+    );
+    println!(
+        "ipm_warm_alloc: {STEPS} Mpc::step steps bit-identical to the written-out loop; \
+         {zero_steps} steady-state steps with 0 allocations"
     );
 }
 

@@ -4,13 +4,7 @@
 //! multiple-shooting examples, whose iterates must be identical (same iteration count, same
 //! solution bits). No tolerance: the JIT performs the tape's operations in the tape's order.
 //! Times are printed for information only (`--nocapture`), never asserted.
-#![allow(dead_code)] // the examples' `main`s are not called here
-
-#[path = "../examples/vdp_multiple_shooting.rs"]
-mod vdp_multiple_shooting;
-
-#[path = "../examples/quadrotor.rs"]
-mod quadrotor;
+use symnlp_examples::{quadrotor, vdp_multiple_shooting};
 
 use std::time::Instant;
 use symnlp::nlp::ocp::{ButcherTableau, Method, Transcription};

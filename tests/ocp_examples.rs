@@ -1,4 +1,4 @@
-//! The optimal-control examples (examples/*.rs built on nlp::ocp) against IPOPT on the
+//! The optimal-control examples (examples/src/*.rs built on nlp::ocp) against IPOPT on the
 //! identical transcriptions: CasADi 3.8.2 + IPOPT 3.14.19 (MUMPS), tol 1e-8, values printed
 //! by `python3 benches/reference/ocp_examples.py` (run 2026-11-25 on this machine; the
 //! script mirrors nlp/src/ocp/transcription.rs variable by variable).
@@ -9,25 +9,9 @@
 //! more, e.g. RK4 M = 4 vs M = 1 changes the Van der Pol cost in the 5th digit).
 //! Measured (2026-11-25): 1e-16…4e-13 relative with the interior point, 2e-8 with the SQP
 //! (its own stopping tolerance), 6e-10 between the race car's two IPOPT formulations.
-#![allow(dead_code)] // the examples' `main`s are not called here
-
-#[path = "../examples/vdp_multiple_shooting.rs"]
-mod vdp_multiple_shooting;
-
-#[path = "../examples/vdp_collocation.rs"]
-mod vdp_collocation;
-
-#[path = "../examples/race_car_ocp.rs"]
-mod race_car_ocp;
-
-#[path = "../examples/cart_pole.rs"]
-mod cart_pole;
-
-#[path = "../examples/quadrotor.rs"]
-mod quadrotor;
-
-#[path = "../examples/two_link_arm.rs"]
-mod two_link_arm;
+use symnlp_examples::{
+    cart_pole, quadrotor, race_car_ocp, two_link_arm, vdp_collocation, vdp_multiple_shooting,
+};
 
 use symnlp::nlp::ocp::{Ocp, Trajectory, Transcription};
 use symnlp::nlp::{Ipm, IpmOptions, Sqp, SqpOptions};
@@ -294,6 +278,8 @@ static GLOBAL: heap::Counting = heap::Counting;
 /// fresh thread (so the thread-local graph starts empty).
 #[derive(Debug)]
 struct Sizes {
+    /// Printed (through `Debug`) for information, not asserted.
+    #[allow(dead_code)]
     nodes_after_transcription: usize,
     nodes_after_compilation: usize,
     peak_heap_bytes: usize,

@@ -1,12 +1,10 @@
-//! CasADi's race-car example (examples/race_car.rs) against CasADi 3.8.2 + IPOPT 3.14.19
+//! CasADi's race-car example (examples/src/race_car.rs) against CasADi 3.8.2 + IPOPT 3.14.19
 //! on the identical formulation (benches/reference/race_car.py, run 2026-11-25 on this
 //! machine): `{"N": 100, "T": 1.9046342722764305, "iterations": 35}` with CasADi's
 //! default Opti formulation, T = 1.9046342735147381 (39 iterations) with
 //! `detect_simple_bounds`, which is the formulation symnlp solves (single-variable rows
 //! become bounds).
-#[allow(dead_code)] // the example's `main` is not called here
-#[path = "../examples/race_car.rs"]
-mod race_car;
+use symnlp_examples::race_car;
 
 use symnlp::nlp::IpmOptions;
 

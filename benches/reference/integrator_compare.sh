@@ -3,7 +3,7 @@
 # twice each (interleaved) on the same machine. Usage: bash benches/reference/integrator_compare.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-cargo build --release --example integrator_compare -q
+cargo build --release -p symnlp-examples --example integrator_compare -q
 for round in 1 2; do
     echo "== round $round: symnlp"
     target/release/examples/integrator_compare

@@ -2,12 +2,12 @@
 identical transcription (ocp_transcription.py mirrors nlp/src/ocp/transcription.rs). The
 problem data here and in the Rust examples must stay in sync:
 
-  vdp_multiple_shooting  examples/vdp_multiple_shooting.rs (CasADi's direct_multiple_shooting.py)
-  vdp_collocation        examples/vdp_collocation.rs (CasADi's direct_collocation.py)
-  race_car               examples/race_car_ocp.rs (CasADi's race_car.py with the Ocp helper)
-  cart_pole              examples/cart_pole.rs
-  quadrotor              examples/quadrotor.rs
-  two_link_arm           examples/two_link_arm.rs
+  vdp_multiple_shooting  examples/src/vdp_multiple_shooting.rs (CasADi's direct_multiple_shooting.py)
+  vdp_collocation        examples/src/vdp_collocation.rs (CasADi's direct_collocation.py)
+  race_car               examples/src/race_car_ocp.rs (CasADi's race_car.py with the Ocp helper)
+  cart_pole              examples/src/cart_pole.rs
+  quadrotor              examples/src/quadrotor.rs
+  two_link_arm           examples/src/two_link_arm.rs
 
 Prints one JSON line per problem; tests/ocp_examples.rs holds the values.
 Usage: python3 benches/reference/ocp_examples.py [name ...]

@@ -1,7 +1,7 @@
 """CasADi's Opti race-car example (casadi/docs/examples/python/race_car.py), unchanged
 formulation: minimum time to drive 1 m with a position-dependent speed limit, RK4 over N
 control intervals. Prints the optimal final time and IPOPT's iteration count as JSON; the
-Rust counterpart is examples/race_car.rs (tested in tests/race_car.rs).
+Rust counterpart is examples/src/race_car.rs (tested in tests/race_car.rs).
 
 Usage: python3 benches/reference/race_car.py [N]
 """

@@ -187,6 +187,34 @@ impl Compiled {
         Ok(())
     }
 
+    /// Sets the parameter entries `range` (a block's, found once through
+    /// [`Compiled::parameter_blocks`]) to `values` without allocating, as an MPC step sets
+    /// the measured state. An error names a wrong length or the first non-finite entry.
+    pub(crate) fn set_parameter_range(
+        &mut self,
+        range: std::ops::Range<usize>,
+        values: &[f64],
+    ) -> Result<(), BuildError> {
+        if values.len() != range.len() {
+            return Err(BuildError::Size {
+                what: "set_value: values".into(),
+                expected: range.len(),
+                got: values.len(),
+            });
+        }
+        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+            return Err(BuildError::NotFinite {
+                what: format!(
+                    "value of parameter '{}'",
+                    self.parameter_index.name(range.start + k)
+                ),
+                value: values[k],
+            });
+        }
+        self.params[range].copy_from_slice(values);
+        Ok(())
+    }
+
     /// Sets all parameter entries at once (`p` as long as [`Compiled::parameter_values`],
     /// finite: checked by the caller).
     pub(crate) fn set_parameter_vector(&mut self, p: &[f64]) {

@@ -60,7 +60,9 @@ pub enum MpcError {
 /// What one MPC step did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepReport {
-    /// The solver's status.
+    /// The solver's status; for a real-time iteration
+    /// [`Status::RealTimeIterationTaken`] (its QP solved, its step taken) or
+    /// `ErrorInStepComputation` (no QP method solved its QP).
     pub status: Status,
     /// Solver iterations.
     pub iterations: usize,
@@ -80,6 +82,20 @@ pub struct StepReport {
     /// Whether the solve was warm-started (every step but the first one and the first
     /// one after [`Mpc::reset`]).
     pub warm: bool,
+    /// With real-time iterations, the KKT residual (the largest of
+    /// [`RtiResidual`](crate::sqp::RtiResidual)'s three) of the plan this step linearised
+    /// at, measured by its preparation: how far from converged the iteration is. `None`
+    /// for a solver's step (its status tells).
+    pub residual: Option<f64>,
+}
+
+impl StepReport {
+    /// Whether the step did what it is for: a solver's converged
+    /// ([`Status::is_success`]), a real-time iteration's step was taken
+    /// ([`Status::RealTimeIterationTaken`]).
+    pub fn succeeded(&self) -> bool {
+        self.status.is_success() || self.status == Status::RealTimeIterationTaken
+    }
 }
 
 /// A closed loop run by [`Mpc::run`].
@@ -94,9 +110,10 @@ pub struct ClosedLoop {
 }
 
 impl ClosedLoop {
-    /// Whether every step's status is a success ([`Status::is_success`]).
+    /// Whether every step succeeded ([`StepReport::succeeded`]: a solver's step converged,
+    /// a real-time iteration's step was taken).
     pub fn all_succeeded(&self) -> bool {
-        self.steps.iter().all(|s| s.status.is_success())
+        self.steps.iter().all(StepReport::succeeded)
     }
 
     /// Median and maximum of the steps' wall seconds ([`StepReport::seconds`]); `(0, 0)`
@@ -164,12 +181,17 @@ pub struct Mpc {
     engine: Engine,
     shift: Shift,
     x0_parameter: String,
+    /// The entries of the initial-state parameter in the parameter vector.
+    x0_entries: std::ops::Range<usize>,
     /// Number of states.
     nx: usize,
     /// Positions of `U[:, 0]` in `x`.
     first_control: Vec<usize>,
     sampling_period: f64,
     previous: Option<Solution>,
+    /// The solution a warm re-solve writes into (then swapped with `previous`): its
+    /// vectors are reused, so that an IPM step allocates nothing in the steady state.
+    next: Solution,
     control: Vec<f64>,
 }
 
@@ -204,8 +226,9 @@ impl Mpc {
     /// the first step (and the first after [`Mpc::reset`]) is solved to convergence by
     /// `first`, each later one is one preparation ([`Rti::prepare`] at the shifted plan)
     /// and one feedback ([`Rti::feedback`] with the measured state). A step's status is
-    /// the feedback's (`MaximumIterationsExceeded`: one iteration, by design), so judge
-    /// such a loop by its cost, not by [`ClosedLoop::all_succeeded`].
+    /// the feedback's ([`Status::RealTimeIterationTaken`], or `ErrorInStepComputation`
+    /// when its QP failed) and its report carries the KKT residual the preparation
+    /// measured ([`StepReport::residual`]).
     pub fn with_rti(
         tr: &Transcription,
         options: SqpOptions,
@@ -226,6 +249,12 @@ impl Mpc {
             .initial_state_parameter()
             .ok_or(MpcError::NoInitialStateParameter)?
             .to_string();
+        let x0_entries = engine_compiled(&engine)
+            .parameter_blocks()
+            .iter()
+            .find(|b| b.name == x0_parameter)
+            .ok_or(MpcError::NoInitialStateParameter)?
+            .range();
         let t_f = tr.final_time().value().ok_or(MpcError::FreeHorizon)?;
         let u = tr.controls();
         let first_control = if u.nrows() > 0 {
@@ -238,11 +267,13 @@ impl Mpc {
             engine,
             shift: tr.shift_plan()?,
             x0_parameter,
+            x0_entries,
             nx: tr.states().nrows(),
             control: vec![0.0; first_control.len()],
             first_control,
             sampling_period: t_f / tr.intervals() as f64,
             previous: None,
+            next: Solution::empty(),
         })
     }
 
@@ -251,6 +282,10 @@ impl Mpc {
     /// point on the first step. The solution becomes the next step's warm start whatever
     /// its status (the report tells the status). With real-time iterations: prepares (if
     /// [`Mpc::prepare`] has not) and runs the feedback.
+    ///
+    /// A warm step re-solves with [`Solver::solve_warm_into`] into vectors kept from the
+    /// step before and shifts in place: with the [`Ipm`](crate::Ipm), a step that takes no
+    /// more iterations than an earlier one allocates nothing.
     pub fn step(&mut self, x0: &[f64]) -> Result<StepReport, MpcError> {
         let start = Instant::now();
         let nx = self.nx;
@@ -264,17 +299,19 @@ impl Mpc {
         }
         let mut report = match &mut self.engine {
             Engine::Solver { solver, compiled } => {
-                compiled.set_value(self.x0_parameter.as_str(), x0)?;
-                let sol = match self.previous.as_mut() {
+                compiled.set_parameter_range(self.x0_entries.clone(), x0)?;
+                match self.previous.as_mut() {
                     Some(prev) => {
                         self.shift.apply(prev)?;
-                        solver.solve_warm(&mut **compiled, prev)?
+                        solver.solve_warm_into(&mut **compiled, prev, &mut self.next)?;
+                        std::mem::swap(prev, &mut self.next);
+                        solver_report(prev, true)
                     }
-                    None => solver.solve(&mut **compiled)?,
-                };
-                let report = solver_report(&sol, self.previous.is_some());
-                self.previous = Some(sol);
-                report
+                    None => {
+                        let sol = self.previous.insert(solver.solve(&mut **compiled)?);
+                        solver_report(sol, false)
+                    }
+                }
             }
             Engine::Rti { .. } => self.rti_step(x0)?,
         };
@@ -306,7 +343,7 @@ impl Mpc {
                 unreachable!("checked above")
             };
             rti.compiled_mut()
-                .set_value(self.x0_parameter.as_str(), x0)?;
+                .set_parameter_range(self.x0_entries.clone(), x0)?;
             let sol = first.solve(rti.compiled_mut())?;
             rti.initialize(&sol)?;
             *started = true;
@@ -333,6 +370,7 @@ impl Mpc {
             feedback_seconds: fb.seconds,
             objective: rti.plan().objective,
             warm: true,
+            residual: Some(rti.residual().max()),
         })
     }
 
@@ -432,6 +470,14 @@ impl Mpc {
     }
 }
 
+/// The compiled problem an engine solves.
+fn engine_compiled(engine: &Engine) -> &Compiled {
+    match engine {
+        Engine::Solver { compiled, .. } => compiled,
+        Engine::Rti { rti, .. } => rti.compiled(),
+    }
+}
+
 /// The report of a solver's step (its `seconds` filled by the caller).
 fn solver_report(sol: &Solution, warm: bool) -> StepReport {
     StepReport {
@@ -442,5 +488,6 @@ fn solver_report(sol: &Solution, warm: bool) -> StepReport {
         feedback_seconds: sol.stats.total_seconds,
         objective: sol.objective,
         warm,
+        residual: None,
     }
 }

@@ -37,6 +37,11 @@ pub enum Status {
     NotEnoughDegreesOfFreedom,
     /// An internal error.
     InternalError,
+    /// One real-time iteration was taken ([`Rti::feedback`](crate::Rti::feedback)): its
+    /// QP was solved and its full step applied. Convergence is not tested, by design: the
+    /// KKT residual ([`Rti::residual`](crate::Rti::residual)) tells how far the plan is
+    /// from a solution. Not [`Status::is_success`] (a converged solve).
+    RealTimeIterationTaken,
 }
 
 impl std::fmt::Display for Status {
@@ -56,6 +61,7 @@ impl std::fmt::Display for Status {
             Status::InvalidNumberDetected => "Invalid_Number_Detected",
             Status::NotEnoughDegreesOfFreedom => "Not_Enough_Degrees_Of_Freedom",
             Status::InternalError => "Internal_Error",
+            Status::RealTimeIterationTaken => "Real_Time_Iteration_Taken",
         })
     }
 }

@@ -1,6 +1,6 @@
 //! Multiple shooting with the adaptive integrator as a call node reaches the optimum of the
 //! Runge–Kutta transcription of the same OCP (CasADi's Van der Pol example,
-//! `examples/vdp_multiple_shooting.rs`): minimise `∫₀¹⁰ x₁² + x₂² + u² dt`,
+//! `examples/src/vdp_multiple_shooting.rs`): minimise `∫₀¹⁰ x₁² + x₂² + u² dt`,
 //! `ẋ₁ = (1 − x₂²)x₁ − x₂ + u`, `ẋ₂ = x₁`, `x(0) = (0, 1)`, `x₁ ≥ −0.25`, `|u| ≤ 1`,
 //! N = 20 intervals, piecewise-constant control.
 use nlp::integrator::{Integrator, IntegratorOptions};

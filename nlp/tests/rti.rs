@@ -6,7 +6,7 @@
 //! solved to tol 1e-8 on the same problem in the test.
 use nlp::mpc::{Mpc, MpcError};
 use nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Simulator, Transcription};
-use nlp::{Ipm, Rti, RtiError, Solution, SqpOptions, Status};
+use nlp::{Ipm, Relation, Rti, RtiError, Solution, SqpOptions, Status};
 use symx::Matrix;
 
 const N: usize = 10;
@@ -71,7 +71,7 @@ fn one_iteration_solves_a_linear_quadratic_ocp_with_active_bounds() {
     rti.initialize(&converged(&tr, &[1.0])).unwrap();
     rti.prepare().unwrap();
     let fb = rti.feedback(&[3.0]).unwrap();
-    assert_eq!(fb.status, Status::MaximumIterationsExceeded);
+    assert_eq!(fb.status, Status::RealTimeIterationTaken);
     assert!(!fb.fallback);
     let reference = converged(&tr, &[3.0]);
     let u = tr
@@ -107,7 +107,7 @@ fn kkt_residual_contracts_superlinearly_after_a_perturbation() {
         rti.prepare().unwrap();
         residuals.push(rti.residual().max());
         let fb = rti.feedback(&x0).unwrap();
-        assert_eq!(fb.status, Status::MaximumIterationsExceeded);
+        assert_eq!(fb.status, Status::RealTimeIterationTaken);
     }
     rti.prepare().unwrap();
     residuals.push(rti.residual().max());
@@ -159,7 +159,12 @@ fn rti_loop_tracks_the_converged_loop() {
     assert!(rti.steps[0].status.is_success());
     assert!(rti.steps[1..]
         .iter()
-        .all(|s| s.status == Status::MaximumIterationsExceeded && s.iterations == 1));
+        .all(|s| s.status == Status::RealTimeIterationTaken && s.iterations == 1));
+    // Every step succeeded (the first converged, the others took their iteration) and
+    // reports the KKT residual its preparation measured; the converged loop none.
+    assert!(rti.all_succeeded() && converged.all_succeeded());
+    assert!(rti.steps[0].residual.is_none() && rti.steps[1..].iter().all(|s| s.residual.is_some()));
+    assert!(converged.steps.iter().all(|s| s.residual.is_none()));
     let (a, b) = (cost(&rti), cost(&converged));
     assert!(
         (a - b).abs() <= 5e-3 * b,
@@ -263,4 +268,41 @@ fn bad_use_is_an_error_naming_it() {
         Mpc::with_rti(&fixed, SqpOptions::default(), Box::new(Ipm::default())),
         Err(MpcError::Rti(RtiError::NoInitialStateParameter))
     ));
+}
+
+/// The feedback's g for the new x0: the rows x0 enters affinely are updated by their
+/// coefficients, and a parameter that enters g otherwise makes the feedback re-evaluate
+/// g. Here p enters `x₀ + x₁ + 3p = 0` affinely and `x₁ − x₀ − p² = 0` not: with both
+/// rows linear in x, one iteration prepared at p = 1 and fed back p = 2 lands on the
+/// feasible point x = (−(3p + p²)/2, (p² − 3p)/2) = (−5, −1) (to rounding, 1e-12); an
+/// update that took p² for affine (its secant slope at p = 1) would land at x₁ ≠ −1.
+#[test]
+fn feedback_inserts_a_parameter_that_enters_g_nonlinearly() {
+    let mut pb = nlp::Problem::new();
+    let x = pb.variable("x", 2).unwrap();
+    let p = pb.parameter("p", 1).unwrap();
+    pb.set_value(&p, &[1.0]).unwrap();
+    pb.minimize((x[0] - 1.0).sq() + (x[1] - 2.0).sq());
+    pb.subject_to((x[0] + x[1] + 3.0 * p[0]).eq(0.0)).unwrap();
+    pb.subject_to((x[1] - x[0] - p[0].sq()).eq(0.0)).unwrap();
+    let mut c = pb.compile().unwrap();
+    let first = Ipm::default().solve(&mut c).unwrap();
+    let mut rti = Rti::new(c, "p", SqpOptions::default()).unwrap();
+    rti.initialize(&first).unwrap();
+    rti.prepare().unwrap();
+    let fb = rti.feedback(&[2.0]).unwrap();
+    assert_eq!(fb.status, Status::RealTimeIterationTaken);
+    let got = &rti.plan().x;
+    assert!(max_diff(got, &[-5.0, -1.0]) < 1e-12, "{got:?}");
+    // The affine case on the OCP: x0 = 3 fed back exactly (`X₀ − x0 = 0`).
+    let (_, tr) = linear_quadratic();
+    let mut rti = Rti::from_transcription(&tr, SqpOptions::default()).unwrap();
+    rti.initialize(&converged(&tr, &[1.0])).unwrap();
+    rti.prepare().unwrap();
+    rti.feedback(&[3.0]).unwrap();
+    let x0 = tr
+        .problem()
+        .variable_indices(&tr.states().column(0).unwrap())
+        .unwrap()[0];
+    assert!((rti.plan().x[x0] - 3.0).abs() < 1e-12);
 }

@@ -168,7 +168,7 @@ fn active_inequality_and_bound_are_held_fixed() {
 
 #[test]
 fn optimal_control_sensitivity_to_a_model_parameter() {
-    // Van der Pol (examples/vdp_multiple_shooting.rs) with the damping coefficient μ of
+    // Van der Pol (examples/src/vdp_multiple_shooting.rs) with the damping coefficient μ of
     // ẋ₁ = (μ − x₂²)x₁ − x₂ + u as a parameter; x₁ ≥ −0.25 and |u| ≤ 1 are active on arcs.
     let mut ocp = Ocp::new(&["x1", "x2"], &["u"]);
     ocp.add_parameter("mu", &[1.0]).unwrap();

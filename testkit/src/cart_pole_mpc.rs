@@ -1,4 +1,4 @@
-//! Cart-pole swing-up MPC (issue 19's benchmark): the model of `examples/cart_pole.rs`
+//! Cart-pole swing-up MPC (issue 19's benchmark): the model of `examples/src/cart_pole.rs`
 //! (Kelly 2017, appendix E), multiple shooting with one RK4 step per interval,
 //! N = 40, dt = 0.05, the initial state a parameter `x0` entering through the equality
 //! `X_0 − x0 = 0` (the first constraint block). Stage k's variables are `[X_k, U_k]`

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use symx::Expr;
 
 /// CasADi's race car (`docs/examples/python/race_car.py`; this repository's
-/// `examples/race_car.rs`): minimum time over 1 m under a position-dependent speed limit,
+/// `examples/src/race_car.rs`): minimum time over 1 m under a position-dependent speed limit,
 /// RK4 multiple shooting on `n` intervals. Same formulation as the example, with one
 /// variable vector per state (`pos`, `speed`). n = 3n + 3.
 pub fn race_car(n: usize) -> Result<Problem, BuildError> {

@@ -151,7 +151,7 @@ pub static FAMILIES: &[Family] = &[
         name: "race_car_rk4",
         kind: Kind::Ocp,
         transcription: "rk4-shooting",
-        source: "CasADi docs/examples/python/race_car.py (this repository's examples/race_car.rs)",
+        source: "CasADi docs/examples/python/race_car.py (this repository's examples/src/race_car.rs)",
         sizes: &[100, 400, 6667],
         build: casadi::race_car,
         references: &[],

@@ -8,8 +8,10 @@
 //!   of the last QP (or one guessed from the multipliers) and factorises the KKT matrix of
 //!   its equality QP. None of this depends on the initial state: the parameter x0 enters
 //!   only the constant term of the rows `X₀ − x0 = 0`.
-//! * [`Rti::feedback`] (with the measured state): sets the parameter, re-evaluates g at x̄
-//!   (the only quantity x0 changes), solves the QP with the active-set method from the
+//! * [`Rti::feedback`] (with the measured state): sets the parameter, updates the
+//!   constants of the rows x0 enters (found once at construction: rows affine in x0 with
+//!   coefficients independent of x, as the OCP's `X₀ − x0 = 0`; all of g is re-evaluated
+//!   instead when x0 enters g otherwise), solves the QP with the active-set method from the
 //!   prepared factorisation (usually one back-substitution, more when the working set
 //!   changes), and takes the full step x̄ + d with the QP's multipliers. No line search,
 //!   no elastic mode: RTI relies on the previous plan being close (the contraction of
@@ -113,9 +115,9 @@ impl RtiResidual {
 /// What one [`Rti::feedback`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Feedback {
-    /// `MaximumIterationsExceeded` after a step (one iteration, convergence not tested:
-    /// RTI by design), `ErrorInStepComputation` when no QP method solved the QP (the
-    /// plan is then left as prepared).
+    /// [`Status::RealTimeIterationTaken`] after a step (one iteration, convergence not
+    /// tested: RTI by design; [`Rti::residual`] measures it), `ErrorInStepComputation`
+    /// when no QP method solved the QP (the plan is then left as prepared).
     pub status: Status,
     /// Active-set iterations of the QP (0 when clarabel solved it).
     pub qp_iterations: usize,
@@ -156,7 +158,7 @@ pub struct Feedback {
 ///     rti.shift(&shift).unwrap(); // the plan one stage forward
 ///     rti.prepare().unwrap(); // before the measurement
 ///     let fb = rti.feedback(&x).unwrap(); // after it: the new plan
-///     assert_eq!(fb.status, nlp::Status::MaximumIterationsExceeded);
+///     assert_eq!(fb.status, nlp::Status::RealTimeIterationTaken);
 ///     x[0] += 0.1 * (x[0] + rti.plan().x[11]);
 /// }
 /// assert!(x[0].abs() < 0.05);
@@ -164,8 +166,11 @@ pub struct Feedback {
 pub struct Rti {
     compiled: Compiled,
     x0_parameter: String,
-    /// Entries of the initial-state parameter.
-    x0_len: usize,
+    /// The entries of the initial-state parameter in the parameter vector.
+    x0_entries: std::ops::Range<usize>,
+    /// How x0 enters g: `(row, entry of x0, coefficient)`, so that a feedback updates
+    /// only those rows; `None` when x0 enters g otherwise (all of g is re-evaluated).
+    x0_terms: Option<Vec<(usize, usize, f64)>>,
     options: SqpOptions,
     shape: Shape,
     geo: Geometry,
@@ -193,7 +198,7 @@ impl Rti {
     /// problem's initial point with zero multipliers ([`Rti::initialize`] replaces it).
     /// Errors: unknown parameter, cones, damped BFGS, invalid options or bounds.
     pub fn new(
-        compiled: Compiled,
+        mut compiled: Compiled,
         x0_parameter: &str,
         options: SqpOptions,
     ) -> Result<Rti, RtiError> {
@@ -204,13 +209,14 @@ impl Rti {
         if !compiled.affine_cones().is_empty() {
             return Err(RtiError::Unsupported("second-order cones"));
         }
-        let x0_len = compiled
+        let x0_entries = compiled
             .parameter_blocks()
             .iter()
             .find(|b| b.name == x0_parameter)
             .ok_or_else(|| RtiError::UnknownParameter(x0_parameter.to_string()))?
-            .len;
+            .range();
         let v = validate(&compiled, None)?;
+        let x0_terms = x0_terms(&mut compiled, &v.x0, x0_entries.clone());
         let (n, m) = (compiled.n(), compiled.m());
         let shape = Shape {
             n,
@@ -255,7 +261,8 @@ impl Rti {
         Ok(Rti {
             compiled,
             x0_parameter: x0_parameter.to_string(),
-            x0_len,
+            x0_entries,
+            x0_terms,
             options,
             shape,
             geo,
@@ -343,25 +350,20 @@ impl Rti {
         if !self.prepared {
             return Err(RtiError::NotPrepared);
         }
-        if x0.len() != self.x0_len {
+        if x0.len() != self.x0_entries.len() {
             return Err(RtiError::InitialStateSize {
                 parameter: self.x0_parameter.clone(),
-                expected: self.x0_len,
+                expected: self.x0_entries.len(),
                 got: x0.len(),
             });
         }
-        self.compiled.set_value(self.x0_parameter.as_str(), x0)?;
+        self.insert_initial_state(x0)?;
         self.prepared = false;
-        // x0 enters only the constants of the initial-state rows: g at the same point.
-        self.compiled.eval_g(&self.it.x, &mut self.it.g);
-        if self.it.g.iter().any(|v| !v.is_finite()) {
-            return Err(RtiError::NonFinite("constraint value"));
-        }
         let (solved, qp_iterations, factorizations, fallback) = self.solve_qp();
         let status = match solved {
             Some(res) => {
                 self.take_step(&res);
-                Status::MaximumIterationsExceeded
+                Status::RealTimeIterationTaken
             }
             None => Status::ErrorInStepComputation,
         };
@@ -405,9 +407,37 @@ impl Rti {
         &mut self.compiled
     }
 
+    /// The compiled problem.
+    pub fn compiled(&self) -> &Compiled {
+        &self.compiled
+    }
+
     /// The name of the initial-state parameter.
     pub fn x0_parameter(&self) -> &str {
         &self.x0_parameter
+    }
+
+    /// Sets the parameter x0 and g at the prepared point for it: the rows x0 enters
+    /// updated by their coefficients, or all of g re-evaluated (see `x0_terms`).
+    fn insert_initial_state(&mut self, x0: &[f64]) -> Result<(), RtiError> {
+        let start = self.x0_entries.start;
+        if let Some(terms) = &self.x0_terms {
+            let old = &self.compiled.parameter_values()[self.x0_entries.clone()];
+            if x0.iter().all(|v| v.is_finite()) {
+                for &(row, k, c) in terms {
+                    self.it.g[row] += c * (x0[k] - old[k]);
+                }
+            }
+        }
+        self.compiled
+            .set_parameter_range(start..start + x0.len(), x0)?;
+        if self.x0_terms.is_none() {
+            self.compiled.eval_g(&self.it.x, &mut self.it.g);
+            if self.it.g.iter().any(|v| !v.is_finite()) {
+                return Err(RtiError::NonFinite("constraint value"));
+            }
+        }
+        Ok(())
     }
 
     /// The plan as the linearisation point: x clamped into its bounds, the multipliers.
@@ -574,6 +604,67 @@ fn residual(err: &Errors) -> RtiResidual {
         dual: err.inf_du,
         complementarity: err.compl,
     }
+}
+
+/// How the parameter entries `x0` enter g, probed at construction: for each entry k, g
+/// at `x` (the initial point) and at `x + 1` with x0_k moved by ±1 and +2. The rows that
+/// move are kept with their coefficient c (central difference) when g moves by c per
+/// unit at both points and linearly (to 1e-12 relative): affine in x0 with a coefficient
+/// independent of x, as the OCP's initial-state rows `X₀ − x0`. `None` otherwise, or when
+/// an evaluation is not finite. The parameter is left as it was.
+fn x0_terms(
+    compiled: &mut Compiled,
+    x: &[f64],
+    entries: std::ops::Range<usize>,
+) -> Option<Vec<(usize, usize, f64)>> {
+    let m = compiled.m();
+    let x_moved: Vec<f64> = x.iter().map(|v| v + 1.0).collect();
+    let base: Vec<f64> = compiled.parameter_values()[entries.clone()].to_vec();
+    let g_at = |c: &mut Compiled, point: &[f64], k: usize, dp: f64| -> Option<Vec<f64>> {
+        let mut p = base.clone();
+        p[k] += dp;
+        c.set_parameter_range(entries.clone(), &p).ok()?;
+        let mut g = vec![0.0; m];
+        c.eval_g(point, &mut g);
+        g.iter().all(|v| v.is_finite()).then_some(g)
+    };
+    let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-12 * scale.max(1.0);
+    let mut terms = Vec::new();
+    let mut affine = true;
+    'entries: for k in 0..base.len() {
+        let mut coefficients: Option<Vec<f64>> = None;
+        for point in [x, &x_moved[..]] {
+            let (Some(g0), Some(up), Some(down), Some(up2)) = (
+                g_at(compiled, point, k, 0.0),
+                g_at(compiled, point, k, 1.0),
+                g_at(compiled, point, k, -1.0),
+                g_at(compiled, point, k, 2.0),
+            ) else {
+                affine = false;
+                break 'entries;
+            };
+            let c: Vec<f64> = (0..m).map(|i| 0.5 * (up[i] - down[i])).collect();
+            for i in 0..m {
+                let scale = g0[i].abs() + c[i].abs();
+                let linear =
+                    close(up[i] - g0[i], c[i], scale) && close(up2[i] - g0[i], 2.0 * c[i], scale);
+                let same = coefficients
+                    .as_ref()
+                    .is_none_or(|c0| close(c0[i], c[i], scale));
+                if !linear || !same {
+                    affine = false;
+                    break 'entries;
+                }
+            }
+            coefficients = Some(c);
+        }
+        let c = coefficients.expect("two points probed");
+        terms.extend((0..m).filter(|&i| c[i] != 0.0).map(|i| (i, k, c[i])));
+    }
+    compiled
+        .set_parameter_range(entries, &base)
+        .expect("the values read back");
+    affine.then_some(terms)
 }
 
 /// The plan before any start: `x` with zero multipliers.

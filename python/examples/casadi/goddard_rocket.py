@@ -1,7 +1,7 @@
 """The Goddard rocket of COPS 3.0 (problem 10) in CasADi Opti, written as a CasADi user
 would: trapezoidal rule with the thrust at the nodes, free final time, N = 100, COPS's
 initial guess. The CasADi half of python/examples/goddard_rocket.py and of docs/casadi.md's
-line-count comparison (examples/goddard_rocket.rs). Prints h(T) = 1.0128320 (COPS: 1.01283)."""
+line-count comparison (examples/src/goddard_rocket.rs). Prints h(T) = 1.0128320 (COPS: 1.01283)."""
 import casadi as ca
 import numpy as np
 

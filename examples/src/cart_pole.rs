@@ -5,7 +5,7 @@
 //! `benches/reference/ocp_examples.py` solves the identical NLP with IPOPT;
 //! `tests/ocp_examples.rs` compares.
 //!
-//! Run: `cargo run --release --example cart_pole > cart_pole.csv`
+//! Run: `cargo run --release -p symnlp-examples --example cart_pole > cart_pole.csv`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{CollocationPoints, Horizon, Method, Ocp, Transcription};
 use symnlp::symx::Matrix;
@@ -47,7 +47,8 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     Ok(ocp.transcribe(&Method::collocation(CollocationPoints::Radau, 3)?, n)?)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/cart_pole.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let tr = transcription(20)?;
     let mut compiled = tr.compile()?;
     let sol = symnlp::nlp::Ipm::default().solve(&mut compiled)?;

@@ -7,13 +7,11 @@
 //! intervals of dt = 0.1 s, 80 closed-loop steps on the nominal plant.
 //! `benches/reference/mpc_casadi.py car` runs the identical loop with CasADi.
 //!
-//! Run: `cargo run --release --example mpc_car [-- sqp] [--json]`
+//! Run: `cargo run --release -p symnlp-examples --example mpc_car [-- sqp] [--json]`
 use symnlp::nlp::ocp::{Horizon, Ocp};
 use symnlp::symx::{Expr, Matrix};
 
-#[path = "mpc_common/mod.rs"]
-mod mpc_common;
-pub use mpc_common::MpcExample;
+pub use crate::mpc_common::MpcExample;
 
 /// Wheelbase (m).
 const WHEELBASE: f64 = 1.0;
@@ -64,6 +62,7 @@ pub fn example() -> MpcExample {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/mpc_car.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     example().main()
 }

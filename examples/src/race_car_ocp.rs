@@ -1,10 +1,10 @@
-//! CasADi's race-car example (`examples/race_car.rs`, written line for line) restated
+//! CasADi's race-car example (`examples/src/race_car.rs`, written line for line) restated
 //! with the `Ocp` helper: minimum time `T` to drive 1 m from standstill, `ṗ = v`,
 //! `v̇ = u − v`, `0 ≤ u ≤ 1`, speed limit `v ≤ 1 − sin(2πp)/2` at every grid point, RK4
-//! over N = 100 intervals. The NLP is the one of `examples/race_car.rs`;
+//! over N = 100 intervals. The NLP is the one of `examples/src/race_car.rs`;
 //! `tests/ocp_examples.rs` compares with IPOPT (`benches/reference/ocp_examples.py`).
 //!
-//! Run: `cargo run --release --example race_car_ocp`
+//! Run: `cargo run --release -p symnlp-examples --example race_car_ocp`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Transcription};
 use symnlp::nlp::Relation;
@@ -36,7 +36,8 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     Ok(ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), n)?)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/race_car_ocp.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let tr = transcription(100)?;
     let mut compiled = tr.compile()?;
     let sol = symnlp::nlp::Ipm::default().solve(&mut compiled)?;

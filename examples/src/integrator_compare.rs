@@ -5,7 +5,7 @@
 //! stiff problems). Run both with
 //! `bash benches/reference/integrator_compare.sh`.
 //!
-//! Run: `cargo run --release --example integrator_compare`
+//! Run: `cargo run --release -p symnlp-examples --example integrator_compare`
 use std::time::Instant;
 use symnlp::nlp::integrator::{Integrator, IntegratorOptions, Method};
 use symnlp::symx::{Function, Matrix};
@@ -13,7 +13,8 @@ use symnlp::symx::{Function, Matrix};
 /// A test problem: name, right-hand side, x0, p, T, CVODES reference x(T).
 type Case<'a> = (&'a str, &'a Function, Vec<f64>, Vec<f64>, f64, Vec<f64>);
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/integrator_compare.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let x = Matrix::sym_vec("x", 2);
     let mu = Matrix::sym_vec("mu", 1);
     let vdp = Function::new(

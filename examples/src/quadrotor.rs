@@ -13,7 +13,7 @@
 //! `docs/performance.md`). `problem_with(true)` gives the dynamics as a compiled
 //! `symx::Function` instead (`Ocp::set_dynamics_function`), also the same NLP.
 //!
-//! Run: `cargo run --release --example quadrotor [-- --calls]`
+//! Run: `cargo run --release -p symnlp-examples --example quadrotor [-- --calls]`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Transcription};
 use symnlp::symx::{Expr, Function, Matrix};
@@ -105,7 +105,8 @@ pub fn transcription_with_calls(n: usize) -> Result<Transcription, Box<dyn std::
     Ok(ocp.transcribe(&method, n)?)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/quadrotor.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let tr = if std::env::args().any(|a| a == "--calls") {
         transcription_with_calls(20)?
     } else {

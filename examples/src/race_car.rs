@@ -6,7 +6,7 @@
 //! `casadi/docs/examples/python/race_car.py`; `benches/reference/race_car.py` is the same
 //! problem and `tests/race_car.rs` checks both give the same `T`.
 //!
-//! Run: `cargo run --release --example race_car`
+//! Run: `cargo run --release -p symnlp-examples --example race_car`
 use std::f64::consts::PI;
 use symnlp::nlp::{bounded, CommonOptions, Ipm, IpmOptions, Problem, Relation, Solution};
 use symnlp::symx::{Expr, Matrix};
@@ -53,7 +53,8 @@ pub fn solve(
     Ok((Ipm::new(options).solve(&mut compiled)?, index_of_t))
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/race_car.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = IpmOptions {
         common: CommonOptions {
             print_level: 5,

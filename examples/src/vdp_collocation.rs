@@ -1,10 +1,10 @@
 //! CasADi's `direct_collocation.py` example (Van der Pol oscillator, the problem of
-//! `examples/vdp_multiple_shooting.rs`) with the `Ocp` helper: N = 20 intervals, Legendre
+//! `examples/src/vdp_multiple_shooting.rs`) with the `Ocp` helper: N = 20 intervals, Legendre
 //! collocation of degree 3, the cost by the collocation quadrature, the state bounds also
 //! at the collocation points. `benches/reference/ocp_examples.py` solves the identical
 //! NLP with IPOPT; `tests/ocp_examples.rs` compares.
 //!
-//! Run: `cargo run --release --example vdp_collocation`
+//! Run: `cargo run --release -p symnlp-examples --example vdp_collocation`
 use symnlp::nlp::ocp::{CollocationPoints, Horizon, Method, Ocp, Trajectory};
 use symnlp::nlp::{Ipm, IpmOptions};
 use symnlp::symx::Matrix;
@@ -31,7 +31,8 @@ pub fn solve(
     Ok(tr.trajectory(&sol)?)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/vdp_collocation.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let traj = solve(20, 3, IpmOptions::default())?;
     println!("{:?}: objective {:.10}", traj.status, traj.objective);
     println!("{}", serde_json::to_string(&traj)?);

@@ -101,7 +101,7 @@ impl MpcExample {
         let cost = self.cost(&run)?;
         if args.iter().any(|a| a == "--json") {
             let failed: Vec<usize> = (0..run.steps.len())
-                .filter(|&s| !run.steps[s].status.is_success())
+                .filter(|&s| !run.steps[s].succeeded())
                 .collect();
             let summary = serde_json::json!({
                 "problem": self.name, "solver": name, "closed_loop_cost": cost,

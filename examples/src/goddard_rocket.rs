@@ -4,12 +4,13 @@
 //! docs/casadi.md; the CasADi half is `python/examples/casadi/goddard_rocket.py`. Both
 //! print h(T) = 1.0128320 (COPS: 1.01283); `nlp/tests/ocp_transcriptions.rs` checks it.
 //!
-//! Run: `cargo run --release --example goddard_rocket`
+//! Run: `cargo run --release -p symnlp-examples --example goddard_rocket`
 use symnlp::nlp::ocp::{ControlInterpolation, Horizon, Method, Ocp};
 use symnlp::nlp::{CommonOptions, Ipm, IpmOptions, Relation};
 use symnlp::symx::Matrix;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/goddard_rocket.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (h0, m0, g0, hc, vc, inf) = (1.0f64, 1.0, 1.0, 500.0, 620.0, f64::INFINITY);
     let c = 0.5 * (g0 * h0).sqrt();
     let (mf, dc, tmax) = (0.6 * m0, 0.5 * vc * m0 / g0, 3.5 * g0 * m0);

@@ -6,7 +6,7 @@
 //! N = 20 intervals. `benches/reference/ocp_examples.py` solves the identical NLP with
 //! IPOPT; `tests/ocp_examples.rs` compares.
 //!
-//! Run: `cargo run --release --example two_link_arm`
+//! Run: `cargo run --release -p symnlp-examples --example two_link_arm`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{CollocationPoints, Horizon, Method, Ocp, Transcription};
 use symnlp::symx::Matrix;
@@ -60,7 +60,8 @@ pub fn transcription(n: usize) -> Result<Transcription, Box<dyn std::error::Erro
     Ok(ocp.transcribe(&Method::collocation(CollocationPoints::Legendre, 3)?, n)?)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/two_link_arm.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let tr = transcription(20)?;
     let mut compiled = tr.compile()?;
     let sol = symnlp::nlp::Ipm::default().solve(&mut compiled)?;

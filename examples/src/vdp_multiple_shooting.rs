@@ -10,7 +10,7 @@
 //! calls it at every interval, so the NLP holds the dynamics once; same optimum, same
 //! iterates (`tests/ocp_examples.rs`).
 //!
-//! Run: `cargo run --release --example vdp_multiple_shooting [-- --calls]`
+//! Run: `cargo run --release -p symnlp-examples --example vdp_multiple_shooting [-- --calls]`
 use symnlp::nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Trajectory};
 use symnlp::nlp::{Ipm, IpmOptions};
 use symnlp::symx::{Function, Matrix};
@@ -80,7 +80,8 @@ pub fn solve_with(
     Ok(tr.trajectory(&sol)?)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/vdp_multiple_shooting.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let calls = std::env::args().any(|a| a == "--calls");
     let traj = solve_with(20, IpmOptions::default(), calls)?;
     println!("{:?}: objective {:.10}", traj.status, traj.objective);

@@ -1,22 +1,18 @@
 //! Quadrotor repositioning by model-predictive control: the 12-state rigid body of
-//! `examples/quadrotor.rs` (Luukkonen 2011), from hover at the origin to hover at
+//! `examples/src/quadrotor.rs` (Luukkonen 2011), from hover at the origin to hover at
 //! `(1, 1, 1)` m: `l = 10 |p − p*|² + |v|² + |angles|² + 0.1 |rates|² + 0.1 Σᵢ (Fᵢ − F_hover)²`,
 //! `φ = 10 l(x(T), F_hover)`, thrusts `0 ≤ Fᵢ ≤ 2.5` N, roll and pitch within ±45°. RK4
 //! multiple shooting, N = 20 intervals of dt = 0.1 s, 50 closed-loop steps on the nominal
 //! plant. `benches/reference/mpc_casadi.py quadrotor` runs the identical loop with CasADi.
 //!
-//! Run: `cargo run --release --example mpc_quadrotor [-- sqp] [--json]`
+//! Run: `cargo run --release -p symnlp-examples --example mpc_quadrotor [-- sqp] [--json]`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{Horizon, Ocp};
 use symnlp::symx::{Expr, Matrix};
 
-#[path = "mpc_common/mod.rs"]
-mod mpc_common;
-pub use mpc_common::MpcExample;
+pub use crate::mpc_common::MpcExample;
 
-#[path = "quadrotor.rs"]
-#[allow(dead_code)]
-mod quadrotor;
+use crate::quadrotor;
 
 /// The stage cost `l(x, u)`.
 pub fn stage_cost(x: &Matrix, u: &Matrix) -> Expr {
@@ -65,6 +61,7 @@ pub fn example() -> MpcExample {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/mpc_quadrotor.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     example().main()
 }

@@ -1,27 +1,23 @@
 //! Cart-pole swing-up by model-predictive control (issue 19's benchmark): the cart-pole of
-//! `examples/cart_pole.rs` (Kelly 2017), from hanging at rest to upright at the origin.
+//! `examples/src/cart_pole.rs` (Kelly 2017), from hanging at rest to upright at the origin.
 //! Each step solves, from the measured state, `min ∫₀ᵀ l dt + φ(x(T))` with
 //! `l = 5 q1² + 10 (q2 − π)² + 0.1 (dq1² + dq2²) + 0.01 u²`, `φ = 100 l(x(T), 0)`,
 //! `|u| ≤ 20` N, `|q1| ≤ 2` m, on a horizon of `T = 2` s: RK4 multiple shooting (one step
 //! per interval), N = 40 intervals of dt = 0.05 s, the initial state a parameter. 100
 //! closed-loop steps on the nominal plant (the same RK4 step), each warm-started from the
-//! shifted previous solution ([`Mpc`]).
+//! shifted previous solution ([`Mpc`](symnlp::nlp::mpc::Mpc)).
 //!
 //! `benches/reference/mpc_casadi.py` runs the identical loop with CasADi (IPOPT,
 //! sqpmethod + qrqp, RTI); `tests/mpc.rs` compares the closed-loop cost.
 //!
-//! Run: `cargo run --release --example mpc_cart_pole [-- sqp] [--json]`
+//! Run: `cargo run --release -p symnlp-examples --example mpc_cart_pole [-- sqp] [--json]`
 use std::f64::consts::PI;
 use symnlp::nlp::ocp::{Horizon, Ocp};
 use symnlp::symx::{Expr, Matrix};
 
-#[path = "mpc_common/mod.rs"]
-mod mpc_common;
-pub use mpc_common::MpcExample;
+pub use crate::mpc_common::MpcExample;
 
-#[path = "cart_pole.rs"]
-#[allow(dead_code)]
-mod cart_pole;
+use crate::cart_pole;
 
 /// Intervals of the horizon.
 pub const N: usize = 40;
@@ -65,6 +61,7 @@ pub fn example() -> MpcExample {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// The example's program (`examples/examples/mpc_cart_pole.rs` runs it).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     example().main()
 }
