@@ -250,9 +250,12 @@ impl Integrator {
     /// first and second order, built here once); third derivatives are refused with
     /// [`symx::SymxError::NoDerivative`]. A failed integration makes the outputs NaN (the
     /// solver calling it then rejects the point). Evaluation allocates nothing once warm,
-    /// with either method: each evaluator keeps a pool of
-    /// buffers (stages, LU factors), one set per concurrent caller (results do not depend
-    /// on which set is used).
+    /// with either method: each evaluator keeps a pool of buffers (stages, LU factors),
+    /// one set per concurrent caller (results do not depend on which set is used). With
+    /// [`IntegratorOptions::sensitivity_error_control`], `xf` is computed together with
+    /// the first-order sensitivities, on the steps of its Jacobian. Reverse products
+    /// through the node come from its Jacobian (the forward sensitivities), not from
+    /// [`Integrator::simulate_with_adjoint`]: symx's external node takes a Jacobian.
     ///
     /// ```
     /// use nlp::integrator::{Integrator, IntegratorOptions};
