@@ -3,7 +3,10 @@
 Prints JSON: for each problem, x(T) and the Jacobian dx(T)/d(x0, p) (column-major) from
 CVODES at tight tolerances (rtol 1e-12, atol 1e-14: the reference values used by
 nlp/tests/integrator.rs), and the median wall time of one integration at the comparison
-tolerances (rtol 1e-6, atol 1e-8) over interleaved repetitions.
+tolerances (rtol 1e-6, atol 1e-8) over interleaved repetitions. Also the Jacobian from
+CVODES at the comparison tolerances with the sensitivities in the error control
+(`fsens_err_con` true) and without (false): the values nlp/tests/integrator_sens_error.rs
+compares with.
 
 Usage: python3 benches/reference/integrator_casadi.py
 """
@@ -49,6 +52,14 @@ def main():
         xf, jx, jp = jac(x0, p0)
         J = np.hstack([np.array(jx), np.array(jp)])
         cmp = ca.integrator("cmp", "cvodes", dae, 0.0, T, {"abstol": 1e-8, "reltol": 1e-6, "max_num_steps": 10**7})
+        loose = {}
+        for con in (True, False):
+            opts = {"abstol": 1e-8, "reltol": 1e-6, "max_num_steps": 10**7, "fsens_err_con": con}
+            sens = ca.integrator("loose", "cvodes", dae, 0.0, T, opts).factory(
+                "sens", ["x0", "p"], ["jac:xf:x0", "jac:xf:p"]
+            )
+            lx, lp = sens(x0, p0)
+            loose[con] = np.hstack([np.array(lx), np.array(lp)]).ravel(order="F").tolist()
         times = []
         for _ in range(15):
             t = time.perf_counter()
@@ -64,6 +75,8 @@ def main():
             "xf_rtol1e-6": np.array(r["xf"]).ravel().tolist(),
             "cvodes_rtol1e-6_median_s": float(np.median(times)),
             "cvodes_rtol1e-6_steps": int(stats.get("nsteps", -1)),
+            "jac_rtol1e-6_fsens_err_con": loose[True],
+            "jac_rtol1e-6_no_fsens_err_con": loose[False],
         }
     print(json.dumps(out, indent=1))
 

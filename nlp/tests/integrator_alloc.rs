@@ -1,40 +1,24 @@
-//! `Integrator::to_function` evaluates without allocating once warm (DOPRI5), counted by
-//! a global allocator that counts the allocations of the calling thread.
-use nlp::integrator::{Integrator, IntegratorOptions};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+//! `Integrator::to_function` evaluates without allocating once warm (DOPRI5 and SDIRK4),
+//! counted by a global allocator that counts the allocations of the calling thread.
+use nlp::integrator::{Integrator, IntegratorOptions, Method};
 use symx::{Function, Matrix};
-
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-// SAFETY: every call is forwarded to the system allocator unchanged.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        System.realloc(ptr, layout, size)
-    }
-}
+use testkit::alloc::ThreadCounting;
 
 #[global_allocator]
-static COUNTING: Counting = Counting;
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
+static GLOBAL: ThreadCounting = ThreadCounting;
 
 #[test]
 fn warm_evaluations_allocate_nothing_and_agree_across_threads() {
+    check(Method::Dopri5);
+}
+
+#[test]
+fn warm_sdirk4_evaluations_allocate_nothing_and_agree_across_threads() {
+    // Its LU factors live in the kept buffers too (faer's LU in place).
+    check(Method::Sdirk4);
+}
+
+fn check(method: Method) {
     // Van der Pol μ = 1 over [0, 1], and the Jacobian of its end state (level 1).
     let x = Matrix::sym_vec("x", 2);
     let mu = Matrix::sym_vec("mu", 1);
@@ -43,7 +27,11 @@ fn warm_evaluations_allocate_nothing_and_agree_across_threads() {
         &[&[x[1], mu[0] * (1.0 - x[0].sq()) * x[1] - x[0]]],
     )
     .unwrap();
-    let int = Integrator::new(&ode, 0.0, 1.0, IntegratorOptions::default()).unwrap();
+    let options = IntegratorOptions {
+        method,
+        ..Default::default()
+    };
+    let int = Integrator::new(&ode, 0.0, 1.0, options).unwrap();
     let f = int.to_function().unwrap();
     let w = Matrix::sym_vec("w", 3);
     let xf = f.apply(&[&w[..2], &w[2..]]).unwrap().remove(0);
@@ -58,15 +46,12 @@ fn warm_evaluations_allocate_nothing_and_agree_across_threads() {
     };
     call(&mut a, &mut b); // warm: the pools get their buffers
     let first = (a.clone(), b.clone());
-    let before = allocations();
-    for _ in 0..50 {
-        call(&mut a, &mut b);
-    }
-    assert_eq!(
-        allocations() - before,
-        0,
-        "allocations in 50 warm evaluations"
-    );
+    let (_, count) = ThreadCounting::during(|| {
+        for _ in 0..50 {
+            call(&mut a, &mut b);
+        }
+    });
+    assert_eq!(count, 0, "allocations in 50 warm evaluations");
     assert_eq!(
         (a.clone(), b.clone()),
         first,

@@ -1,12 +1,12 @@
 //! Dormand–Prince 5(4): the explicit adaptive stepper (Hairer, Nørsett & Wanner, *Solving
 //! ODEs I*, §II.5), first same as last.
 use super::options::{IntegratorError, IntegratorOptions, IntegratorStats};
-use super::stepper::{next_step_size, Stepper};
+use super::stepper::{error_norm, next_step_size, Stepper};
 use symx::Function;
 
 /// Dormand–Prince 5(4) coefficients (Dormand & Prince 1980; Hairer–Nørsett–Wanner Table 5.2).
 /// The system is autonomous, so the nodes `c` are not needed.
-const A: [[f64; 6]; 7] = [
+pub(super) const A: [[f64; 6]; 7] = [
     [0.0; 6],
     [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
@@ -51,7 +51,9 @@ const E: [f64; 7] = [
 pub(super) struct Dopri<'a> {
     rhs: &'a Function,
     p: &'a [f64],
-    /// Entries under error control (the original states).
+    /// The number of original states (the first block under error control).
+    nx: usize,
+    /// Entries under error control: the states, and the sensitivities if controlled.
     controlled: usize,
     buf: DopriBuffers,
     h: f64,
@@ -59,6 +61,8 @@ pub(super) struct Dopri<'a> {
     fresh: bool,
     options: IntegratorOptions,
     stats: IntegratorStats,
+    /// Where accepted steps are recorded for an adjoint pass (`h`, `zₙ`), if anywhere.
+    tape: Option<&'a mut Vec<f64>>,
 }
 
 /// The buffers of a DOPRI5 integration, kept between integrations of the same system so
@@ -72,10 +76,12 @@ pub(super) struct DopriBuffers {
 
 impl<'a> Dopri<'a> {
     /// A stepper for `rhs` (state length `nz`, the first `controlled` entries under error
-    /// control) using `buf`, resized as needed (no allocation when it already fits).
+    /// control, in blocks of `nx`) using `buf`, resized as needed (no allocation when it
+    /// already fits).
     pub(super) fn new(
         rhs: &'a Function,
         nz: usize,
+        nx: usize,
         controlled: usize,
         p: &'a [f64],
         options: IntegratorOptions,
@@ -87,13 +93,21 @@ impl<'a> Dopri<'a> {
         Dopri {
             rhs,
             p,
+            nx,
             controlled,
             buf,
             h: options.initial_step.unwrap_or(0.0),
             fresh: false,
             options,
             stats: IntegratorStats::default(),
+            tape: None,
         }
+    }
+
+    /// Records every accepted step in `tape` (see [`super::adjoint`]).
+    pub(super) fn with_tape(mut self, tape: Option<&'a mut Vec<f64>>) -> Dopri<'a> {
+        self.tape = tape;
+        self
     }
 
     /// The buffers, for the next integration.
@@ -117,7 +131,7 @@ impl<'a> Dopri<'a> {
 
     /// Hairer's starting step (Solving ODEs I, §II.4): from ‖z‖, ‖f(z)‖ and one Euler step.
     fn initial_step(&mut self, z: &[f64], span: f64) -> f64 {
-        let n = self.controlled;
+        let n = self.nx;
         let (atol, rtol) = (self.options.atol, self.options.rtol);
         // Weighted by atol + rtol·|z| (`weight(z, z)`), without a buffer.
         let rms = |v: &mut dyn Iterator<Item = f64>| {
@@ -186,20 +200,19 @@ impl Stepper for Dopri<'_> {
             }
             // The 5th-order solution is the last stage's point (FSAL).
             let znew = &self.buf.stage;
-            let mut sum = 0.0;
-            let mut finite = true;
-            for i in 0..self.controlled {
+            let err = error_norm(self.controlled, self.nx, |i| {
                 let mut e = 0.0;
                 for (s, &w) in E.iter().enumerate() {
                     e += w * self.buf.k[s][i];
                 }
-                let r = h * e / self.weight(z[i], znew[i]);
-                finite &= r.is_finite();
-                sum += r * r;
-            }
-            let err = (sum / self.controlled.max(1) as f64).sqrt();
-            let finite = finite && znew.iter().all(|v| v.is_finite());
+                h * e / self.weight(z[i], znew[i])
+            });
+            let finite = err.is_finite() && znew.iter().all(|v| v.is_finite());
             if finite && err <= 1.0 {
+                if let Some(tape) = self.tape.as_mut() {
+                    tape.push(h);
+                    tape.extend_from_slice(&z[..self.nx]);
+                }
                 *t = if last { target } else { *t + h };
                 z.copy_from_slice(&self.buf.stage);
                 self.buf.k.swap(0, 6);

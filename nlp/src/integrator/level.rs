@@ -1,5 +1,6 @@
 //! The hierarchy of systems an [`Integrator`](super::Integrator) integrates: the ODE
 //! (level 0) and the variational equations of each level (level k + 1).
+use faer::MatMut;
 use symx::{Expr, Function, Matrix, SymxError};
 
 /// One right-hand side `(z, p) → ż` of the hierarchy (the first `nx` entries of `z` are
@@ -58,6 +59,39 @@ impl Level {
             entries: symx::sparsity::entries(jac.sparsity()),
         });
         Ok(())
+    }
+
+    /// `I − c·∂ż/∂z` at `z` (its first `nz` entries) into `into` (dense, `nz × nz`), with
+    /// `values` and `work` as scratch (at least the Jacobian's nonzeros and work size).
+    /// The Jacobian must have been built ([`Level::add_jacobian`]).
+    pub(super) fn iteration_matrix(
+        &self,
+        z: &[f64],
+        p: &[f64],
+        c: f64,
+        values: &mut [f64],
+        work: &mut [f64],
+        mut into: MatMut<'_, f64>,
+    ) {
+        let jac = self
+            .jacobian
+            .as_ref()
+            .expect("Jacobians built for the implicit method");
+        let nnz = jac.entries.len();
+        jac.values
+            .eval(&[&z[..self.nz], p], &mut [&mut values[..nnz]], work)
+            .expect("sizes fixed at construction");
+        for col in 0..self.nz {
+            for r in 0..self.nz {
+                into[(r, col)] = 0.0;
+            }
+        }
+        for (&v, &(r, col)) in values.iter().zip(&jac.entries) {
+            into[(r, col)] = -c * v;
+        }
+        for i in 0..self.nz {
+            into[(i, i)] += 1.0;
+        }
     }
 
     /// The variational equations of this level with respect to `(x0, p)`: state

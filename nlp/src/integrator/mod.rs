@@ -12,29 +12,37 @@
 //!
 //! **Sensitivities.** Derivatives of `x(T)` with respect to `(x₀, p)` come from the
 //! variational equations `Ṡ = f_x S + f_p` integrated together with `x` by the *same*
-//! steps: the error control looks at the `x` components only, so the step sequence is the
-//! one of the plain simulation and the sensitivities are the exact derivatives of the
-//! numerical map `(x₀, p) ↦ x_N` (internal numerical differentiation, Bock 1981), which is
-//! what an optimizer needs for its Newton steps to be consistent. Second derivatives repeat
-//! the construction once more. Adjoint (reverse) products `Jᵀȳ` are formed from the
-//! forward sensitivities (cheap for the small state and control dimensions of shooting),
-//! not by a backward adjoint integration.
+//! steps. By default the error control looks at the `x` components only, so the step
+//! sequence is the one of the plain simulation and the sensitivities are the exact
+//! derivatives of the numerical map `(x₀, p) ↦ x_N` (internal numerical differentiation,
+//! Bock 1981), which is what an optimizer needs for its Newton steps to be consistent.
+//! [`IntegratorOptions::sensitivity_error_control`] puts the sensitivities under the
+//! error control too (CVODES' `fsens_err_con`): accurate sensitivities where the
+//! variational equations have a transient the states do not show. Second derivatives
+//! repeat the construction once more. Adjoint (reverse) products `vᵀ∂x(T)/∂(x₀, p)`:
+//! [`Integrator::simulate_with_adjoint`] runs a backward pass over the recorded steps
+//! (the discrete adjoint, see `adjoint`), one pass per `v` whatever `nx + np`; the
+//! reverse products of [`Integrator::to_function`]'s node still come from its forward
+//! sensitivities (symx's external node takes a Jacobian, not a reverse product).
 //!
 //! [`Integrator::to_function`] wraps all this as an external [`Function`] `F(x0, p) → xf`
 //! whose Jacobian and Hessian work through symx's derivative builders, so it can be
 //! called in a [`crate::Problem`]'s expressions.
+mod adjoint;
 mod dopri;
 mod level;
+mod lu;
 mod options;
 mod sdirk;
 mod stepper;
 
 pub use options::{IntegratorError, IntegratorOptions, IntegratorStats, Method};
 
+use adjoint::{dopri_record_len, sdirk_record_len, vjp_function, Backward};
 use dopri::{Dopri, DopriBuffers};
 use level::Level;
-use sdirk::Sdirk;
-use std::sync::{Arc, Mutex, PoisonError};
+use sdirk::{Sdirk, SdirkBuffers};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use stepper::Stepper;
 use symx::{Expr, Function, Matrix};
 
@@ -61,6 +69,8 @@ pub struct Integrator {
     t0: f64,
     tf: f64,
     options: IntegratorOptions,
+    /// `(x, p, v) → (f_xᵀ v, f_pᵀ v)`, built by the first adjoint integration.
+    vjp: OnceLock<Function>,
 }
 
 impl Integrator {
@@ -95,6 +105,7 @@ impl Integrator {
             t0,
             tf,
             options,
+            vjp: OnceLock::new(),
         })
     }
 
@@ -162,14 +173,89 @@ impl Integrator {
         Ok((xf, z[self.nx..self.nx + self.nx * m].to_vec()))
     }
 
+    /// `x(tf)` and the row `vᵀ ∂x(tf)/∂(x0, p)` (length `nx + np`: the `x0` part, then the
+    /// `p` part) by the adjoint method: one integration that records its steps, then one
+    /// backward pass over them (see the module notes). The derivative is that of the very
+    /// map [`Integrator::simulate`] computes (same steps, `x(tf)` bit-identical), equal to
+    /// `vᵀ` times [`Integrator::simulate_with_jacobian`]'s Jacobian up to rounding when the
+    /// sensitivities are not under error control; its cost does not grow with `nx + np`
+    /// (one backward pass per `v` instead of `nx + np` sensitivity columns).
+    ///
+    /// ```
+    /// use nlp::integrator::{Integrator, IntegratorOptions};
+    /// use symx::{Function, Matrix};
+    /// // ẋ = −k·x: x(1) = x0·e^{−k}, so ∂x(1)/∂(x0, k) = (e^{−k}, −x0·e^{−k}).
+    /// let x = Matrix::sym_vec("x", 1);
+    /// let k = Matrix::sym_vec("k", 1);
+    /// let ode = Function::new(&[&x, &k], &[&[-k[0] * x[0]]]).unwrap();
+    /// let int = Integrator::new(&ode, 0.0, 1.0, IntegratorOptions::default()).unwrap();
+    /// let (xf, row) = int.simulate_with_adjoint(&[2.0], &[0.5], &[1.0]).unwrap();
+    /// let e = (-0.5f64).exp();
+    /// assert!((xf[0] - 2.0 * e).abs() < 1e-7);
+    /// assert!((row[0] - e).abs() < 1e-7 && (row[1] + 2.0 * e).abs() < 1e-7);
+    /// ```
+    pub fn simulate_with_adjoint(
+        &self,
+        x0: &[f64],
+        p: &[f64],
+        v: &[f64],
+    ) -> Result<(Vec<f64>, Vec<f64>), IntegratorError> {
+        self.check_args(x0, p)?;
+        if v.len() != self.nx {
+            return Err(IntegratorError::Length {
+                what: "v",
+                expected: self.nx,
+                got: v.len(),
+            });
+        }
+        let vjp = self.vjp()?;
+        let mut ws = Workspace {
+            tape: Some(Vec::new()),
+            ..Default::default()
+        };
+        let mut xf = vec![0.0; self.nx];
+        self.run_in(0, x0, p, &[self.tf], &mut xf, &mut ws)?;
+        let tape = ws.tape.take().expect("recorded");
+        let mut lambda = v.to_vec();
+        let mut pbar = vec![0.0; self.np];
+        let mut backward = Backward::new(&self.levels[0], vjp, p, self.nx);
+        match self.options.method {
+            Method::Dopri5 => {
+                for record in tape.rchunks(dopri_record_len(self.nx)) {
+                    backward.dopri_step(record, &mut lambda, &mut pbar);
+                }
+            }
+            Method::Sdirk4 => {
+                for record in tape.rchunks(sdirk_record_len(self.nx)) {
+                    backward.sdirk_step(record, &mut lambda, &mut pbar);
+                }
+            }
+        }
+        lambda.extend(pbar);
+        Ok((xf, lambda))
+    }
+
+    /// The compiled vector-Jacobian product of the ODE, built on first use.
+    fn vjp(&self) -> Result<&Function, IntegratorError> {
+        if self.vjp.get().is_none() {
+            let f = vjp_function(&self.levels[0], self.nx, self.np)?;
+            // Another thread may have set it meanwhile: the same function.
+            let _ = self.vjp.set(f);
+        }
+        Ok(self.vjp.get().expect("set above"))
+    }
+
     /// This integrator as an external symx function `F(x0, p) → xf` (inputs named `x0`
     /// and `p`, output `xf`), with its Jacobian and Hessian (the sensitivity equations of
     /// first and second order, built here once); third derivatives are refused with
     /// [`symx::SymxError::NoDerivative`]. A failed integration makes the outputs NaN (the
-    /// solver calling it then rejects the point). With [`Method::Dopri5`], evaluation
-    /// allocates nothing once warm: each evaluator keeps a pool of buffers, one set per
-    /// concurrent caller (results do not depend on which set is used); [`Method::Sdirk4`]
-    /// still allocates its LU factors per call.
+    /// solver calling it then rejects the point). Evaluation allocates nothing once warm,
+    /// with either method: each evaluator keeps a pool of buffers (stages, LU factors),
+    /// one set per concurrent caller (results do not depend on which set is used). With
+    /// [`IntegratorOptions::sensitivity_error_control`], `xf` is computed together with
+    /// the first-order sensitivities, on the steps of its Jacobian. Reverse products
+    /// through the node come from its Jacobian (the forward sensitivities), not from
+    /// [`Integrator::simulate_with_adjoint`]: symx's external node takes a Jacobian.
     ///
     /// ```
     /// use nlp::integrator::{Integrator, IntegratorOptions};
@@ -204,6 +290,13 @@ impl Integrator {
         for k in (0..=ORDER).rev() {
             let int = int.clone();
             let picked = sel[k].clone();
+            // With the sensitivities under error control they choose the steps: `xf` is
+            // then computed with them (level 1), on the steps of its Jacobian.
+            let run = if k == 0 && self.options.sensitivity_error_control {
+                1
+            } else {
+                k
+            };
             let name = match k {
                 0 => "integrator".to_string(),
                 1 => "jac_integrator".to_string(),
@@ -214,7 +307,7 @@ impl Integrator {
             let eval = move |args: &[f64], out: &mut [f64]| {
                 let take = || pool.lock().unwrap_or_else(PoisonError::into_inner).pop();
                 let mut ws = take().unwrap_or_default();
-                match int.run_in(k, &args[..nx], &args[nx..], &[int.tf], &mut [], &mut ws) {
+                match int.run_in(run, &args[..nx], &args[nx..], &[int.tf], &mut [], &mut ws) {
                     Ok(_) => out
                         .iter_mut()
                         .zip(&picked)
@@ -303,8 +396,8 @@ impl Integrator {
         self.run_in(k, x0, p, times, out, &mut Workspace::default())
     }
 
-    /// [`Integrator::run`] with the buffers of `ws` (reused: a DOPRI5 integration that
-    /// fits in them allocates nothing). The final state is left in `ws.state`.
+    /// [`Integrator::run`] with the buffers of `ws` (reused: an integration that fits in
+    /// them allocates nothing, unless it records a tape). The final state is left in `ws.state`.
     fn run_in(
         &self,
         k: usize,
@@ -317,19 +410,38 @@ impl Integrator {
         let nz = self.levels[k].nz;
         ws.state.resize(nz, 0.0);
         self.initial_state(k, x0, &mut ws.state);
+        let controlled = self.controlled(k);
         match self.options.method {
             Method::Dopri5 => {
                 let rhs = &self.levels[k].rhs;
                 let buffers = std::mem::take(&mut ws.dopri);
-                let mut dopri = Dopri::new(rhs, nz, self.nx, p, self.options, buffers);
+                let mut dopri = Dopri::new(rhs, nz, self.nx, controlled, p, self.options, buffers)
+                    .with_tape(ws.tape.as_mut());
                 let result = self.drive(&mut dopri, &mut ws.state, times, out);
                 ws.dopri = dopri.into_buffers();
                 result
             }
             Method::Sdirk4 => {
-                let mut sdirk = Sdirk::new(&self.levels[..=k], self.nx, p, self.options);
-                self.drive(&mut sdirk, &mut ws.state, times, out)
+                let levels = &self.levels[..=k];
+                let buffers = std::mem::take(&mut ws.sdirk);
+                let mut sdirk = Sdirk::new(levels, self.nx, controlled, p, self.options, buffers)
+                    .with_tape(ws.tape.as_mut());
+                let result = self.drive(&mut sdirk, &mut ws.state, times, out);
+                ws.sdirk = sdirk.into_buffers();
+                result
             }
+        }
+    }
+
+    /// How many leading entries of level `k`'s state are under error control: the states,
+    /// and with [`IntegratorOptions::sensitivity_error_control`] the first-order
+    /// sensitivities too (all of level 1; of a higher level, its part that is level 1, so
+    /// that every level ≥ 1 takes the same steps).
+    fn controlled(&self, k: usize) -> usize {
+        if self.options.sensitivity_error_control && k >= 1 {
+            self.levels[1].nz
+        } else {
+            self.nx
         }
     }
 
@@ -410,9 +522,12 @@ fn check_options(t0: f64, tf: f64, options: &IntegratorOptions) -> Result<(), In
     Ok(())
 }
 
-/// The buffers of one integration: the state and the explicit stepper's stages.
+/// The buffers of one integration: the state, the stepper's buffers and, for an adjoint
+/// integration, the tape of its steps.
 #[derive(Debug, Default)]
 struct Workspace {
     state: Vec<f64>,
     dopri: DopriBuffers,
+    sdirk: SdirkBuffers,
+    tape: Option<Vec<f64>>,
 }

@@ -90,6 +90,18 @@ pub struct IntegratorOptions {
     pub initial_step: Option<f64>,
     /// The integration method (default [`Method::Dopri5`]).
     pub method: Method,
+    /// Whether the forward sensitivities take part in the step-size control (CVODES'
+    /// `fsens_err_con`; default `false`). When `true`, an integration that computes
+    /// sensitivities ([`Integrator::simulate_with_jacobian`](super::Integrator::simulate_with_jacobian),
+    /// [`Integrator::to_function`](super::Integrator::to_function)) accepts a step only if
+    /// the error of every column of `∂x/∂(x₀, p)` is within the tolerances too (the largest
+    /// weighted RMS norm over `x` and the columns, weights `atol + rtol·|·|`): accurate
+    /// sensitivities where the variational equations have a fast transient that `x` alone
+    /// does not (a relaxation jump), at the price of more, smaller steps. Off by default
+    /// because the states then choose the steps alone: the sensitivities are the exact
+    /// derivatives of the very map [`Integrator::simulate`](super::Integrator::simulate)
+    /// computes, and an integration with sensitivities costs no extra steps.
+    pub sensitivity_error_control: bool,
 }
 
 impl Default for IntegratorOptions {
@@ -100,6 +112,7 @@ impl Default for IntegratorOptions {
             max_steps: 100_000,
             initial_step: None,
             method: Method::Dopri5,
+            sensitivity_error_control: false,
         }
     }
 }
@@ -127,8 +140,12 @@ pub struct IntegratorStats {
     pub rejected: usize,
     /// Right-hand side evaluations.
     pub rhs_evaluations: usize,
-    /// Jacobian evaluations and LU factorizations (implicit method; 0 for DOPRI5).
+    /// LU factorizations of the Newton matrix `I − hγ f_x` (implicit method; 0 for
+    /// DOPRI5). Kept across steps while Newton's iteration converges fast (RADAU5's rule).
     pub factorizations: usize,
+    /// Evaluations of the Jacobian `f_x` for the Newton matrix (implicit method; 0 for
+    /// DOPRI5).
+    pub jacobians: usize,
     /// Steps rejected because Newton's iteration did not converge (implicit method;
     /// included in `rejected`).
     pub newton_failures: usize,

@@ -42,3 +42,25 @@ pub(super) fn next_step_size(
         h * 0.2
     }
 }
+
+/// The error norm of the step-size control: the largest weighted RMS norm over the blocks
+/// of `block` consecutive entries among the first `len` (`len` a multiple of `block`: the
+/// states, then each sensitivity column when they are under error control), `scaled(i)`
+/// being entry `i`'s error divided by its weight. With one block this is the usual
+/// weighted RMS norm.
+pub(super) fn error_norm(len: usize, block: usize, mut scaled: impl FnMut(usize) -> f64) -> f64 {
+    let mut worst = 0.0f64;
+    for start in (0..len.max(1)).step_by(block.max(1)) {
+        let mut sum = 0.0;
+        for i in start..(start + block).min(len) {
+            let r = scaled(i);
+            sum += r * r;
+        }
+        let norm = (sum / block.max(1) as f64).sqrt();
+        // A NaN norm wins and stays (the step is then rejected as non-finite).
+        if norm.is_nan() || norm > worst {
+            worst = norm;
+        }
+    }
+    worst
+}
