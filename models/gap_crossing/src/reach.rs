@@ -438,12 +438,14 @@ mod tests {
             let heights = (0..7)
                 .map(|_| (0..21).map(|i| h(-1.0 + 0.5 * i as f64)).collect())
                 .collect();
-            let mut s = Scenario::default();
-            s.terrain = crate::scenario::TerrainSpec::HeightMap {
-                file: "test".into(),
-                origin: [-1.0, -1.0],
-                spacing: [0.5, 0.5],
-                heights,
+            let s = Scenario {
+                terrain: crate::scenario::TerrainSpec::HeightMap {
+                    file: "test".into(),
+                    origin: [-1.0, -1.0],
+                    spacing: [0.5, 0.5],
+                    heights,
+                },
+                ..Scenario::default()
             };
             s.validate().unwrap();
             s

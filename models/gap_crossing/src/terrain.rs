@@ -473,13 +473,13 @@ const POWER_TO_BERNSTEIN: [[f64; 4]; 4] = [
 /// `[0, size[0]] × [0, size[1]]`: a range holding its values there.
 fn bernstein_range(c: &[f64; 16], size: [f64; 2]) -> [f64; 2] {
     let mut range = [f64::INFINITY, f64::NEG_INFINITY];
-    for k in 0..4 {
-        for l in 0..4 {
+    for bk in &POWER_TO_BERNSTEIN {
+        for bl in &POWER_TO_BERNSTEIN {
             let mut v = 0.0;
             for b in 0..4 {
                 for a in 0..4 {
                     let d = c[a + 4 * b] * size[0].powi(a as i32) * size[1].powi(b as i32);
-                    v += POWER_TO_BERNSTEIN[k][a] * POWER_TO_BERNSTEIN[l][b] * d;
+                    v += bk[a] * bl[b] * d;
                 }
             }
             range = [range[0].min(v), range[1].max(v)];
