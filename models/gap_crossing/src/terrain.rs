@@ -609,7 +609,7 @@ impl HeightMap {
     /// Why a grid of `n = [nx, ny]` nodes at `origin` with `spacing` and heights up to
     /// `max_abs` cannot be tabulated, if it cannot: its points (ghost and padding nodes
     /// included) must be distinct numbers, and the polynomial coefficients (up to
-    /// 144·max|z|/(Δx³Δy³), the bound of [`CATMULL_ROM`]'s rows times the ghost nodes'
+    /// 144·max|z|/(Δx³Δy³), the bound of the Catmull-Rom segment matrix's rows times the ghost nodes'
     /// 3·max|z|, with a 1e6 margin for derivative tables) finite.
     pub fn grid_problem(
         origin: [f64; 2],
