@@ -130,6 +130,51 @@ impl Interpolant2 {
         Interpolant2::fit(x, y, values, 4, not_a_knot_fit, false)
     }
 
+    /// A piecewise bicubic (or lower) polynomial given cell by cell: on the cell
+    /// `[x[i], x[i+1]] × [y[j], y[j+1]]` the table is `Σ_a Σ_b c[a + 4b] · s^a · t^b` with
+    /// `s = x − x[i]`, `t = y − y[j]`, `a, b ≤ 3`, where `c` is the block of 16
+    /// coefficients starting at `coeffs[16·(i + (nx − 1)·j)]`. Each grid strictly
+    /// increasing, at least two points, every coefficient finite. With `extrapolate` the
+    /// end cells' polynomials extend beyond the grid, else the table is zero there. For
+    /// interpolation schemes the other constructors do not offer (e.g. Catmull-Rom).
+    /// ```
+    /// use symx::Interpolant2;
+    /// // f(x, y) = x·y on one cell [1, 2] × [0, 1]: (1 + s)·t = t + s·t.
+    /// let mut c = vec![0.0; 16];
+    /// c[4] = 1.0; // t
+    /// c[5] = 1.0; // s·t
+    /// let table = Interpolant2::from_cells(&[1.0, 2.0], &[0.0, 1.0], &c, false).unwrap();
+    /// assert_eq!(table.value(1.5, 0.5), 0.75);
+    /// assert_eq!(table.value(3.0, 0.5), 0.0);
+    /// ```
+    pub fn from_cells(
+        x: &[f64],
+        y: &[f64],
+        coeffs: &[f64],
+        extrapolate: bool,
+    ) -> Result<Interpolant2, SymxError> {
+        check_grid("x grid", x, 2)?;
+        check_grid("y grid", y, 2)?;
+        let cells = (x.len() - 1) * (y.len() - 1);
+        if coeffs.len() != 16 * cells {
+            return Err(SymxError::Table {
+                reason: format!(
+                    "{cells} cells need {} coefficients, got {}",
+                    16 * cells,
+                    coeffs.len()
+                ),
+            });
+        }
+        if let Some(i) = coeffs.iter().position(|v| !v.is_finite()) {
+            return Err(SymxError::Table {
+                reason: format!("coefficient {i} is not finite"),
+            });
+        }
+        Ok(Interpolant2 {
+            table: Arc::new(Table::from_cells(&[x, y], coeffs.to_vec(), extrapolate)),
+        })
+    }
+
     fn fit(
         x: &[f64],
         y: &[f64],
@@ -158,6 +203,37 @@ impl Interpolant2 {
     /// The table's value at a point.
     pub fn value(&self, x: f64, y: f64) -> f64 {
         self.table.eval(&[x, y])
+    }
+
+    /// The partial derivative along `axis` (0: x, 1: y) applied to two expressions: the
+    /// node that differentiating [`Interpolant2::eval`] gives, on the same derivative
+    /// table of this thread's graph (built once per graph, unlike looking up
+    /// [`Interpolant2::derivative`]); `Err` for another axis.
+    /// ```
+    /// use symx::{Expr, Function, Interpolant2};
+    /// let table = Interpolant2::linear(&[0.0, 1.0], &[0.0, 1.0], &[0.0, 1.0, 10.0, 11.0]).unwrap();
+    /// let (x, y) = (Expr::sym("x"), Expr::sym("y"));
+    /// let dy = table.eval_partial(1, x, y).unwrap();
+    /// let f = Function::new(&[&[x, y]], &[&[dy]]).unwrap();
+    /// assert_eq!(f.call(&[&[0.5, 0.5]]).unwrap(), vec![vec![10.0]]);
+    /// ```
+    pub fn eval_partial(
+        &self,
+        axis: usize,
+        x: impl Into<Expr>,
+        y: impl Into<Expr>,
+    ) -> Result<Expr, SymxError> {
+        if axis > 1 {
+            return Err(SymxError::Table {
+                reason: format!("axis {axis} of a 2-D table"),
+            });
+        }
+        let (x, y) = (x.into().id, y.into().id);
+        Ok(Expr::from_id(graph::with(|g| {
+            let t = g.table_id(&self.table);
+            let d = g.derivative_table(t, axis);
+            g.interpolant2(x, y, d)
+        })))
     }
 
     /// The table of the partial derivative along `axis` (0: x, 1: y); `Err` for another axis.

@@ -89,6 +89,16 @@ impl Table {
         }
     }
 
+    /// A table from given per-cell coefficients (`4^d` per cell, cells with axis 0
+    /// fastest, as stored). The sizes must have been checked ([`Table::check`]).
+    pub fn from_cells(grids: &[&[f64]], coeffs: Vec<f64>, extrapolate: bool) -> Table {
+        Table {
+            grids: grids.iter().map(|g| g.to_vec()).collect(),
+            coeffs,
+            extrapolate,
+        }
+    }
+
     /// Why this table (read from a file) cannot be evaluated, if it cannot: 1 to 8 axes of
     /// at least 2 finite, strictly increasing points, `4^d` coefficients per cell.
     pub fn check(&self) -> Result<(), String> {

@@ -291,6 +291,9 @@ impl Checker<'_> {
         if measured {
             return;
         }
+        if k >= 2 {
+            self.body_height(k, st);
+        }
         // (6)–(9) foot distances.
         let pairs = [
             ("(6)", Foot::BR, Foot::FR, s.same_side_sq),
@@ -315,6 +318,38 @@ impl Checker<'_> {
                 what,
                 d2 - bounds.max,
             );
+        }
+    }
+
+    /// The optional body-height limits (`motion.body_height_min`/`max`) at stance `k`.
+    fn body_height(&mut self, k: usize, st: &Stance) {
+        let m = self.s.motion;
+        for j in Biped::ALL {
+            let c = st.com.get(j);
+            let above = c[2] - self.terrain.height_at(c[0], c[1]);
+            let who = Some(j.name().to_string());
+            if let Some(lo) = m.body_height_min {
+                let name =
+                    format!("body height above the ground below motion.body_height_min = {lo} (m)");
+                self.test("motion", &name, k, who.clone(), lo - above);
+            }
+            if let Some(hi) = m.body_height_max {
+                let name =
+                    format!("body height above the ground above motion.body_height_max = {hi} (m)");
+                self.test("motion", &name, k, who.clone(), above - hi);
+            }
+        }
+    }
+
+    /// The optional CoM travel limit (`motion.com_travel_max`) between stances k and k+1.
+    fn com_travel(&mut self, k: usize, a: &Stance, b: &Stance) {
+        let Some(t) = self.s.motion.com_travel_max else {
+            return;
+        };
+        for j in Biped::ALL {
+            let d = dist2(a.com.get(j), b.com.get(j)).sqrt();
+            let name = format!("CoM travel above motion.com_travel_max = {t} (m)");
+            self.test("motion", &name, k, Some(j.name().to_string()), d - t);
         }
     }
 
@@ -426,6 +461,7 @@ pub fn check_with(file: &SolutionFile, opts: &Options) -> Report {
             continue;
         }
         let turn = (s.gait == Gait::Crawl).then(|| schedule[k]);
+        c.com_travel(k + 1, &st[k], &st[k + 1]);
         moves += c.transition(k + 1, &st[k], &st[k + 1], turn);
     }
     let max_residual = c.max_residual;

@@ -27,22 +27,23 @@ pub const BYTES_PER_STANCE: u64 = 3 << 18;
 /// Memory assumed available when the system does not say (bytes).
 pub const FALLBACK_AVAILABLE_BYTES: u64 = 4 << 30;
 
-/// Memory per stance and per height-map node (bytes), 12 KiB: the model states a height
-/// map's height and slope as a sum over every node of the grid, at every foot query.
-/// Peak resident memory of the release CLI, crawl gait, n_step 60, 2026-11-27 (machine
-/// loaded; `/usr/bin/time -f %M`): 162 MiB on a 21 × 7 grid (147 nodes), 319 MiB on
-/// 41 × 13 (533 nodes); issue 20 reports 2.0 GB on a 0.1 m grid over 10 m × 3 m (3131
-/// nodes). With [`BYTES_PER_STANCE`] and [`BASE_BYTES`] the estimate is 212 MiB, 484 MiB
-/// and 2.3 GiB: 1.1–1.5× those peaks.
-pub const BYTES_PER_STANCE_NODE: u64 = 12 << 10;
+/// Memory per height-map node (bytes), 6 KiB, independent of `n_step`: the model looks a
+/// height map up in tables of one bicubic polynomial per cell (16 coefficients, 128 bytes
+/// per node), the table of `h` and the derivative tables (to third order) the model's
+/// derivatives use, which each thread's expression graph builds for itself. Peak resident
+/// memory of the release CLI, free gait, n_step 60, 2026-11-27 (machine loaded;
+/// `/usr/bin/time -f %M`): 49 MiB on a 0.1 m grid over 10 m × 3 m (3131 nodes), 316 MiB
+/// on a 0.02 m grid (75651 nodes), against 34 MiB for the default scenario: 3.8–4.8 KiB
+/// per node; the estimate (127 MiB and 552 MiB) is 1.7–2.6× those peaks.
+pub const BYTES_PER_GRID_NODE: u64 = 6 << 10;
 
 /// A problem too large for the memory available.
 #[derive(Debug, thiserror::Error)]
 #[error(
     "n_step = {n_step}{} is too large: building and solving it needs about {} of memory \
-     (estimate {} + {} per stance{}), but {} is available; at most n_step = {max_n_step} fits",
-    grid_text(*nodes), gib(*estimate), gib(BASE_BYTES), mib(BYTES_PER_STANCE),
-    node_text(*nodes), gib(*available)
+     (estimate {}{} + {} per stance), but {} is available; {}",
+    grid_text(*nodes), gib(*estimate), gib(BASE_BYTES), node_text(*nodes),
+    mib(BYTES_PER_STANCE), gib(*available), fits_text(*max_n_step, *nodes)
 )]
 pub struct TooLarge {
     /// The scenario's `n_step`.
@@ -69,7 +70,17 @@ fn node_text(nodes: usize) -> String {
     if nodes == 0 {
         String::new()
     } else {
-        format!(" + {} per stance and node", kib(BYTES_PER_STANCE_NODE))
+        format!(" + {} per grid node", kib(BYTES_PER_GRID_NODE))
+    }
+}
+
+fn fits_text(max_n_step: usize, nodes: usize) -> String {
+    if max_n_step >= 2 {
+        format!("at most n_step = {max_n_step} fits")
+    } else if nodes > 0 {
+        "the height map alone does not fit: use a coarser grid".into()
+    } else {
+        "no n_step fits".into()
     }
 }
 
@@ -93,11 +104,12 @@ pub fn memory_estimate(n_step: usize) -> u64 {
 /// Estimated peak memory of planning `n_step` stances on a height map of `nodes` nodes
 /// (0: another terrain), bytes.
 pub fn memory_estimate_on_grid(n_step: usize, nodes: usize) -> u64 {
-    BASE_BYTES.saturating_add(per_stance(nodes).saturating_mul(n_step as u64))
+    fixed(nodes).saturating_add(BYTES_PER_STANCE.saturating_mul(n_step as u64))
 }
 
-fn per_stance(nodes: usize) -> u64 {
-    BYTES_PER_STANCE.saturating_add(BYTES_PER_STANCE_NODE.saturating_mul(nodes as u64))
+/// The part of the estimate that does not grow with `n_step`.
+fn fixed(nodes: usize) -> u64 {
+    BASE_BYTES.saturating_add(BYTES_PER_GRID_NODE.saturating_mul(nodes as u64))
 }
 
 /// The number of nodes of `s`'s height map (0 for other terrains).
@@ -128,7 +140,7 @@ pub fn check_with(s: &Scenario, available: u64) -> Result<(), TooLarge> {
         nodes,
         estimate,
         available,
-        max_n_step: (available.saturating_sub(BASE_BYTES) / per_stance(nodes)) as usize,
+        max_n_step: (available.saturating_sub(fixed(nodes)) / BYTES_PER_STANCE) as usize,
     })
 }
 
@@ -160,8 +172,9 @@ mod tests {
         );
     }
 
-    /// A height map's grid counts: 2000 × 2000 nodes at n_step 60 need terabytes and are
-    /// refused with the grid in the message; the 16 × 5 hills grid fits.
+    /// A height map's grid counts once (not per stance): 2000 × 2000 nodes need 15 GiB
+    /// and are refused with the grid in the message; a 0.02 m grid over 10 m × 3 m
+    /// (501 × 151 nodes) fits at n_step 60.
     #[test]
     fn counts_the_height_map_grid() {
         let grid = |nx: usize, ny: usize| Scenario {
@@ -173,14 +186,17 @@ mod tests {
             },
             ..Scenario::default()
         };
-        let avail = 16u64 << 30;
+        let avail = 8u64 << 30;
         assert!(check_with(&grid(16, 5), avail).is_ok());
+        assert!(check_with(&grid(501, 151), avail).is_ok());
         let e = check_with(&grid(2000, 2000), avail).unwrap_err();
         assert_eq!(e.nodes, 4_000_000);
         assert_eq!(e.max_n_step, 0);
         let msg = e.to_string();
         assert!(
-            msg.contains("height map of 4000000 nodes") && msg.contains("per stance and node"),
+            msg.contains("height map of 4000000 nodes")
+                && msg.contains("per grid node")
+                && msg.contains("use a coarser grid"),
             "{msg}"
         );
     }

@@ -289,6 +289,42 @@ fn stance_constraints(
         }
         foot_distances(pb, s, label, &v.feet[k])?;
         rigid_legs(pb, s, label, &v.coms[k], &v.feet[k])?;
+        motion_limits(pb, s, terrain, label, &v.coms[k - 1], &v.coms[k])?;
+    }
+    Ok(())
+}
+
+/// The scenario's optional [`crate::scenario::MotionLimits`] at stance `label` (≥ 2):
+/// each CoM's height above the ground under it, and its travel from the previous stance.
+/// Nothing when no limit is set.
+fn motion_limits(
+    pb: &mut Problem,
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    label: usize,
+    previous: &[Matrix; 2],
+    coms: &[Matrix; 2],
+) -> Result<(), BuildError> {
+    let m = &s.motion;
+    for (j, (c, before)) in Biped::ALL.iter().zip(coms.iter().zip(previous)) {
+        if m.body_height_min.is_some() || m.body_height_max.is_some() {
+            let above = c[2] - terrain.height(c[0], c[1]);
+            let name = format!("motion body height {}, stance {label}", j.name());
+            pb.subject_to_named(
+                &name,
+                nlp::bounded(
+                    m.body_height_min.unwrap_or(f64::NEG_INFINITY),
+                    above,
+                    m.body_height_max.unwrap_or(f64::INFINITY),
+                ),
+            )?;
+        }
+        if let Some(t) = m.com_travel_max {
+            pb.subject_to_named(
+                &format!("motion CoM travel {}, stance {label}", j.name()),
+                (c - before).sumsqr().le(t * t),
+            )?;
+        }
     }
     Ok(())
 }

@@ -11,14 +11,26 @@
 //! [`uncrossable`]: a foot stands only in the terrain's allowed regions, and can step
 //! from one region to another only when their horizontal distance is below `r` (at
 //! distance ≥ r a step would need `‖Δr‖ ≥ r`; the spec counts equality as not crossable,
-//! see docs/gap-crossing.md). If no region reachable that way from a foot's start comes
-//! within `ρ` of its goal CoM, no plan reaches the goal. For the spec's gap this is "the
-//! keep-out zone (gap plus both margins) is at least as wide as the step reach".
+//! see docs/gap-crossing.md). If no point of the ground over a region reachable that way
+//! from a foot's start comes within `ρ` of its goal CoM (3-D: [`Terrain::distance_from`],
+//! with the ground's height range where the terrain bounds it), no plan reaches the goal.
+//! For the spec's gap this is "the keep-out zone (gap plus both margins) is at least as
+//! wide as the step reach"; on a height map (one region, the grid's rectangle) it is "the
+//! goal CoM is farther than ρ from the ground", e.g. a goal 1.5 m above a flat map.
+//!
+//! A continuous surface has no rise certificate for a single step: however steep, it can
+//! be climbed in steps shorter than `r`. What a height map's rises and drops do bound is
+//! the height of the final feet (the goal CoM high above the highest ground needs feet
+//! on ground within ρ in 3-D, above) and the moves (below: the 3-D distance from a foot's
+//! start to its goal CoM, and `h_top` = the largest height on the map). The heights and
+//! slopes of a height map are bounded cell by cell by the Bernstein coefficients of its
+//! bicubic pieces (`terrain::HeightMap`), which also gives the slope bound of
+//! [`force_threshold`].
 //!
 //! [`stances_needed`]: each foot needs at least `⌈(‖start − goal CoM‖ − ρ)/r⌉` moves
 //! and one foot moves per transition (10), so `1 + Σ` moves stances at least. Sharper,
 //! when the terrain's height is bounded above by `h_top` (`Terrain::height_bound`: 0
-//! for gaps and stones, the rise of a step up; none for a height map) and the goal CoM
+//! for gaps and stones, the rise of a step up; a height map's largest height) and the goal CoM
 //! is more than `GOAL_TOL` above it: the final CoM is at least `a = z_goal − GOAL_TOL −
 //! h_top` above the final foot, which is at `√leg_length_sq` from it, so the foot ends
 //! within `√(leg_length_sq − a²)` of the CoM horizontally and within
@@ -56,7 +68,9 @@ pub struct Uncrossable {
     pub reach: f64,
     /// How close to its goal CoM the foot must end, ρ (m).
     pub need_within: f64,
-    /// Horizontal distance from the goal CoM to the nearest point the foot can stand on (m).
+    /// A lower bound on the 3-D distance from the goal CoM to the points the foot can
+    /// stand on (m; [`Terrain::distance_from`]: horizontal, and vertical where the terrain
+    /// bounds its heights).
     pub nearest: f64,
     /// The x range covered by the regions the foot can reach (m).
     pub reachable_x: [f64; 2],
@@ -81,7 +95,7 @@ impl fmt::Display for Uncrossable {
         }
         write!(
             f,
-            "; it must end within {:.4} m of its goal CoM (leg + 0.05 m goal tolerance) but can come no closer than {:.4} m",
+            "; it must end within {:.4} m of its goal CoM (leg + 0.05 m goal tolerance) but can come no closer than {:.4} m (3-D, the ground's heights included)",
             self.need_within, self.nearest
         )
     }
@@ -239,7 +253,7 @@ pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
         let ok = reachable(terrain, &regions, p[0], p[1], reach);
         let nearest = ok
             .iter()
-            .map(|&k| regions[k].distance_to(g[0], g[1]))
+            .map(|&k| terrain.distance_from(&regions[k], g))
             .fold(f64::INFINITY, f64::min);
         if nearest <= rho {
             continue;
@@ -408,6 +422,46 @@ mod tests {
         let tail = 0.35 / (std::f64::consts::PI * 1e4);
         assert!((d - 0.02f64.hypot(0.35 - 2.0 * tail)).abs() < 1e-9, "{c}");
         s.apply_overrides(&["terrain.rise=0.25"]).unwrap();
+        assert_eq!(uncrossable(&s), None);
+    }
+
+    /// The default scenario on a height map over x ∈ [−1, 9], y ∈ [−1, 2] (0.5 m grid):
+    /// flat (0), nothing is certified and the stance bound is the default's 37 (the map's
+    /// height bound is 0, exactly: the Bernstein coefficients of a flat map vanish);
+    /// with the back goal CoM 1.5 m above the ground, every foot of the back biped must
+    /// end within ρ = 0.7571 m of it but the ground is 1.5 m below it: certified, with
+    /// 1.5000 in the message. A 0.6 m plateau from x = 4 on with the front goal CoM 0.5 m
+    /// above it (1.1 m) is not certified (it can be climbed in short steps).
+    #[test]
+    fn height_map_certificates() {
+        let map = |h: &dyn Fn(f64) -> f64| -> Scenario {
+            let heights = (0..7)
+                .map(|_| (0..21).map(|i| h(-1.0 + 0.5 * i as f64)).collect())
+                .collect();
+            let s = Scenario {
+                terrain: crate::scenario::TerrainSpec::HeightMap {
+                    file: "test".into(),
+                    origin: [-1.0, -1.0],
+                    spacing: [0.5, 0.5],
+                    heights,
+                },
+                ..Scenario::default()
+            };
+            s.validate().unwrap();
+            s
+        };
+        let mut s = map(&|_| 0.0);
+        assert_eq!(terrain::of(&s).height_bound(), Some(0.0));
+        assert_eq!(uncrossable(&s), None);
+        assert_eq!(force_threshold(&s, &*terrain::of(&s)), None);
+        assert_eq!(stances_needed(&s).needed, 37);
+        s.goal.b[2] = 1.5;
+        let c = uncrossable(&s).expect("certificate");
+        assert!(matches!(c.foot, Foot::BR | Foot::BL), "{c}");
+        assert!((c.nearest - 1.5).abs() < 1e-12, "{c}");
+        assert!(c.to_string().contains("no closer than 1.5000 m"), "{c}");
+        let mut s = map(&|x| if x >= 4.0 { 0.6 } else { 0.0 });
+        s.goal.f[2] = 1.1;
         assert_eq!(uncrossable(&s), None);
     }
 

@@ -15,7 +15,8 @@
 //!   tensor-product Catmull-Rom spline (C¹), allowed on the grid's rectangle.
 use crate::scenario::{Gap, Scenario, TerrainSpec};
 use std::f64::consts::PI;
-use symx::{if_else, le, lt, Expr};
+use std::sync::OnceLock;
+use symx::{Expr, Interpolant2};
 
 /// A closed axis-aligned box `x[0] ≤ x ≤ x[1]`, `y[0] ≤ y ≤ y[1]` (bounds may be infinite).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,6 +98,14 @@ pub trait Terrain: Send + Sync {
         None
     }
 
+    /// A lower bound on the 3-D distance from `p` to the points of the ground over region
+    /// `r`: the horizontal distance to `r` and, when [`Terrain::height_range`] knows the
+    /// heights there, the vertical distance from `p` to that range.
+    fn distance_from(&self, r: &Region, p: [f64; 3]) -> f64 {
+        let vertical = self.height_range(r).map_or(0.0, |h| outside(p[2], h));
+        r.distance_to(p[0], p[1]).hypot(vertical)
+    }
+
     /// Unit surface normal `(−h_x, −h_y, 1)/‖·‖` at a point (points up, out of the ground).
     fn normal_at(&self, x: f64, y: f64) -> [f64; 3] {
         let [hx, hy] = self.slope_at(x, y);
@@ -143,12 +152,13 @@ pub fn of(s: &Scenario) -> Box<dyn Terrain> {
             spacing,
             heights,
             ..
-        } => Box::new(HeightMap {
-            origin: *origin,
-            spacing: *spacing,
-            heights: heights.clone(),
-        }),
+        } => Box::new(HeightMap::new(*origin, *spacing, heights.clone())),
     }
+}
+
+/// How far `z` lies outside `[lo, hi]` (0 inside).
+fn outside(z: f64, [lo, hi]: [f64; 2]) -> f64 {
+    (lo - z).max(z - hi).max(0.0)
 }
 
 /// `(D/π)·atan(k·(x − edge))`: a smoothed step of height `D` at `edge` (symbolic).
@@ -409,24 +419,19 @@ pub fn catmull_rom_slope(t: f64) -> f64 {
     d * t.signum()
 }
 
-/// [`catmull_rom`] and its derivative as expressions of `t`.
-fn catmull_rom_expr(t: Expr) -> (Expr, Expr) {
-    let a = t.abs();
-    let inner = (1.5 * a - 2.5) * a * a + 1.0;
-    let outer = ((-0.5 * a + 2.5) * a - 4.0) * a + 2.0;
-    let d_inner = (4.5 * a - 5.0) * a;
-    let d_outer = (-1.5 * a + 5.0) * a - 4.0;
-    let k = if_else(le(a, 1.0), inner, if_else(lt(a, 2.0), outer, 0.0));
-    let dk = t.sign() * if_else(le(a, 1.0), d_inner, if_else(lt(a, 2.0), d_outer, 0.0));
-    (k, dk)
-}
-
 /// A height map: `heights[j][i]` is the height at `x = origin[0] + i·spacing[0]`,
 /// `y = origin[1] + j·spacing[1]`, interpolated by the tensor-product Catmull-Rom spline
 /// `h(x, y) = Σ_i Σ_j z_ij K((x − x_i)/Δx) K((y − y_j)/Δy)`, with one ghost node beyond
 /// each edge, linearly extrapolated (`z_{−1} = 2z_0 − z_1`), so that the surface is C¹,
 /// passes through every node and reproduces planes exactly. Feet stay on the grid's
 /// rectangle.
+///
+/// The spline is a bicubic polynomial on each cell, so the model states `h` as one
+/// lookup node of a [`symx::Interpolant2`] holding those polynomials (its gradient and
+/// higher derivatives are lookups of derivative tables): the model's size and the cost
+/// of an evaluation do not depend on the grid's size. The numeric [`Terrain::height_at`]
+/// sums the kernel over the at most 4 × 4 nodes around the point, an independent
+/// computation of the same surface (equal to rounding).
 #[derive(Clone, Debug)]
 pub struct HeightMap {
     /// `(x, y)` of node `[0][0]` (m).
@@ -435,7 +440,90 @@ pub struct HeightMap {
     pub spacing: [f64; 2],
     /// Heights, one row per y, one column per x (m); at least 2 × 2.
     pub heights: Vec<Vec<f64>>,
+    /// The lookup table of `h`, built on first use.
+    surface: OnceLock<Result<Interpolant2, String>>,
+    /// Bounds on each cell of the rectangle, row by row, built on first use.
+    bounds: OnceLock<Vec<CellBounds>>,
 }
+
+/// What is known of the surface on one grid cell: a range holding its heights and a bound
+/// on its slope, from the Bernstein coefficients of the cell's bicubic and of its partial
+/// derivatives (a polynomial lies within the range of its Bernstein coefficients; Farin,
+/// *Curves and Surfaces for CAGD*, §5.3 and §16.2).
+#[derive(Clone, Debug)]
+struct CellBounds {
+    /// The cell.
+    box_: Region,
+    /// `[min, max]` of the height over the cell (m), or a range holding them.
+    h: [f64; 2],
+    /// A bound on `‖∇h‖` over the cell.
+    slope: f64,
+}
+
+/// `B[k][a] = C(k, a)/C(3, a)`: the power coefficient `a` of a cubic on [0, 1] contributes
+/// `B[k][a]` times itself to Bernstein coefficient `k`.
+const POWER_TO_BERNSTEIN: [[f64; 4]; 4] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [1.0, 1.0 / 3.0, 0.0, 0.0],
+    [1.0, 2.0 / 3.0, 1.0 / 3.0, 0.0],
+    [1.0, 1.0, 1.0, 1.0],
+];
+
+/// `[min, max]` of the Bernstein coefficients of `Σ c[a + 4b] s^a t^b` on
+/// `[0, size[0]] × [0, size[1]]`: a range holding its values there.
+fn bernstein_range(c: &[f64; 16], size: [f64; 2]) -> [f64; 2] {
+    let mut range = [f64::INFINITY, f64::NEG_INFINITY];
+    for bk in &POWER_TO_BERNSTEIN {
+        for bl in &POWER_TO_BERNSTEIN {
+            let mut v = 0.0;
+            for b in 0..4 {
+                for a in 0..4 {
+                    let d = c[a + 4 * b] * size[0].powi(a as i32) * size[1].powi(b as i32);
+                    v += bk[a] * bl[b] * d;
+                }
+            }
+            range = [range[0].min(v), range[1].max(v)];
+        }
+    }
+    range
+}
+
+impl CellBounds {
+    fn of(c: &[f64], corner: [f64; 2], size: [f64; 2]) -> CellBounds {
+        let mut h = [0.0; 16];
+        h.copy_from_slice(c);
+        // ∂/∂s and ∂/∂t, again as bicubics (their top powers zero).
+        let (mut hs, mut ht) = ([0.0; 16], [0.0; 16]);
+        for b in 0..4 {
+            for a in 0..3 {
+                hs[a + 4 * b] = (a + 1) as f64 * h[a + 1 + 4 * b];
+                ht[b + 4 * a] = (a + 1) as f64 * h[b + 4 * (a + 1)];
+            }
+        }
+        let abs_max = |r: [f64; 2]| r[0].abs().max(r[1].abs());
+        CellBounds {
+            box_: Region {
+                x: [corner[0], corner[0] + size[0]],
+                y: [corner[1], corner[1] + size[1]],
+            },
+            h: bernstein_range(&h, size),
+            slope: abs_max(bernstein_range(&hs, size)).hypot(abs_max(bernstein_range(&ht, size))),
+        }
+    }
+}
+
+/// Nodes of zero height added beyond each ghost node, so that the table covers the whole
+/// support of the kernel sum (which vanishes 2 spacings beyond the ghost nodes).
+const PAD: isize = 2;
+
+/// The Catmull-Rom segment between nodes `k` and `k + 1` in powers of `u = (x − x_k)/Δ`:
+/// `p(u) = Σ_a Σ_o CATMULL_ROM[a][o] · z_{k−1+o} · u^a` (the kernel's pieces, regrouped).
+const CATMULL_ROM: [[f64; 4]; 4] = [
+    [0.0, 1.0, 0.0, 0.0],
+    [-0.5, 0.0, 0.5, 0.0],
+    [1.0, -2.5, 2.0, -0.5],
+    [-0.5, 1.5, -1.5, 0.5],
+];
 
 impl HeightMap {
     fn nx(&self) -> usize {
@@ -499,33 +587,159 @@ impl HeightMap {
         (h, [hx, hy])
     }
 
-    /// Height and gradient as expressions: a sum over every node of the grid (symx has no
-    /// lookup of a piecewise polynomial other than its own splines), so the model grows
-    /// with the grid ([`crate::limits::BYTES_PER_STANCE_NODE`]).
-    fn expr(&self, x: Expr, y: Expr) -> (Expr, [Expr; 2]) {
-        let (is, js) = self.indices();
-        let [dx, dy] = self.spacing;
-        let kx: Vec<(isize, Expr, Expr)> = is
-            .map(|i| {
-                let (k, d) = catmull_rom_expr((x - self.origin[0]) / dx - i as f64);
-                (i, k, d / dx)
-            })
-            .collect();
-        let (mut h, mut hx, mut hy) = (Expr::zero(), Expr::zero(), Expr::zero());
-        for j in js {
-            let (ky, dky) = catmull_rom_expr((y - self.origin[1]) / dy - j as f64);
-            let dky = dky / dy;
-            let (mut row, mut drow) = (Expr::zero(), Expr::zero());
-            for (i, k, d) in &kx {
-                let z = self.node(*i, j);
-                row += z * *k;
-                drow += z * *d;
-            }
-            h += row * ky;
-            hx += drow * ky;
-            hy += row * dky;
+    /// The height map of `heights` on the grid at `origin` with `spacing`.
+    pub fn new(origin: [f64; 2], spacing: [f64; 2], heights: Vec<Vec<f64>>) -> HeightMap {
+        HeightMap {
+            origin,
+            spacing,
+            heights,
+            surface: OnceLock::new(),
+            bounds: OnceLock::new(),
         }
-        (h, [hx, hy])
+    }
+
+    /// The grid's points along one axis (`n` nodes, `origin`, `spacing`) with the ghost
+    /// node and [`PAD`] zero nodes beyond each end.
+    fn padded_axis(origin: f64, spacing: f64, n: usize) -> Vec<f64> {
+        (-1 - PAD..=n as isize + PAD)
+            .map(|p| origin + p as f64 * spacing)
+            .collect()
+    }
+
+    /// Why a grid of `n = [nx, ny]` nodes at `origin` with `spacing` and heights up to
+    /// `max_abs` cannot be tabulated, if it cannot: its points (ghost and padding nodes
+    /// included) must be distinct numbers, and the polynomial coefficients (up to
+    /// 144·max|z|/(Δx³Δy³), the bound of the Catmull-Rom segment matrix's rows times the ghost nodes'
+    /// 3·max|z|, with a 1e6 margin for derivative tables) finite.
+    pub fn grid_problem(
+        origin: [f64; 2],
+        spacing: [f64; 2],
+        n: [usize; 2],
+        max_abs: f64,
+    ) -> Option<String> {
+        for k in 0..2 {
+            let axis = HeightMap::padded_axis(origin[k], spacing[k], n[k]);
+            if axis.windows(2).any(|w| w[1] <= w[0]) || axis.iter().any(|v| !v.is_finite()) {
+                return Some(format!(
+                    "spacing {} is too fine for coordinates near {}: the grid's points are not distinct numbers",
+                    spacing[k], origin[k]
+                ));
+            }
+        }
+        let bound = 144e6 * max_abs / (spacing[0].powi(3) * spacing[1].powi(3));
+        (!bound.is_finite()).then(|| {
+            format!(
+                "heights up to {max_abs} m on a spacing of {spacing:?} m overflow the spline's coefficients"
+            )
+        })
+    }
+
+    /// The lookup table of the spline (see the type's doc), or why it cannot be built
+    /// (a grid too fine for its coordinates, heights too large for the coefficients;
+    /// [`TerrainSpec::validate`] reports it).
+    pub fn surface(&self) -> Result<&Interpolant2, &str> {
+        self.surface
+            .get_or_init(|| self.build_surface())
+            .as_ref()
+            .map_err(String::as_str)
+    }
+
+    fn build_surface(&self) -> Result<Interpolant2, String> {
+        let (xs, ys, coeffs) = self.cell_polynomials();
+        Interpolant2::from_cells(&xs, &ys, &coeffs, false).map_err(|e| e.to_string())
+    }
+
+    /// The padded grid's points and the 16 coefficients of each padded cell's bicubic
+    /// (the layout of [`Interpolant2::from_cells`]).
+    fn cell_polynomials(&self) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (nx, ny) = (self.nx(), self.heights.len());
+        let [dx, dy] = self.spacing;
+        let xs = HeightMap::padded_axis(self.origin[0], dx, nx);
+        let ys = HeightMap::padded_axis(self.origin[1], dy, ny);
+        let z = |i: isize, j: isize| {
+            let inside = |k: isize, n: usize| (-1..=n as isize).contains(&k);
+            if inside(i, nx) && inside(j, ny) {
+                self.node(i, j)
+            } else {
+                0.0
+            }
+        };
+        // Weights of each node in each power of s = x − x_k: CATMULL_ROM[a][o] / Δ^a.
+        let weights = |d: f64| {
+            let mut w = CATMULL_ROM;
+            for (a, row) in w.iter_mut().enumerate() {
+                row.iter_mut().for_each(|v| *v /= d.powi(a as i32));
+            }
+            w
+        };
+        let (wx, wy) = (weights(dx), weights(dy));
+        let (cx, cy) = (xs.len() - 1, ys.len() - 1);
+        let mut coeffs = vec![0.0; 16 * cx * cy];
+        for l in 0..cy {
+            for k in 0..cx {
+                // Padded cell (k, l) starts at node (k − 1 − PAD, l − 1 − PAD).
+                let (i0, j0) = (k as isize - 1 - PAD, l as isize - 1 - PAD);
+                let mut rows = [[0.0; 4]; 4];
+                for (q, row) in rows.iter_mut().enumerate() {
+                    for (a, r) in row.iter_mut().enumerate() {
+                        *r = (0..4)
+                            .map(|o| wx[a][o] * z(i0 - 1 + o as isize, j0 - 1 + q as isize))
+                            .sum();
+                    }
+                }
+                let c = &mut coeffs[16 * (k + cx * l)..16 * (k + cx * l + 1)];
+                for b in 0..4 {
+                    for a in 0..4 {
+                        c[a + 4 * b] = (0..4).map(|q| wy[b][q] * rows[q][a]).sum();
+                    }
+                }
+            }
+        }
+        (xs, ys, coeffs)
+    }
+
+    /// Bounds of the height and slope on each cell of the grid's rectangle (built once).
+    fn cells(&self) -> &[CellBounds] {
+        self.bounds.get_or_init(|| {
+            let (xs, ys, coeffs) = self.cell_polynomials();
+            let (cx, n) = (xs.len() - 1, [self.nx() - 1, self.heights.len() - 1]);
+            let first = (PAD + 1) as usize;
+            let mut out = Vec::with_capacity(n[0] * n[1]);
+            for l in first..first + n[1] {
+                for k in first..first + n[0] {
+                    let c = &coeffs[16 * (k + cx * l)..16 * (k + cx * l + 1)];
+                    let size = [xs[k + 1] - xs[k], ys[l + 1] - ys[l]];
+                    out.push(CellBounds::of(c, [xs[k], ys[l]], size));
+                }
+            }
+            out
+        })
+    }
+
+    /// The cells of the grid's rectangle meeting region `r`, each with its box cut to `r`.
+    fn cells_in<'a>(&'a self, r: &'a Region) -> impl Iterator<Item = (Region, &'a CellBounds)> {
+        self.cells().iter().filter_map(move |c| {
+            let cut = Region {
+                x: [c.box_.x[0].max(r.x[0]), c.box_.x[1].min(r.x[1])],
+                y: [c.box_.y[0].max(r.y[0]), c.box_.y[1].min(r.y[1])],
+            };
+            (cut.x[0] <= cut.x[1] && cut.y[0] <= cut.y[1]).then_some((cut, c))
+        })
+    }
+
+    /// Height and gradient as expressions: lookups of the table and of its derivative
+    /// tables (NaN if the table cannot be built, which validation rules out).
+    fn expr(&self, x: Expr, y: Expr) -> (Expr, [Expr; 2]) {
+        match self.surface() {
+            Ok(table) => {
+                let partial = |axis| table.eval_partial(axis, x, y).expect("axis 0 or 1");
+                (table.eval(x, y), [partial(0), partial(1)])
+            }
+            Err(_) => {
+                let nan = Expr::constant(f64::NAN);
+                (nan, [nan, nan])
+            }
+        }
     }
 }
 
@@ -554,6 +768,33 @@ impl Terrain for HeightMap {
     fn slope_at(&self, x: f64, y: f64) -> [f64; 2] {
         self.eval(x, y).1
     }
+    /// The largest upper Bernstein bound over the rectangle's cells (feet stand only there).
+    fn height_bound(&self) -> Option<f64> {
+        Some(
+            self.cells()
+                .iter()
+                .map(|c| c.h[1])
+                .fold(f64::NEG_INFINITY, f64::max),
+        )
+    }
+    /// The largest slope bound over the rectangle's cells.
+    fn slope_bound(&self) -> Option<f64> {
+        Some(self.cells().iter().map(|c| c.slope).fold(0.0, f64::max))
+    }
+    /// The union of the cells' height ranges over the cells meeting `r` (`None` when `r`
+    /// is off the grid).
+    fn height_range(&self, r: &Region) -> Option<[f64; 2]> {
+        self.cells_in(r)
+            .map(|(_, c)| c.h)
+            .reduce(|a, b| [a[0].min(b[0]), a[1].max(b[1])])
+    }
+    /// Cell by cell: the distance from `p` to the cell's box cut to `r`, times the cell's
+    /// height range.
+    fn distance_from(&self, r: &Region, p: [f64; 3]) -> f64 {
+        self.cells_in(r)
+            .map(|(cut, c)| cut.distance_to(p[0], p[1]).hypot(outside(p[2], c.h)))
+            .fold(f64::INFINITY, f64::min)
+    }
     fn regions(&self) -> Vec<Region> {
         let [x0, y0] = self.origin;
         let x1 = x0 + (self.nx().max(1) - 1) as f64 * self.spacing[0];
@@ -571,17 +812,17 @@ mod tests {
     use symx::Function;
 
     fn hills() -> HeightMap {
-        HeightMap {
-            origin: [-0.5, -0.5],
-            spacing: [0.5, 0.4],
-            heights: (0..5)
+        HeightMap::new(
+            [-0.5, -0.5],
+            [0.5, 0.4],
+            (0..5)
                 .map(|j| {
                     (0..8)
                         .map(|i| 0.1 * ((i as f64) * 0.9).sin() * ((j as f64) * 0.7).cos())
                         .collect()
                 })
                 .collect(),
-        }
+        )
     }
 
     /// The symbolic height and gradient agree with the numeric height and its central
@@ -651,11 +892,7 @@ mod tests {
                     .collect()
             })
             .collect();
-        let m = HeightMap {
-            origin: [-1.0, 0.5],
-            spacing: [0.1, 0.2],
-            heights,
-        };
+        let m = HeightMap::new([-1.0, 0.5], [0.1, 0.2], heights);
         let full = |x: f64, y: f64| {
             let (is, js) = m.indices();
             let (mut h, mut hx, mut hy) = (0.0, 0.0, 0.0);
@@ -693,6 +930,143 @@ mod tests {
         );
     }
 
+    /// The model's lookup tables (value and both partial derivatives, compiled) equal the
+    /// kernel sum and its gradient to rounding, at pseudo-random points over the grid, its
+    /// ghost cells and beyond them (where both vanish), on node lines and cell corners;
+    /// tolerance 1e-12 absolute (the terms are of order max|z|/Δ ≈ 3 m/m, so a few ulps of
+    /// each, Horner in metres against the kernel in grid units, stay below 1e-14). The second derivatives (lookups of derivative
+    /// tables) match central differences of the numeric gradient (step 1e-6 m; the
+    /// spline's third derivative is bounded by ≈ 3·max|z|/Δ³ ≈ 10⁴ here, so the error is
+    /// below 1e-7; tolerance 1e-5).
+    #[test]
+    fn height_map_table_equals_the_kernel_sum() {
+        let heights: Vec<Vec<f64>> = (0..6)
+            .map(|j| {
+                (0..9)
+                    .map(|i| 0.05 * ((i * 5 + j * 3) % 7) as f64 - 0.1 + 0.01 * i as f64)
+                    .collect()
+            })
+            .collect();
+        let m = HeightMap::new([0.3, -0.7], [0.25, 0.15], heights);
+        let (x, y) = (Expr::sym("x"), Expr::sym("y"));
+        let [hx, hy] = m.gradient(x, y);
+        let hess = symx::gradient(hx, &[x, y]).unwrap();
+        let hyy = symx::gradient(hy, &[y]).unwrap()[0];
+        let f = Function::new(
+            &[&[x, y]],
+            &[&[m.height(x, y), hx, hy, hess[0], hess[1], hyy]],
+        )
+        .unwrap();
+        let mut seed = 12345u64;
+        let mut rand = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        // Grid x from 0.3 to 2.3, y from −0.7 to 0.05; ghost cells one spacing beyond,
+        // the support ends three spacings beyond.
+        let mut points: Vec<(f64, f64)> = (0..400)
+            .map(|_| (-0.6 + 3.8 * rand(), -1.3 + 2.0 * rand()))
+            .collect();
+        for i in -4..=12 {
+            for j in -4..=9 {
+                points.push((0.3 + 0.25 * i as f64, -0.7 + 0.15 * j as f64));
+                points.push((0.3 + 0.25 * i as f64, -0.7 + 0.15 * (j as f64 + 0.37)));
+            }
+        }
+        for (px, py) in points {
+            let out = f.call(&[&[px, py]]).unwrap()[0].clone();
+            let (h, [gx, gy]) = m.eval(px, py);
+            for (got, want) in [(out[0], h), (out[1], gx), (out[2], gy)] {
+                assert!(
+                    (got - want).abs() <= 1e-12,
+                    "({px}, {py}): table {got} vs kernel {want}"
+                );
+            }
+            // The spline is C¹ only: its second derivatives jump on node lines, where a
+            // central difference averages the two sides; test them off those lines.
+            let off_nodes =
+                |v: f64, o: f64, dv: f64| ((v - o) / dv - ((v - o) / dv).round()).abs() > 1e-4;
+            if !(off_nodes(px, 0.3, 0.25) && off_nodes(py, -0.7, 0.15)) {
+                continue;
+            }
+            let d = 1e-6;
+            let fd = |dx: f64, dy: f64, k: usize| {
+                (m.eval(px + dx, py + dy).1[k] - m.eval(px - dx, py - dy).1[k]) / (2.0 * d)
+            };
+            for (got, want) in [
+                (out[3], fd(d, 0.0, 0)),
+                (out[4], fd(0.0, d, 0)),
+                (out[5], fd(0.0, d, 1)),
+            ] {
+                assert!(
+                    (got - want).abs() <= 1e-5 * (1.0 + want.abs()),
+                    "second derivative at ({px}, {py}): {got} vs {want}"
+                );
+            }
+        }
+    }
+
+    /// The model's expression of a height map has the same size on any grid: a lookup
+    /// node (the tables hold the grid).
+    #[test]
+    fn height_map_expression_size_does_not_depend_on_the_grid() {
+        let (x, y) = (Expr::sym("x"), Expr::sym("y"));
+        let size = |n: usize| {
+            let m = HeightMap::new([0.0, 0.0], [0.1, 0.1], vec![vec![0.01; n]; n]);
+            let [gx, gy] = m.gradient(x, y);
+            Function::new(&[&[x, y]], &[&[m.height(x, y), gx, gy]])
+                .unwrap()
+                .instruction_count()
+        };
+        assert_eq!(size(4), size(200));
+    }
+
+    /// The cell bounds hold: at pseudo-random points of every cell the height lies in the
+    /// cell's range and the slope below its bound, and the ranges are not loose (within
+    /// 0.05 m of the node heights on this 0.1 m-amplitude map); the height bound is the
+    /// largest range's top, at least the highest node.
+    #[test]
+    fn height_map_cell_bounds_hold() {
+        let m = hills();
+        let mut seed = 99u64;
+        let mut rand = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let cells = m.cells();
+        assert_eq!(cells.len(), 7 * 4);
+        for c in cells {
+            for _ in 0..50 {
+                let x = c.box_.x[0] + rand() * (c.box_.x[1] - c.box_.x[0]);
+                let y = c.box_.y[0] + rand() * (c.box_.y[1] - c.box_.y[0]);
+                let (h, [gx, gy]) = m.eval(x, y);
+                assert!(
+                    h >= c.h[0] - 1e-15 && h <= c.h[1] + 1e-15,
+                    "{h} not in {:?}",
+                    c.h
+                );
+                assert!(gx.hypot(gy) <= c.slope + 1e-12);
+            }
+            assert!(c.h[1] - c.h[0] < 0.25, "{:?}", c.h);
+        }
+        let top = m
+            .heights
+            .iter()
+            .flatten()
+            .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        let bound = m.height_bound().unwrap();
+        assert!(bound >= top && bound < top + 0.05, "{bound} vs {top}");
+        let r = m.regions()[0];
+        let all = m.height_range(&r).unwrap();
+        assert_eq!(all[1], bound);
+        // Off the grid: no heights known.
+        assert_eq!(m.height_range(&Region::strip(10.0, 11.0)), None);
+    }
+
     #[test]
     fn height_map_interpolates_and_is_c1() {
         let m = hills();
@@ -702,12 +1076,13 @@ mod tests {
                 assert!((m.height_at(x, y) - z).abs() < 1e-12, "node ({i}, {j})");
             }
         }
-        let plane = HeightMap {
-            heights: (0..4)
+        let plane = HeightMap::new(
+            m.origin,
+            m.spacing,
+            (0..4)
                 .map(|j| (0..5).map(|i| 0.3 * i as f64 - 0.2 * j as f64).collect())
                 .collect(),
-            ..m.clone()
-        };
+        );
         for &(x, y) in &[(-0.4, -0.3), (0.13, 0.61), (1.45, 0.7)] {
             let want = 0.3 * (x + 0.5) / 0.5 - 0.2 * (y + 0.5) / 0.4;
             assert!((plane.height_at(x, y) - want).abs() < 1e-12);

@@ -176,6 +176,16 @@ impl TerrainSpec {
                     checks.push(("terrain.heights".into(), format!("a rectangular grid of at least 2 × 2 numbers is needed (from {file}), got {} rows", heights.len())));
                 } else if heights.iter().flatten().any(|v| !v.is_finite()) {
                     checks.push(("terrain.heights".into(), "must be finite numbers".into()));
+                } else if spacing.iter().chain(origin).all(|v| v.is_finite())
+                    && spacing.iter().all(|d| *d > 0.0)
+                {
+                    let max_abs = heights.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                    let n = [cols, heights.len()];
+                    if let Some(why) =
+                        crate::terrain::HeightMap::grid_problem(*origin, *spacing, n, max_abs)
+                    {
+                        checks.push(("terrain.spacing".into(), why));
+                    }
                 }
             }
         }
@@ -198,9 +208,9 @@ impl TerrainSpec {
 }
 
 /// The largest height-map CSV file read (bytes): 16 MiB, about a million nodes written
-/// with 15 characters each. Larger grids would not fit the planner's memory at any useful
-/// n_step ([`crate::limits::BYTES_PER_STANCE_NODE`]: a million nodes need 12 GiB per
-/// stance); a 2000 × 2000 CSV used to be read and planned for minutes with no output.
+/// with 15 characters each, whose lookup tables need about 4 GiB
+/// ([`crate::limits::BYTES_PER_GRID_NODE`]); a 2000 × 2000 CSV used to be read and
+/// planned for minutes with no output.
 pub const MAX_HEIGHT_CSV_BYTES: u64 = 16 << 20;
 
 /// Reads a height-map CSV (at most [`MAX_HEIGHT_CSV_BYTES`]): rows of comma-separated numbers, `#` comment lines and blank
@@ -219,7 +229,7 @@ pub fn read_height_csv(path: &Path) -> Result<Vec<Vec<f64>>, ScenarioError> {
     if size > MAX_HEIGHT_CSV_BYTES {
         return Err(bad(format!(
             "the file is {size} bytes, more than the {} MiB a height map may have (about a million nodes; \
-             the planner's memory grows with the grid's nodes times n_step, see docs/gap-crossing.md, \"Size limit\"): use a coarser grid",
+             the planner's memory grows with the grid's nodes, see docs/gap-crossing.md, \"Size limit\"): use a coarser grid",
             MAX_HEIGHT_CSV_BYTES >> 20
         )));
     }

@@ -365,6 +365,62 @@ pub struct Scenario {
     /// The ground (default: the `gap` table's gap).
     #[serde(default)]
     pub terrain: TerrainSpec,
+    /// Optional limits on the body's motion (the `motion` table; all off by default, and
+    /// then the model is the spec's).
+    #[serde(default, skip_serializing_if = "MotionLimits::is_unset")]
+    pub motion: MotionLimits,
+}
+
+/// Optional limits on the body's motion, a user's additions to the spec's model (the
+/// scenario's `motion` table; each off when absent). They hold from stance 2 on (the
+/// start is as given); the model states them as constraints and `check` verifies them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionLimits {
+    /// Least height of each CoM above the ground under it, `z − h(x, y)` (m; over a
+    /// gap, h is its bottom).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_height_min: Option<f64>,
+    /// Greatest height of each CoM above the ground under it (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_height_max: Option<f64>,
+    /// Greatest distance each CoM travels per transition, `‖c^{k+1} − c^k‖` (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub com_travel_max: Option<f64>,
+}
+
+impl MotionLimits {
+    /// No limit set (the spec's model).
+    pub fn is_unset(&self) -> bool {
+        *self == MotionLimits::default()
+    }
+
+    /// Everything wrong with the limits: finite, body heights and travel positive, the
+    /// least body height not above the greatest.
+    pub fn validate(&self) -> Vec<Invalid> {
+        let mut bad = Vec::new();
+        for (name, v) in [
+            ("body_height_min", self.body_height_min),
+            ("body_height_max", self.body_height_max),
+            ("com_travel_max", self.com_travel_max),
+        ] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                bad.push(Invalid {
+                    field: format!("motion.{name}"),
+                    message: format!("must be a positive finite number (m), got {v}"),
+                });
+            }
+        }
+        if let (Some(lo), Some(hi)) = (self.body_height_min, self.body_height_max) {
+            if lo > hi {
+                bad.push(Invalid {
+                    field: "motion.body_height_min".into(),
+                    message: format!("must not exceed body_height_max ({hi}), got {lo}"),
+                });
+            }
+        }
+        bad
+    }
 }
 
 impl Default for Scenario {
@@ -413,6 +469,7 @@ impl Default for Scenario {
             },
             gait: Gait::Free,
             terrain: TerrainSpec::Gap,
+            motion: MotionLimits::default(),
         }
     }
 }
@@ -604,6 +661,7 @@ impl Scenario {
             }
         }
         bad.extend(self.terrain.validate());
+        bad.extend(self.motion.validate());
         if bad.is_empty() && finite {
             self.validate_start(&mut bad);
         }

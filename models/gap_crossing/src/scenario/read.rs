@@ -26,6 +26,28 @@ fn join(path: &str, key: &str) -> String {
     }
 }
 
+/// The `motion` limits are serialised only when set: before merging into them, the
+/// unset ones are added as nulls (so that `--set motion.KEY=…` and a file's `[motion]`
+/// table find them).
+fn add_unset_limits(b: &mut serde_json::Map<String, Value>) {
+    let all = super::MotionLimits {
+        body_height_min: Some(0.0),
+        body_height_max: Some(0.0),
+        com_travel_max: Some(0.0),
+    };
+    let Ok(Value::Object(names)) = serde_json::to_value(all) else {
+        return;
+    };
+    let table = b
+        .entry("motion")
+        .or_insert_with(|| Value::Object(Default::default()));
+    if let Value::Object(t) = table {
+        for name in names.keys() {
+            t.entry(name.clone()).or_insert(Value::Null);
+        }
+    }
+}
+
 /// Deep-merges `patch` into `base` (the serialised defaults). Keys absent from `base` are
 /// unknown fields; a value of another kind than the default's is a type error. Both are
 /// reported with the dotted path, which serde's own errors do not give.
@@ -34,6 +56,9 @@ fn merge(base: &mut Value, patch: Value, path: &str) -> Result<(), ScenarioError
         (Value::Object(b), Value::Object(p)) => {
             for (key, pv) in p {
                 let here = join(path, &key);
+                if here == "motion" {
+                    add_unset_limits(b);
+                }
                 match b.get_mut(&key) {
                     Some(bv) if here == "terrain" => merge_terrain(bv, pv)?,
                     Some(bv) => merge(bv, pv, &here)?,
@@ -69,6 +94,11 @@ fn merge(base: &mut Value, patch: Value, path: &str) -> Result<(), ScenarioError
                 });
             }
             *b = Value::Number(p);
+            Ok(())
+        }
+        // An optional value not set yet (the `motion` limits).
+        (b @ Value::Null, p @ Value::Number(_)) => {
+            *b = p;
             Ok(())
         }
         (b @ Value::String(_), p @ Value::String(_)) => {
