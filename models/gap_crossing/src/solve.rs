@@ -99,19 +99,8 @@ pub enum Backend {
     Sqp,
 }
 
-/// The planner's default for the interior-point method's
-/// `perturbation_skip_zero_after` (nlp's default 20): after one iteration whose KKT
-/// matrix needed a Hessian perturbation δ_w > 0, the next inertia correction starts from
-/// κ_w⁻·δ_w instead of first factorising with δ_w = 0. The gap model's Hessian is
-/// nonconvex at nearly every iteration, so the δ_w = 0 attempt was almost always a wasted
-/// factorisation: on the default scenario 5.1 % fewer instructions for the whole run
-/// (callgrind), the same iteration count in every solve and the same objective to all
-/// printed digits (the plan differs at round-off, 1e-18 N in some forces). `--opt
-/// perturbation_skip_zero_after=N` overrides it.
-pub const PERTURBATION_SKIP_ZERO_AFTER: usize = 1;
-
 /// Options of a planning run.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Settings {
     /// Solver back end.
     pub backend: Backend,
@@ -119,21 +108,6 @@ pub struct Settings {
     pub ipm: IpmOptions,
     /// SQP options (used with [`Backend::Sqp`]).
     pub sqp: SqpOptions,
-}
-
-impl Default for Settings {
-    /// The interior-point method with its defaults except
-    /// [`PERTURBATION_SKIP_ZERO_AFTER`]; the SQP's defaults.
-    fn default() -> Settings {
-        Settings {
-            backend: Backend::Ipm,
-            ipm: IpmOptions {
-                perturbation_skip_zero_after: PERTURBATION_SKIP_ZERO_AFTER,
-                ..IpmOptions::default()
-            },
-            sqp: SqpOptions::default(),
-        }
-    }
 }
 
 impl Settings {
