@@ -12,7 +12,11 @@
 //! (three candidates on the default gap: the run's user CPU time 22.4 s → 14.3 s, against
 //! 13.1 s without these candidates; docs/performance.md). A candidate solved on the
 //! walking horizon stops when it stalls (`solve::STALL_ITERATIONS`; the crawl gait at
-//! gap depth 0.5 ran 984 iterations on one before).
+//! gap depth 0.5 ran 984 iterations on one before), and every candidate counts as failed
+//! past `solve::SEARCH_MAX_ITER` (200) iterations of the interior-point method: the
+//! family's "w 0.299 at 2.6" ran 313 and 202 on two candidates of round 1 that lost
+//! to ones of 99–134 iterations (on all 31 scenarios of
+//! `models/gap_crossing/scripts/scenario_table.py` no candidate past 200 won).
 use crate::check::GOAL_TOL;
 use crate::crossing::{self, Candidate};
 use crate::plan::Plan;
@@ -166,6 +170,9 @@ pub(crate) fn run(
     start: &Run,
 ) -> Result<Searched, PlanningError> {
     use rayon::prelude::*;
+    // Capped like the schedule search's re-solves: a candidate still running past
+    // `SEARCH_MAX_ITER` iterations counts as failed (module docs).
+    let settings = &settings.capped();
     let mut out = Searched {
         solved: Vec::new(),
         best: None,

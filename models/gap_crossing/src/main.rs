@@ -509,34 +509,11 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         .num_threads(threads)
         .build()
         .map_err(|e| CliError::Threads(threads, e.to_string()))?;
-    let n = match a.shard {
-        Some(sh) => (0..grid.len()).filter(|&k| sh.holds(k)).count(),
-        None => grid.len(),
-    };
     let points_dir = a.out.join("points");
     if a.solutions {
         std::fs::create_dir_all(&points_dir).map_err(io(&points_dir))?;
     }
-    let axes: Vec<&str> = grid.axes.iter().map(|ax| ax.key.as_str()).collect();
-    let of = a.shard.map_or(String::new(), |sh| {
-        format!(" of shard {}/{}", sh.index, sh.count)
-    });
-    eprintln!(
-        "sweep: {n} points{of} ({}) on {threads} threads",
-        if axes.is_empty() {
-            "no axes: the base scenario".to_string()
-        } else {
-            axes.join(" × ")
-        }
-    );
-    // Drawn on stderr; indicatif hides it when stderr is not a terminal.
-    let bar = indicatif::ProgressBar::new(n as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} points, {elapsed} elapsed, ~{eta} left  {msg}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = progress_bar(announce_sweep(&grid, a.shard, threads));
     let failed = std::sync::atomic::AtomicUsize::new(0);
     let save_errors = std::sync::Mutex::new(Vec::<String>::new());
     let started = std::time::Instant::now();
@@ -568,20 +545,68 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
         eprintln!("warning: {e}");
     }
 
-    let files = match a.shard {
+    let files = write_sweep(&a.out, a.shard, &grid, &results, wall, threads)?;
+    Ok(report_sweep(&grid, &results, wall, threads, &files))
+}
+
+/// Prints what a sweep is about to run (points, axes, shard, threads) on stderr and
+/// returns its number of points.
+fn announce_sweep(grid: &Grid, shard: Option<Shard>, threads: usize) -> usize {
+    let n = match shard {
+        Some(sh) => (0..grid.len()).filter(|&k| sh.holds(k)).count(),
+        None => grid.len(),
+    };
+    let axes: Vec<&str> = grid.axes.iter().map(|ax| ax.key.as_str()).collect();
+    let of = shard.map_or(String::new(), |sh| {
+        format!(" of shard {}/{}", sh.index, sh.count)
+    });
+    eprintln!(
+        "sweep: {n} points{of} ({}) on {threads} threads",
+        if axes.is_empty() {
+            "no axes: the base scenario".to_string()
+        } else {
+            axes.join(" × ")
+        }
+    );
+    n
+}
+
+/// The sweep's progress bar over `n` points, drawn on stderr (indicatif hides it when
+/// stderr is not a terminal).
+fn progress_bar(n: usize) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} points, {elapsed} elapsed, ~{eta} left  {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Writes a sweep's results into `out`: a shard's mergeable file, or the summary and
+/// plots of a whole run; returns the paths written.
+fn write_sweep(
+    out: &Path,
+    shard: Option<Shard>,
+    grid: &Grid,
+    results: &[PointResult],
+    wall: f64,
+    threads: usize,
+) -> Result<Vec<PathBuf>, CliError> {
+    Ok(match shard {
         Some(shard) => {
             let file = ShardFile {
                 grid: grid.clone(),
                 shard,
-                results: results.clone(),
+                results: results.to_vec(),
                 wall_seconds: wall,
                 threads,
             };
-            vec![file.write(&a.out)?]
+            vec![file.write(out)?]
         }
-        None => sweep::write_outputs(&a.out, &grid, &results, wall, threads)?,
-    };
-    Ok(report_sweep(&grid, &results, wall, threads, &files))
+        None => sweep::write_outputs(out, grid, results, wall, threads)?,
+    })
 }
 
 /// `sweep merge`: the shards' results as the summary of one run.

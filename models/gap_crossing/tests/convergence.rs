@@ -148,3 +148,40 @@ fn version_1_history_still_renders() {
     let svg = render::convergence_svg(&c, "old");
     assert!(svg.contains("not recorded"));
 }
+
+/// The planner records the (10) residual of every iterate of a scheduled solve as an
+/// exact 0 without evaluating it (`solve::solve_scheduled`): the probe evaluates it at
+/// every iterate of the crawl schedule's solve on the default scenario and finds
+/// exactly 0 each time, and the solve's plan has several feet moving over the run (so
+/// the zeros come from the shared variables, not from a plan that stands still).
+#[test]
+fn scheduled_iterates_satisfy_10_exactly() {
+    let s = Scenario::default();
+    let terrain = GapTerrain { gap: s.gap };
+    let guess = gait::crawl(&s);
+    let formulation = Formulation::Scheduled(gait::crawl_schedule(s.n_step));
+    let model = model::build(&s, &terrain, &formulation, &guess).unwrap();
+    let mut compiled = model.problem.compile().unwrap();
+    let mut probe = ResidualProbe::new(&s, &model).unwrap();
+    let mut residuals = Vec::new();
+    let mut callback = |v: &nlp::IterationView<'_>| {
+        residuals.push(probe.at(v.x()));
+        std::ops::ControlFlow::Continue(())
+    };
+    let solution = Settings::default()
+        .solver()
+        .solve_with_callback(&mut compiled, &mut callback)
+        .unwrap();
+    assert!(solution.status.is_success(), "{:?}", solution.status);
+    assert!(residuals.len() > 10, "{}", residuals.len());
+    assert!(residuals.iter().all(|&r| r == 0.0), "{residuals:?}");
+    let flat = model.problem.evaluate(&model.layout, &solution.x).unwrap();
+    let moved = (1..s.n_step)
+        .filter(|&k| {
+            Foot::ALL.iter().any(|&i| {
+                (0..3).any(|d| flat[foot_offset(k, i) + d] != flat[foot_offset(k - 1, i) + d])
+            })
+        })
+        .count();
+    assert!(moved >= 40, "{moved} transitions move a foot");
+}
