@@ -63,7 +63,8 @@ pub struct PyMpc {
 fn report_dict<'py>(py: Python<'py>, r: &StepReport) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("status", r.status.to_string())?;
-    d.set_item("success", r.status.is_success())?;
+    d.set_item("success", r.succeeded())?;
+    d.set_item("residual", r.residual)?;
     d.set_item("iterations", r.iterations)?;
     d.set_item("seconds", r.seconds)?;
     d.set_item("solve_seconds", r.solve_seconds)?;
@@ -122,7 +123,8 @@ impl PyMpc {
     }
 
     /// One step from the measured state `x0`; returns a dict (`status`, `success`,
-    /// `iterations`, `seconds`, `solve_seconds`, `objective`, `warm`).
+    /// `residual` (a real-time iteration's KKT residual, else `None`), `iterations`,
+    /// `seconds`, `solve_seconds`, `objective`, `warm`).
     fn step<'py>(
         &mut self,
         py: Python<'py>,

@@ -276,6 +276,7 @@ def test_mpc_step_by_step_equals_shift_and_warm_solves():
     prev = tr.solve()
     first = mpc.step(x)
     assert first["success"] and not first["warm"]
+    assert first["residual"] is None  # only a real-time iteration reports one
     assert mpc.control[0] == pytest.approx(prev.value(tr.controls[0, 0]), abs=1e-12)
     # The next step: Mpc shifts and warm-starts; by hand: shift, set x0, solve_warm.
     x = [x[0] + 0.1 * (x[0] + mpc.control[0])]
