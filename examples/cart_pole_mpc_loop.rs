@@ -33,6 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect::<Result<Vec<_>, _>>()?;
     let u = pb.variable("U", n)?;
     let x0 = pb.parameter("x0", 4)?;
+    pb.set_value(&x0, &[0.0; 4])?; // compiling needs values (set each step below)
     pb.subject_to(xs[0].eq(&x0))?;
     let mut cost = Expr::zero();
     for k in 0..n {
@@ -40,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cost = cost + xs[k].sumsqr() + 0.01 * u[k].sq();
     }
     pb.minimize(cost + 10.0 * xs[n].sumsqr());
-    pb.subject_to(bounded(-20.0, &u, 20.0))?;
+    pb.subject_to(bounded(-20.0, u.clone(), 20.0))?;
     let mut compiled = pb.compile()?;
 
     // Closed loop: measure, solve (warm), apply the first control to the "plant".
