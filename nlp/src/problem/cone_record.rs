@@ -2,10 +2,10 @@
 use symx::Expr;
 
 /// Smoothing ε of the smooth form `√(‖v‖² + ε²) − t ≤ ε` of a second-order cone (see
-/// [`Problem::subject_to_cone`]).
+/// [`Problem::subject_to_cone`](crate::Problem::subject_to_cone)).
 pub const CONE_SMOOTHING: f64 = 1e-8;
 
-/// A second-order cone `‖v‖ ≤ t` recorded by [`Problem::subject_to_cone`].
+/// A second-order cone `‖v‖ ≤ t` recorded by [`Problem::subject_to_cone`](crate::Problem::subject_to_cone).
 #[derive(Clone, Debug)]
 pub struct Cone {
     /// The name given when declaring it (also the name of its smooth row).

@@ -2,7 +2,7 @@
 use super::error::BuildError;
 
 /// One number for every entry, or one number per entry: the `lower` and `upper` arguments
-/// of [`Problem::set_bounds`].
+/// of [`Problem::set_bounds`](crate::Problem::set_bounds).
 ///
 /// Built implicitly by `From`: `0.0`, `&[0.0, 1.0]`, `&vec`, `&v[..]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
