@@ -39,8 +39,8 @@ pub use integrator::{Integrator, IntegratorError, IntegratorOptions};
 pub use ipm::Ipm;
 pub use parameter::ParameterKey;
 pub use problem::{
-    Block, BuildError, ComplementarityReport, PerEntry, Problem, ProblemFileError, SolverFunction,
-    ToFunctionError, PROBLEM_FILE_VERSION,
+    linspace, Block, BuildError, ComplementarityReport, PerEntry, Problem, ProblemFileError,
+    SolverFunction, ToFunctionError, PROBLEM_FILE_VERSION,
 };
 
 pub use log::{format_summary, format_table};

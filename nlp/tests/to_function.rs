@@ -189,3 +189,161 @@ fn mistakes_are_errors() {
     let err = f.call(&[&[0.5, 1.0, 0.5]]).unwrap_err();
     assert!(matches!(err, ToFunctionError::NotSolved { .. }), "{err}");
 }
+
+/// Inner QP with an affine solution map: min (y1 − a)² + (y2 − 2a)² s.t. y1 + y2 = b has
+/// y1* = (b − a)/2, y2* = (b + a)/2 (Lagrange: y1 − a = y2 − 2a, y1 + y2 = b). As an
+/// external call node with inputs (a, b) and outputs (y1, y2).
+fn affine_inner_node() -> symx::Function {
+    let mut pb = Problem::new();
+    let y = pb.variable("y", 2).unwrap();
+    let a = pb.scalar_parameter("a").unwrap();
+    let b = pb.scalar_parameter("b").unwrap();
+    pb.set_value(a, &[0.0]).unwrap();
+    pb.set_value(b, &[0.0]).unwrap();
+    pb.minimize((y[0] - a).sq() + (y[1] - a * 2.0).sq());
+    pb.subject_to((y[0] + y[1]).eq(b)).unwrap();
+    pb.to_function(&[&[a, b]], &[&[y[0], y[1]]])
+        .unwrap()
+        .into_external("inner_qp")
+        .unwrap()
+}
+
+/// Outer: min_{a,b} (y1* − 1)² + (y2* − 2)² + 0.1(a² + b²), optionally with y1* ≥ 1.
+/// With u = y1* = (b − a)/2, v = y2* = (b + a)/2: a² + b² = 2(u² + v²), so the objective
+/// is (u − 1)² + (v − 2)² + 0.2(u² + v²): u = 1/1.2, v = 2/1.2 (a = v − u = 1/1.2,
+/// b = u + v = 2.5); with u ≥ 1 active, u = 1, v = 2/1.2 (a = 2/3, b = 8/3).
+fn bilevel(with_constraint: bool, options: nlp::IpmOptions) -> nlp::Solution {
+    let node = affine_inner_node();
+    let mut outer = Problem::new();
+    let ab = outer.variable("ab", 2).unwrap();
+    outer.set_initial(&ab, &[0.3, 0.7]).unwrap();
+    let y = &node.apply(&[&[ab[0], ab[1]]]).unwrap()[0];
+    outer.minimize((y[0] - 1.0).sq() + (y[1] - 2.0).sq() + (ab[0].sq() + ab[1].sq()) * 0.1);
+    if with_constraint {
+        outer.subject_to(y[0].ge(1.0)).unwrap();
+    }
+    let sol = nlp::Ipm::new(options)
+        .solve(&mut outer.compile().unwrap())
+        .unwrap();
+    assert!(sol.status.is_success(), "{}", sol.message);
+    sol
+}
+
+#[test]
+fn a_solver_node_inside_an_outer_problem_matches_the_closed_form() {
+    let exact = nlp::IpmOptions::default();
+    let quasi_newton = nlp::IpmOptions {
+        hessian_approximation: nlp::IpmHessian::LimitedMemory,
+        ..Default::default()
+    };
+    // Tolerances: the outer IPM stops at tol 1e-8 on a strongly convex problem, and the
+    // inner solves are accurate to about 1e-9; 1e-6 leaves margin for both.
+    for options in [exact, quasi_newton] {
+        let sol = bilevel(false, options.clone());
+        assert!((sol.x[0] - 1.0 / 1.2).abs() < 1e-6, "{:?}", sol.x);
+        assert!((sol.x[1] - 2.5).abs() < 1e-6, "{:?}", sol.x);
+        let sol = bilevel(true, options);
+        assert!((sol.x[0] - 2.0 / 3.0).abs() < 1e-6, "{:?}", sol.x);
+        assert!((sol.x[1] - 8.0 / 3.0).abs() < 1e-6, "{:?}", sol.x);
+    }
+}
+
+#[test]
+fn a_solver_node_differentiates_like_finite_differences() {
+    // The chain's energy and a middle height as functions of (length, end heights),
+    // through the node: its Jacobian (sensitivities) against central differences of its
+    // values, and its second derivatives (differences of sensitivities) against central
+    // differences of the Jacobian.
+    let (pb, p, y) = chain(10);
+    let energy: symx::Expr = y.iter().copied().sum();
+    let node = pb
+        .to_function(&[&p], &[&[y[5], energy]])
+        .unwrap()
+        .into_external("chain")
+        .unwrap();
+    let q = Matrix::sym_vec("q", 3);
+    let out = &node.apply(&[q.entries()]).unwrap()[0];
+    let value = symx::Function::new(&[&q], &[&[out[0] + out[1] * 0.5]]).unwrap();
+    let grad = symx::gradient(out[0] + out[1] * 0.5, &q).unwrap();
+    let gradient = symx::Function::new(&[&q], &[&grad]).unwrap();
+    let at = [2.0, 1.0, 0.5];
+    let g = gradient.call(&[&at]).unwrap().swap_remove(0);
+    let h = 1e-5; // as in jacobian_matches_finite_differences_on_a_chain
+    for j in 0..3 {
+        let mut plus = at;
+        plus[j] += h;
+        let mut minus = at;
+        minus[j] -= h;
+        let fd = (value.call(&[&plus]).unwrap()[0][0] - value.call(&[&minus]).unwrap()[0][0])
+            / (2.0 * h);
+        assert!(
+            (g[j] - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+            "{j}: {} vs {fd}",
+            g[j]
+        );
+    }
+    // Hessian of the node's output (central differences of sensitivities, step 1e-4)
+    // against central differences of the gradient with step 1e-3: both err by O(h²) and
+    // by the sensitivities' accuracy over h; 1e-4 relative covers both.
+    let hess = symx::hessian(out[0] + out[1] * 0.5, &q).unwrap().to_dense();
+    let hessian = symx::Function::new(&[&q], &[&hess]).unwrap();
+    let hv = hessian.call(&[&at]).unwrap().swap_remove(0);
+    let h = 1e-3;
+    for j in 0..3 {
+        let mut plus = at;
+        plus[j] += h;
+        let mut minus = at;
+        minus[j] -= h;
+        let (gp, gm) = (
+            gradient.call(&[&plus]).unwrap().swap_remove(0),
+            gradient.call(&[&minus]).unwrap().swap_remove(0),
+        );
+        for i in j..3 {
+            // symx::hessian stores the lower triangle (i ≥ j).
+            let fd = (gp[i] - gm[i]) / (2.0 * h);
+            let a = hv[i + 3 * j];
+            assert!(
+                (a - fd).abs() <= 1e-4 * (1.0 + fd.abs()),
+                "({i},{j}): {a} vs {fd}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_solver_node_is_nan_where_the_solve_fails_and_safe_across_threads() {
+    let (pb, p, y) = chain(4);
+    let node = pb
+        .to_function(&[&p], &[&y])
+        .unwrap()
+        .into_external("chain")
+        .unwrap();
+    // Too short to span the ends: the solve fails, the outputs are NaN.
+    let bad = node.call(&[&[0.5, 1.0, 0.5]]).unwrap().swap_remove(0);
+    assert!(bad.iter().all(|v| v.is_nan()), "{bad:?}");
+    // Concurrent callers get the serial values, bit for bit.
+    let inputs = [
+        [2.0, 1.0, 0.5],
+        [2.5, 0.8, 0.4],
+        [1.8, 1.1, 0.9],
+        [3.0, 0.0, 0.0],
+    ];
+    let serial: Vec<Vec<f64>> = inputs
+        .iter()
+        .map(|i| node.call(&[i]).unwrap().swap_remove(0))
+        .collect();
+    let parallel: Vec<Vec<f64>> = std::thread::scope(|s| {
+        let handles: Vec<_> = inputs
+            .iter()
+            .map(|i| s.spawn(|| node.call(&[i]).unwrap().swap_remove(0)))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(serial, parallel);
+    // Third derivatives do not exist: a clear error naming the function.
+    let q = Matrix::sym_vec("q", 3);
+    let y4 = node.apply(&[q.entries()]).unwrap()[0][1];
+    let h = symx::hessian(y4, &q).unwrap();
+    let err = symx::jacobian(h.values(), &q).unwrap_err();
+    assert!(err.to_string().contains("jac_jac_chain"), "{err}");
+}

@@ -1,7 +1,6 @@
 //! [`Phase`]: where one transcribed phase of an optimal control problem lives in its
 //! [`Problem`] — grid, state and control variables, final time — and how a solution reads
 //! back from them as a [`Trajectory`].
-use super::transcription::StagedRows;
 use super::{CollocationStates, ControlInterpolation, Grid, OcpError, Trajectory};
 use crate::problem::Problem;
 use crate::solution::Solution;
@@ -96,4 +95,14 @@ impl Phase {
             collocation,
         })
     }
+}
+
+/// A constraint group written once per stage: `stages` consecutive runs of `per_stage`
+/// raw rows (rows as added, before simple-bound detection) from `start`.
+#[derive(Clone, Debug)]
+pub(crate) struct StagedRows {
+    pub(crate) name: String,
+    pub(crate) start: usize,
+    pub(crate) stages: usize,
+    pub(crate) per_stage: usize,
 }

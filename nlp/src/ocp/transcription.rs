@@ -1,7 +1,7 @@
 //! Transcription of an [`Ocp`] into a [`Problem`]: direct multiple shooting, direct
 //! collocation, trapezoidal or Hermite–Simpson collocation on a uniform or user-given
 //! [`Grid`] of `N` intervals, with controls piecewise constant or linear between nodes.
-use super::phase::Phase;
+use super::phase::{Phase, StagedRows};
 use super::{
     ButcherTableau, Collocation, CollocationPoints, ControlInterpolation, Grid, Horizon, Ocp,
     OcpError, Trajectory,
@@ -104,16 +104,6 @@ impl Method {
 pub struct Transcription {
     problem: Problem,
     phase: Phase,
-}
-
-/// A constraint group written once per stage: `stages` consecutive runs of `per_stage`
-/// raw rows (rows as added, before simple-bound detection) from `start`.
-#[derive(Clone, Debug)]
-pub(crate) struct StagedRows {
-    pub(crate) name: String,
-    pub(crate) start: usize,
-    pub(crate) stages: usize,
-    pub(crate) per_stage: usize,
 }
 
 /// Counts the raw rows added to the problem and records the per-stage groups.

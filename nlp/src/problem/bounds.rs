@@ -1,62 +1,10 @@
 //! Variable bounds: per-entry bound values ([`PerEntry`]) and the detection of simple
 //! bounds (constraint rows on a single variable turned into bounds, as CasADi's
 //! `detect_simple_bounds` option does).
-use super::{check_bound, row_name, Block, BuildError, Problem};
+pub use super::per_entry::PerEntry;
 
-/// One number for every entry, or one number per entry: the `lower` and `upper` arguments
-/// of [`Problem::set_bounds`].
-///
-/// Built implicitly by `From`: `0.0`, `&[0.0, 1.0]`, `&vec`, `&v[..]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum PerEntry<'a> {
-    /// The same value for every entry.
-    All(f64),
-    /// Entry k gets value k; the length must match.
-    Each(&'a [f64]),
-}
-
-impl From<f64> for PerEntry<'_> {
-    fn from(v: f64) -> Self {
-        PerEntry::All(v)
-    }
-}
-impl<'a> From<&'a [f64]> for PerEntry<'a> {
-    fn from(v: &'a [f64]) -> Self {
-        PerEntry::Each(v)
-    }
-}
-impl<'a, const N: usize> From<&'a [f64; N]> for PerEntry<'a> {
-    fn from(v: &'a [f64; N]) -> Self {
-        PerEntry::Each(v)
-    }
-}
-impl<'a> From<&'a Vec<f64>> for PerEntry<'a> {
-    fn from(v: &'a Vec<f64>) -> Self {
-        PerEntry::Each(v)
-    }
-}
-
-impl PerEntry<'_> {
-    /// Checks that there is a value for each of `n` entries; `what` names the argument.
-    pub(crate) fn check_len(&self, n: usize, what: &str) -> Result<(), BuildError> {
-        match self {
-            PerEntry::Each(v) if v.len() != n => Err(BuildError::Size {
-                what: what.to_string(),
-                expected: n,
-                got: v.len(),
-            }),
-            _ => Ok(()),
-        }
-    }
-
-    /// The value of entry `k` (after [`PerEntry::check_len`]).
-    pub(crate) fn get(&self, k: usize) -> f64 {
-        match self {
-            PerEntry::All(v) => *v,
-            PerEntry::Each(v) => v[k],
-        }
-    }
-}
+use super::block::{check_bound, row_name, Block};
+use super::{BuildError, Problem};
 
 /// The problem as compiled: variable bounds and the rows of g that remain after simple
 /// bound detection (all written rows when it is off).
