@@ -1,5 +1,5 @@
 """CasADi half of the hanging-chain line-count pair (issue 22 item 6; the symnlp half is
-examples/chain_sweep.rs): n links between x = 0 and x = 1, the chain's length and end
+examples/examples/chain_sweep.rs): n links between x = 0 and x = 1, the chain's length and end
 heights as parameters, re-solved 20 times, each solve warm-started from the last.
 Run: python3 benches/reference/chain_sweep_casadi.py (casadi 3.8.2, benches/reference/setup.sh)."""
 import casadi as ca

@@ -7,9 +7,9 @@ Run from the repository root: python3 benches/reference/count_lines.py"""
 import sys
 
 PAIRS = [
-    ("Goddard rocket", "examples/goddard_rocket.rs", "python/examples/casadi/goddard_rocket.py"),
-    ("hanging chain, 20 re-solves", "examples/chain_sweep.rs", "benches/reference/chain_sweep_casadi.py"),
-    ("cart-pole MPC loop", "examples/cart_pole_mpc_loop.rs", "python/examples/casadi/cartpole_mpc.py"),
+    ("Goddard rocket", "examples/src/goddard_rocket.rs", "python/examples/casadi/goddard_rocket.py"),
+    ("hanging chain, 20 re-solves", "examples/examples/chain_sweep.rs", "benches/reference/chain_sweep_casadi.py"),
+    ("cart-pole MPC loop", "examples/examples/cart_pole_mpc_loop.rs", "python/examples/casadi/cartpole_mpc.py"),
 ]
 
 

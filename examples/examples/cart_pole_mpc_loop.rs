@@ -5,7 +5,7 @@
 //! is `python/examples/casadi/cartpole_mpc.py`. Both print the same angles and forces.
 //! (`examples/mpc_cart_pole.rs` is the swing-up benchmark with the `Mpc` helper.)
 //!
-//! Run: `cargo run --release --example cart_pole_mpc_loop`
+//! Run: `cargo run --release -p symnlp-examples --example cart_pole_mpc_loop`
 use symnlp::nlp::ocp::ButcherTableau;
 use symnlp::nlp::{bounded, Ipm, Problem, Relation};
 use symnlp::symx::{Expr, Function, Matrix};

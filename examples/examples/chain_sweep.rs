@@ -3,7 +3,7 @@
 //! of docs/casadi.md (issue 22 item 6); the CasADi half is
 //! `benches/reference/chain_sweep_casadi.py`. Both print the same energies.
 //!
-//! Run: `cargo run --release --example chain_sweep`
+//! Run: `cargo run --release -p symnlp-examples --example chain_sweep`
 use symnlp::nlp::{linspace, Ipm, Problem, Relation};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
