@@ -249,15 +249,7 @@ impl Rti {
             mult: Mult::zeros(n, m, 0),
             have_mult: true,
         };
-        let curv = Curvature {
-            hv: vec![0.0; shape.hp.row_idx().len()],
-            bfgs: Vec::new(),
-            row_weight: vec![0.0; m],
-            bound_weight: vec![0.0; n],
-            rho_a_last: 0.0,
-            delta_last: 0.0,
-            extra_shift: 0.0,
-        };
+        let curv = Curvature::new(&shape);
         Ok(Rti {
             compiled,
             x0_parameter: x0_parameter.to_string(),

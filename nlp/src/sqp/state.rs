@@ -218,7 +218,7 @@ fn first_iterate(
 
 impl Curvature {
     /// No curvature yet: B = I for BFGS, no weights, no shifts.
-    fn new(shape: &Shape) -> Curvature {
+    pub(super) fn new(shape: &Shape) -> Curvature {
         let n = shape.n;
         Curvature {
             hv: vec![0.0; shape.hp.row_idx().len()],
