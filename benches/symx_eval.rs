@@ -38,6 +38,17 @@
 //! Hessian, with the JIT's compile times (benches/reference/native_casadi.py measures
 //! CasADi's VM and its generated C on the same functions).
 //!
+//! `native_rust_chain`, `native_rust_gap`, `native_rust_quadrotor` (`cargo bench --bench
+//! symx_eval -- native_rust`): tape, JIT and generated Rust (`Function::to_rust`) on the
+//! same three functions. The generated modules are compiled by `rustc` with cargo's
+//! `--release` settings when the group runs (so `cargo bench --no-run` stays fast) into a
+//! program that criterion drives through a pipe (`iter_custom`: the program times its own
+//! loop of calls); its outputs are checked bit for bit against the tape first. Run only when
+//! a filter names them. With `SYMX_NATIVE_RUST_KEEP=1` the program is kept (its path is
+//! printed) for callgrind: `echo "K CALLS" | valgrind --tool=callgrind DIR/main
+//! DIR/inputs.bin DIR/out.bin` runs function K (0 ∇f, 1 Jacobian, 2 Hessian). See
+//! [`GeneratedRust`].
+//!
 //! `native_compile` (`cargo bench --bench symx_eval -- native_compile`): the JIT's compile
 //! time per 1000 instructions at several sizes (linear if flat).
 //!
@@ -606,6 +617,310 @@ fn bench_native(c: &mut Criterion) {
     }
 }
 
+/// Rustc's flags for the generated programs: what `cargo build --release` passes for this
+/// workspace's release profile (opt-level 3, 16 codegen units, no debug info).
+const RELEASE_FLAGS: [&str; 8] = [
+    "--edition",
+    "2021",
+    "-C",
+    "opt-level=3",
+    "-C",
+    "codegen-units=16",
+    "-C",
+    "debuginfo=0",
+];
+
+/// The `main` of a generated program: reads every function's inputs (the binary file
+/// `argv[1]`, the functions' inputs one after the other), writes every output once to
+/// `argv[2]`, then answers each stdin line `k iters` with the nanoseconds that `iters`
+/// calls of function `k` took.
+const PROGRAM_MAIN: &str = r#"
+type Eval = fn(&[&[f64]], &mut [&mut [f64]], &mut [f64]) -> Result<(), &'static str>;
+
+fn main() {
+    use std::io::{BufRead, Write};
+    let args: Vec<String> = std::env::args().collect();
+    let bytes = std::fs::read(&args[1]).expect("inputs");
+    let data: Vec<f64> = bytes.chunks(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect();
+    let mut at = 0;
+    let mut runs = Vec::new();
+    let mut written = Vec::new();
+    for (eval, ins, outs, work) in FUNCTIONS {
+        let inputs: Vec<Vec<f64>> = ins.iter().map(|&n| { at += n; data[at - n..at].to_vec() }).collect();
+        let mut outputs: Vec<Vec<f64>> = outs.iter().map(|&n| vec![0.0; n]).collect();
+        let mut work = vec![0.0; work];
+        {
+            let i: Vec<&[f64]> = inputs.iter().map(|v| v.as_slice()).collect();
+            let mut o: Vec<&mut [f64]> = outputs.iter_mut().map(|v| v.as_mut_slice()).collect();
+            eval(&i, &mut o, &mut work).expect("eval");
+        }
+        for v in &outputs { for x in v { written.extend_from_slice(&x.to_le_bytes()); } }
+        runs.push((eval, inputs, outputs, work));
+    }
+    std::fs::write(&args[2], written).expect("outputs");
+    let stdout = std::io::stdout();
+    for line in std::io::stdin().lock().lines() {
+        let line = line.unwrap();
+        let mut it = line.split_whitespace().map(|t| t.parse::<usize>().unwrap());
+        let (k, iters) = (it.next().unwrap(), it.next().unwrap());
+        let (eval, inputs, outputs, work) = &mut runs[k];
+        let i: Vec<&[f64]> = inputs.iter().map(|v| v.as_slice()).collect();
+        let mut o: Vec<&mut [f64]> = outputs.iter_mut().map(|v| v.as_mut_slice()).collect();
+        let t = std::time::Instant::now();
+        for _ in 0..iters {
+            eval(std::hint::black_box(&i), &mut o, work).unwrap();
+            std::hint::black_box(&o);
+        }
+        writeln!(stdout.lock(), "{}", t.elapsed().as_nanos()).unwrap();
+    }
+}
+"#;
+
+/// Generated Rust (`Function::to_rust`) of several functions compiled into one program
+/// that runs as a child process: `time(k, iters)` is the wall time of `iters` calls of
+/// function `k` measured inside the program (no process or pipe cost), for criterion's
+/// `iter_custom`.
+struct GeneratedRust {
+    child: std::process::Child,
+    stdin: std::process::ChildStdin,
+    stdout: std::io::BufReader<std::process::ChildStdout>,
+    /// Rustc's wall time (s).
+    compile: f64,
+    /// Bytes of generated Rust.
+    bytes: usize,
+}
+
+impl GeneratedRust {
+    /// Generates and compiles the program for `fns` (each with its inputs), starts it and
+    /// checks its outputs against the tape bit for bit (no NaN occurs at the bench points).
+    fn start(tag: &str, fns: &[(&Function, &[&[f64]])]) -> GeneratedRust {
+        use std::fmt::Write as _;
+        use std::process::{Command, Stdio};
+        let dir =
+            std::env::temp_dir().join(format!("symx_native_rust_{}_{tag}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut src = String::from("#![allow(clippy::all, unused)]\n");
+        let mut table = String::new();
+        let mut inputs = Vec::new();
+        for (k, (f, ins)) in fns.iter().enumerate() {
+            writeln!(src, "mod f{k} {{\n{}\n}}", f.to_rust().unwrap()).unwrap();
+            write!(
+                table,
+                "(f{k}::eval as Eval, &f{k}::INPUT_SIZES, &f{k}::OUTPUT_SIZES, f{k}::WORK_SIZE), "
+            )
+            .unwrap();
+            inputs.extend(
+                ins.iter()
+                    .flat_map(|v| v.iter())
+                    .flat_map(|v| v.to_le_bytes()),
+            );
+        }
+        writeln!(
+            src,
+            "const FUNCTIONS: [(Eval, &[usize], &[usize], usize); {}] = [{table}];",
+            fns.len()
+        )
+        .unwrap();
+        src.push_str(PROGRAM_MAIN);
+        std::fs::write(dir.join("main.rs"), &src).unwrap();
+        std::fs::write(dir.join("inputs.bin"), inputs).unwrap();
+        let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+        let t = Instant::now();
+        let status = Command::new(rustc)
+            .args(RELEASE_FLAGS)
+            .arg("-o")
+            .arg(dir.join("main"))
+            .arg(dir.join("main.rs"))
+            .status()
+            .expect("rustc runs");
+        assert!(
+            status.success(),
+            "{tag}: the generated Rust does not compile"
+        );
+        let compile = t.elapsed().as_secs_f64();
+        let mut child = Command::new(dir.join("main"))
+            .arg(dir.join("inputs.bin"))
+            .arg(dir.join("outputs.bin"))
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let (stdin, stdout) = (child.stdin.take().unwrap(), child.stdout.take().unwrap());
+        let mut run = GeneratedRust {
+            child,
+            stdin,
+            stdout: std::io::BufReader::new(stdout),
+            compile,
+            bytes: src.len(),
+        };
+        run.time(0, 1); // the outputs file is complete once the program answers
+        let bits: Vec<u64> = std::fs::read(dir.join("outputs.bin"))
+            .unwrap()
+            .chunks(8)
+            .map(|b| u64::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        let want: Vec<u64> = fns
+            .iter()
+            .flat_map(|(f, ins)| f.call(ins).unwrap().concat())
+            .map(f64::to_bits)
+            .collect();
+        assert!(
+            bits == want,
+            "{tag}: the generated Rust's outputs differ from the tape's"
+        );
+        if std::env::var_os("SYMX_NATIVE_RUST_KEEP").is_some() {
+            eprintln!("{tag}: generated program kept in {}", dir.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+        run
+    }
+
+    /// Wall time of `iters` calls of function `k`, measured by the program.
+    fn time(&mut self, k: usize, iters: u64) -> Duration {
+        use std::io::{BufRead, Write};
+        writeln!(self.stdin, "{k} {iters}").unwrap();
+        self.stdin.flush().unwrap();
+        let mut line = String::new();
+        self.stdout.read_line(&mut line).unwrap();
+        Duration::from_nanos(line.trim().parse().unwrap())
+    }
+
+    /// Per-call median (µs) of 7 repetitions of `calls` calls each (as [`per_call`]
+    /// but timed per repetition, not per call).
+    fn per_call(&mut self, k: usize, calls: u64) -> f64 {
+        let mut v: Vec<f64> = (0..7)
+            .map(|_| self.time(k, calls).as_secs_f64() * 1e6 / calls as f64)
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[3]
+    }
+}
+
+impl Drop for GeneratedRust {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The same per-call median as [`GeneratedRust::per_call`] for a symx evaluator.
+fn per_call_batch(f: &Function, ins: &[&[f64]], calls: u64) -> f64 {
+    let mut out = vec![0.0; f.output_sizes()[0]];
+    let mut work = vec![0.0; f.work_size()];
+    let mut v: Vec<f64> = (0..7)
+        .map(|_| {
+            let t = Instant::now();
+            hot_loop(f, ins, &mut out, &mut work, calls as usize);
+            t.elapsed().as_secs_f64() * 1e6 / calls as f64
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v[3]
+}
+
+/// Tape, JIT and generated Rust on ∇f, ∂g/∂x and the Hessian of one problem: prints the
+/// rustc and JIT compile times, the per-call medians of the three measured alternately
+/// (3 rounds, median of rounds) and generated Rust / JIT, then times the three in the
+/// criterion group `{group}/eval`.
+fn native_rust_versus_jit(c: &mut Criterion, group: &str, fns: &Compiled, ins: [&[f64]; 3]) {
+    let all: [(&str, &Function, &[&[f64]]); 3] = [
+        ("grad_f", &fns.grad, &ins[..1]),
+        ("jac_g", &fns.jac, &ins[..1]),
+        ("hess_L", &fns.hess, &ins[..]),
+    ];
+    let pairs: Vec<(&Function, &[&[f64]])> = all.iter().map(|&(_, f, a)| (f, a)).collect();
+    let mut rust = GeneratedRust::start(group, &pairs);
+    eprintln!(
+        "{group} generated Rust {:.1} MB, rustc (release settings) {:.1} s",
+        rust.bytes as f64 / 1e6,
+        rust.compile
+    );
+    let mut g = c.benchmark_group(format!("{group}/eval"));
+    g.sample_size(20)
+        .measurement_time(Duration::from_secs(3))
+        .warm_up_time(Duration::from_secs(1));
+    for (k, (name, f, args)) in all.into_iter().enumerate() {
+        let t = Instant::now();
+        let native = f.jit().unwrap();
+        let compile = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        f.call(args).unwrap();
+        let calls = ((0.05 / t.elapsed().as_secs_f64()) as u64).clamp(10, 2000);
+        let mut rounds = [Vec::new(), Vec::new(), Vec::new()];
+        for _ in 0..3 {
+            rounds[0].push(per_call_batch(f, args, calls));
+            rounds[1].push(per_call_batch(&native, args, calls));
+            rounds[2].push(rust.per_call(k, calls));
+        }
+        let [tape, jit, gen] = rounds.map(|mut v| {
+            v.sort_by(f64::total_cmp);
+            v[1]
+        });
+        eprintln!(
+            "{group} {name:6} jit compile {:8.1} ms  tape {tape:9.2} us  jit {jit:8.2} us  rust {gen:8.2} us  rust/jit {:.3}",
+            1e3 * compile,
+            gen / jit
+        );
+        for (evaluator, f) in [("tape", f), ("jit", &native)] {
+            let mut out = vec![0.0; f.output_sizes()[0]];
+            let mut work = vec![0.0; f.work_size()];
+            g.bench_function(BenchmarkId::new(name, evaluator), |b| {
+                b.iter(|| {
+                    f.eval(black_box(args), &mut [&mut out], &mut work).unwrap();
+                    black_box(&out);
+                })
+            });
+        }
+        g.bench_function(BenchmarkId::new(name, "rust"), |b| {
+            b.iter_custom(|iters| rust.time(k, iters))
+        });
+    }
+    g.finish();
+}
+
+/// `native_rust_chain`, `native_rust_gap`, `native_rust_quadrotor` (`cargo bench --bench
+/// symx_eval -- native_rust`): tape, JIT and generated Rust on the problems of
+/// [`bench_native`] (the quadrotor at `SYMX_NATIVE_RUST_STAGES` stages, default
+/// [`NATIVE_STAGES`]). Run only when a filter names them: rustc takes minutes on the
+/// larger problems.
+fn bench_native_rust(c: &mut Criterion) {
+    // Only when named (rustc takes minutes on the larger problems).
+    if !std::env::args().skip(1).any(|a| a.contains("native_rust")) {
+        return;
+    }
+    if selected("native_rust_chain/eval/hess_L") {
+        let (p, x0) = chain(LINKS);
+        let fns = compile(&differentiate(p));
+        let (x, sigma, lambda) = inputs(LINKS, &x0);
+        native_rust_versus_jit(c, "native_rust_chain", &fns, [&x, &sigma, &lambda]);
+    }
+    if selected("native_rust_gap/eval/hess_L") {
+        let m = gap_model(&gap_scenario());
+        let fns = compile(&differentiate(gap_symbolic(&m)));
+        let compiled = m.problem.compile().unwrap();
+        let mut x0 = vec![0.0; compiled.n()];
+        compiled.initial_point(&mut x0);
+        let (x, sigma, lambda) = inputs(compiled.m(), &x0);
+        native_rust_versus_jit(c, "native_rust_gap", &fns, [&x, &sigma, &lambda]);
+    }
+    if selected("native_rust_quadrotor/eval/hess_L") {
+        let stages = std::env::var("SYMX_NATIVE_RUST_STAGES")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(NATIVE_STAGES);
+        let o = quadrotor_ocp::build(stages, false);
+        let fns = compile(&differentiate(Symbolic {
+            f: o.f,
+            g: o.g,
+            x: o.w,
+        }));
+        let m = (stages + 1) * quadrotor_ocp::NX;
+        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(stages));
+        native_rust_versus_jit(c, "native_rust_quadrotor", &fns, [&x, &sigma, &lambda]);
+    }
+}
+
 /// `native_compile` (`cargo bench --bench symx_eval -- native_compile`): the JIT's
 /// compile time of ∇f, ∂g/∂x and the Hessian against their size, on the hanging chain and
 /// the quadrotor OCP (inlined RK4) at several sizes and on the gap model: one line per
@@ -663,6 +978,7 @@ criterion_group!(
     bench_ocp,
     bench_map,
     bench_native,
+    bench_native_rust,
     bench_native_compile
 );
 

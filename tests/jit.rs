@@ -100,19 +100,48 @@ fn gap_model_matches_the_tape() {
     );
 }
 
+/// CPU seconds this process has used (user + system, all threads; Linux's
+/// `/proc/self/stat` in ticks of 1/100 s), or NaN elsewhere: less sensitive than wall time
+/// to the other processes of a loaded machine. For printed information only.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // The fields after the command name (which ends with the last ')'): utime and stime
+    // are the 12th and 13th of them.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let ticks: Vec<f64> = rest
+        .split_whitespace()
+        .skip(11)
+        .take(2)
+        .filter_map(|t| t.parse().ok())
+        .collect();
+    if ticks.len() == 2 {
+        (ticks[0] + ticks[1]) / 100.0
+    } else {
+        f64::NAN
+    }
+}
+
 /// Solves `tr` with the tape and with native evaluators, three times each, interleaved:
-/// identical iteration counts and solution bits; prints the median times and their ratio.
+/// identical iteration counts and solution bits; prints the JIT's compile time and the
+/// median solve times (wall and CPU) with the number of solves after which the JIT's
+/// compile time is paid back (the measurement behind `Problem::compile`'s default).
 fn same_solve(name: &str, tr: &Transcription) {
+    let t = Instant::now();
     let tape = tr.compile().unwrap();
+    let build = t.elapsed().as_secs_f64();
+    let (t, cpu) = (Instant::now(), cpu_seconds());
     let native = tape.clone().with_evaluator(Evaluator::Jit).unwrap();
+    let (jit_compile, jit_compile_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - cpu);
     let mut times = [Vec::new(), Vec::new()];
+    let mut cpu_times = [Vec::new(), Vec::new()];
     let mut sols = Vec::new();
     for _ in 0..3 {
         for (k, c) in [&tape, &native].into_iter().enumerate() {
             let mut c = c.clone();
-            let t = Instant::now();
+            let (t, cpu) = (Instant::now(), cpu_seconds());
             let sol = Ipm::default().solve(&mut c).unwrap();
             times[k].push(t.elapsed().as_secs_f64());
+            cpu_times[k].push(cpu_seconds() - cpu);
             sols.push(sol);
         }
     }
@@ -134,12 +163,20 @@ fn same_solve(name: &str, tr: &Transcription) {
         v[1]
     };
     let (t_tape, t_jit) = (median(&mut times[0]), median(&mut times[1]));
+    let (c_tape, c_jit) = (median(&mut cpu_times[0]), median(&mut cpu_times[1]));
     eprintln!(
-        "{name}: {} iterations; tape {:.1} ms, jit {:.1} ms, ratio {:.2}",
+        "{name}: {} iterations; wall: transcribe+compile {:.0} ms, jit compile {:.0} ms, solve tape {:.1} ms, jit {:.1} ms ({:.2}x), jit pays after {:.1} solves; CPU: jit compile {:.2} s, solve tape {:.2} s, jit {:.2} s, pays after {:.1} solves",
         first.stats.iterations,
+        1e3 * build,
+        1e3 * jit_compile,
         1e3 * t_tape,
         1e3 * t_jit,
-        t_jit / t_tape
+        t_jit / t_tape,
+        jit_compile / (t_tape - t_jit),
+        jit_compile_cpu,
+        c_tape,
+        c_jit,
+        jit_compile_cpu / (c_tape - c_jit)
     );
 }
 

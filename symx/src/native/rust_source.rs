@@ -1,15 +1,168 @@
 //! [`Function::to_rust`]: a function as a self-contained Rust module for deployment
 //! (`no_std`, no allocation, no dependency: the math functions are the C library's, which
 //! Rust's `std` calls too).
+//!
+//! Nothing is copied per call: each generated function `exec(w, x, y)` reads its inputs
+//! where the caller keeps them (`x[k]`), writes its outputs where the caller wants them
+//! (`y[k]`), and has its constants as literals; the work vector `w` holds only the
+//! temporaries (and the arguments gathered for a call of another function).
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
-use crate::function::Function;
+use crate::function::{Function, Instr};
 use crate::op::Op;
 use rustc_hash::FxHashMap;
 use std::fmt::Write;
 
 /// Tape instructions per generated function (keeps rustc's compile time linear).
 const CHUNK: usize = 1024;
+
+/// Where the generated code finds a register of one function.
+#[derive(Clone, Copy)]
+enum Place {
+    /// Entry `i` of input `k`: `*xk.add(i)`.
+    Input(usize, usize),
+    /// Entry `i` of output `k`: `*yk.add(i)`.
+    Output(usize, usize),
+    /// A constant (a template register no instruction writes): a literal.
+    Constant(f64),
+    /// A temporary: `*w.add(r)`.
+    Work(usize),
+}
+
+/// The place of every register of `f`. Inputs and constants are never written (compilation
+/// gives temporaries only registers after the output slots).
+fn places(f: &Function) -> Vec<Place> {
+    let mut p: Vec<Place> = (0..f.work_size).map(Place::Work).collect();
+    for (k, &v) in f.template.iter().enumerate() {
+        p[f.template_start + k] = Place::Constant(v);
+    }
+    for (k, (&n, &at)) in f.input_sizes.iter().zip(&f.input_offsets).enumerate() {
+        (0..n).for_each(|i| p[at + i] = Place::Input(k, i));
+    }
+    for (k, (&n, &at)) in f.output_sizes.iter().zip(&f.output_offsets).enumerate() {
+        (0..n).for_each(|i| p[at + i] = Place::Output(k, i));
+    }
+    p
+}
+
+/// The output entries no instruction writes (constant outputs), with their values.
+fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
+    let mut written = vec![false; f.work_size];
+    for ins in &f.tape {
+        if ins.op == Op::Call {
+            let call = &f.calls[ins.d as usize];
+            let n: usize = call.function.output_sizes.iter().sum();
+            let out = call.out as usize;
+            written[out..out + n].iter_mut().for_each(|w| *w = true);
+        } else {
+            written[ins.d as usize] = true;
+        }
+    }
+    let mut c = Vec::new();
+    for (k, (&n, &at)) in f.output_sizes.iter().zip(&f.output_offsets).enumerate() {
+        for i in (0..n).filter(|&i| !written[at + i]) {
+            c.push((k, i, f.template[at + i - f.template_start]));
+        }
+    }
+    c
+}
+
+/// The text of one generated function's body, noting the inputs and outputs it uses.
+struct Body<'a> {
+    out: String,
+    places: &'a [Place],
+    inputs: Vec<bool>,
+    outputs: Vec<bool>,
+}
+
+impl Body<'_> {
+    /// The expression reading register `r` (or the place writing it).
+    fn reg(&mut self, r: u32) -> String {
+        match self.places[r as usize] {
+            Place::Input(k, i) => {
+                self.inputs[k] = true;
+                format!("*x{k}.add({i})")
+            }
+            Place::Output(k, i) => {
+                self.outputs[k] = true;
+                format!("*y{k}.add({i})")
+            }
+            Place::Constant(v) => lit(v),
+            Place::Work(r) => format!("*w.add({r})"),
+        }
+    }
+
+    /// The value computed by `ins`, other than a call.
+    fn value(&mut self, ins: &Instr) -> Result<String, SymxError> {
+        let (a, b, c) = (self.reg(ins.a), self.reg(ins.b), self.reg(ins.c));
+        Ok(match ins.op {
+            Op::Add => format!("{a} + {b}"),
+            Op::Sub => format!("{a} - {b}"),
+            Op::Mul => format!("{a} * {b}"),
+            Op::Div => format!("{a} / {b}"),
+            Op::Neg => format!("-{a}"),
+            Op::Sq => format!("{{ let a = {a}; a * a }}"),
+            Op::Sym => a,
+            Op::Abs => format!("f64::from_bits(({a}).to_bits() & !(1u64 << 63))"),
+            Op::Sign => format!("{{ let a = {a}; if a > 0.0 {{ 1.0 }} else if a < 0.0 {{ -1.0 }} else {{ a * 0.0 }} }}"),
+            Op::Not => format!("b2f({a} == 0.0)"),
+            Op::Pow => format!("pow_({a}, {b})"),
+            Op::Min => format!("f64::min({a}, {b})"),
+            Op::Max => format!("f64::max({a}, {b})"),
+            Op::Lt => format!("b2f({a} < {b})"),
+            Op::Le => format!("b2f({a} <= {b})"),
+            Op::Eq => format!("b2f({a} == {b})"),
+            Op::Ne => format!("b2f({a} != {b})"),
+            Op::And => format!("b2f({a} != 0.0 && {b} != 0.0)"),
+            Op::Or => format!("b2f({a} != 0.0 || {b} != 0.0)"),
+            Op::StrongMul => format!("{{ let a = {a}; if a == 0.0 {{ 0.0 }} else {{ a * {b} }} }}"),
+            Op::IfElse => format!("if {a} != 0.0 {{ {b} }} else {{ {c} }}"),
+            op => match (library_unary(op), library_binary(op)) {
+                (Some(h), _) => format!("{h}({a})"),
+                (_, Some(h)) => format!("{h}({a}, {b})"),
+                _ => return Err(unsupported("Rust", op)),
+            },
+        })
+    }
+
+    /// A call of `g` (generated as `callee`): its arguments are gathered into the scratch
+    /// block at `s`, laid out as `g`'s inputs, and its outputs written straight into the
+    /// call's block of registers.
+    fn call(&mut self, f: &Function, ins: &Instr, callee: &str) {
+        let call = &f.calls[ins.d as usize];
+        let g = &call.function;
+        let s = f.call_scratch;
+        let mut p = 0;
+        for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
+            for i in 0..n {
+                let v = self.reg(call.args[p]);
+                writeln!(self.out, "    *w.add({}) = {v};", s + at + i).unwrap();
+                p += 1;
+            }
+        }
+        let xs: Vec<String> = g
+            .input_offsets
+            .iter()
+            .map(|at| format!("w.add({}) as *const f64", s + at))
+            .collect();
+        let mut q = call.out as usize;
+        let ys: Vec<String> = g
+            .output_sizes
+            .iter()
+            .map(|n| {
+                q += n;
+                format!("w.add({})", q - n)
+            })
+            .collect();
+        writeln!(
+            self.out,
+            "    {{ let x = [{}]; let y = [{}]; {callee}(w.add({s}), x.as_ptr(), y.as_ptr()); }}",
+            xs.join(", "),
+            ys.join(", ")
+        )
+        .unwrap();
+    }
+}
 
 struct Writer {
     out: String,
@@ -28,91 +181,61 @@ impl Writer {
             callees.push(self.function(&c.function)?);
         }
         let name = format!("exec{}", self.names.len());
+        let places = places(f);
         let mut chunks = Vec::new();
         for (k, part) in f.tape.chunks(CHUNK).enumerate() {
             let chunk = format!("{name}_{k}");
-            let o = &mut self.out;
-            writeln!(o, "#[inline(never)]\nunsafe fn {chunk}(w: *mut f64) {{").unwrap();
+            let mut body = Body {
+                out: String::new(),
+                places: &places,
+                inputs: vec![false; f.input_sizes.len()],
+                outputs: vec![false; f.output_sizes.len()],
+            };
             for ins in part {
-                let r = |i: u32| format!("*w.add({i})");
-                let (a, b, c) = (r(ins.a), r(ins.b), r(ins.c));
-                let v = match ins.op {
-                    Op::Add => format!("{a} + {b}"),
-                    Op::Sub => format!("{a} - {b}"),
-                    Op::Mul => format!("{a} * {b}"),
-                    Op::Div => format!("{a} / {b}"),
-                    Op::Neg => format!("-{a}"),
-                    Op::Sq => format!("{{ let a = {a}; a * a }}"),
-                    Op::Sym => a,
-                    Op::Abs => format!("f64::from_bits(({a}).to_bits() & !(1u64 << 63))"),
-                    Op::Sign => format!("{{ let a = {a}; if a > 0.0 {{ 1.0 }} else if a < 0.0 {{ -1.0 }} else {{ a * 0.0 }} }}"),
-                    Op::Not => format!("b2f({a} == 0.0)"),
-                    Op::Pow => format!("pow_({a}, {b})"),
-                    Op::Min => format!("f64::min({a}, {b})"),
-                    Op::Max => format!("f64::max({a}, {b})"),
-                    Op::Lt => format!("b2f({a} < {b})"),
-                    Op::Le => format!("b2f({a} <= {b})"),
-                    Op::Eq => format!("b2f({a} == {b})"),
-                    Op::Ne => format!("b2f({a} != {b})"),
-                    Op::And => format!("b2f({a} != 0.0 && {b} != 0.0)"),
-                    Op::Or => format!("b2f({a} != 0.0 || {b} != 0.0)"),
-                    Op::StrongMul => format!("{{ let a = {a}; if a == 0.0 {{ 0.0 }} else {{ a * {b} }} }}"),
-                    Op::IfElse => format!("if {a} != 0.0 {{ {b} }} else {{ {c} }}"),
-                    Op::Call => {
-                        let call = &f.calls[ins.d as usize];
-                        let g = &call.function;
-                        let s = f.call_scratch;
-                        let mut p = 0;
-                        for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
-                            for i in 0..n {
-                                writeln!(o, "    *w.add({}) = *w.add({});", s + at + i, call.args[p]).unwrap();
-                                p += 1;
-                            }
-                        }
-                        writeln!(o, "    {}(w.add({s}));", callees[ins.d as usize]).unwrap();
-                        let mut q = 0;
-                        for (&n, &at) in g.output_sizes.iter().zip(&g.output_offsets) {
-                            for i in 0..n {
-                                writeln!(o, "    *w.add({}) = *w.add({});", call.out as usize + q, s + at + i).unwrap();
-                                q += 1;
-                            }
-                        }
-                        continue;
-                    }
-                    op => match (library_unary(op), library_binary(op)) {
-                        (Some(h), _) => format!("{h}({a})"),
-                        (_, Some(h)) => format!("{h}({a}, {b})"),
-                        _ => return Err(unsupported("Rust", op)),
-                    },
-                };
-                writeln!(o, "    *w.add({}) = {v};", ins.d).unwrap();
+                if ins.op == Op::Call {
+                    body.call(f, ins, &callees[ins.d as usize]);
+                } else {
+                    let v = body.value(ins)?;
+                    let d = body.reg(ins.d);
+                    writeln!(body.out, "    {d} = {v};").unwrap();
+                }
             }
-            writeln!(o, "}}\n").unwrap();
+            self.emit(&chunk, &body);
             chunks.push(chunk);
         }
         let o = &mut self.out;
-        writeln!(o, "/// Runs the tape on a work vector whose inputs are filled.\nunsafe fn {name}(w: *mut f64) {{").unwrap();
-        let t: Vec<String> = f.template.iter().map(|v| lit(*v)).collect();
         writeln!(
             o,
-            "    const TEMPLATE: [f64; {}] = [{}];",
-            t.len(),
-            t.join(", ")
+            "/// Runs the tape: inputs at `x[k]`, outputs to `y[k]`, temporaries in `w`.\nunsafe fn {name}(w: *mut f64, x: *const *const f64, y: *const *mut f64) {{"
         )
         .unwrap();
-        writeln!(
-            o,
-            "    core::ptr::copy_nonoverlapping(TEMPLATE.as_ptr(), w.add({}), {});",
-            f.template_start,
-            t.len()
-        )
-        .unwrap();
+        for (k, i, v) in constant_outputs(f) {
+            writeln!(o, "    *(*y.add({k})).add({i}) = {};", lit(v)).unwrap();
+        }
         for c in &chunks {
-            writeln!(o, "    {c}(w);").unwrap();
+            writeln!(o, "    {c}(w, x, y);").unwrap();
         }
         writeln!(o, "}}\n").unwrap();
         self.names.insert(f.uid, name.clone());
         Ok(name)
+    }
+
+    /// Writes the generated function `name` with `body`, binding the inputs and outputs it uses.
+    fn emit(&mut self, name: &str, body: &Body) {
+        let o = &mut self.out;
+        writeln!(
+            o,
+            "#[inline(never)]\nunsafe fn {name}(w: *mut f64, x: *const *const f64, y: *const *mut f64) {{"
+        )
+        .unwrap();
+        for k in (0..body.inputs.len()).filter(|&k| body.inputs[k]) {
+            writeln!(o, "    let x{k} = *x.add({k});").unwrap();
+        }
+        for k in (0..body.outputs.len()).filter(|&k| body.outputs[k]) {
+            writeln!(o, "    let y{k} = *y.add({k});").unwrap();
+        }
+        o.push_str(&body.out);
+        writeln!(o, "}}\n").unwrap();
     }
 }
 
@@ -161,7 +284,8 @@ unsafe fn pow_(a: f64, b: f64) -> f64 {
     if b == trunc(b) && f64::from_bits(b.to_bits() & !(1u64 << 63)) <= 64.0 {
         __powidf2(a, b as i32)
     } else {
-        pow(a, b)
+        // Hidden from the optimiser, which would turn `pow(a, 0.5)` into a square root.
+        pow(a, core::hint::black_box(b))
     }
 }
 
@@ -220,7 +344,7 @@ impl Function {
             self.name
         )
         .unwrap();
-        writeln!(o, "#[allow(clippy::all, unused_parens, unused_unsafe, unsafe_op_in_unsafe_fn, dead_code)]").unwrap();
+        writeln!(o, "#[allow(clippy::all, unused_parens, unused_unsafe, unsafe_op_in_unsafe_fn, dead_code, unused_variables)]").unwrap();
         writeln!(o, "mod generated {{").unwrap();
         o.push_str(PRELUDE);
         o.push_str(&w.out);
@@ -268,14 +392,9 @@ impl Function {
             patterns.join(", ")
         )
         .unwrap();
-        let ins = list(&self.input_offsets);
-        let outs = list(&self.output_offsets);
         write!(
             o,
-            r#"const INPUT_OFFSETS: [usize; {ni}] = [{ins}];
-const OUTPUT_OFFSETS: [usize; {no}] = [{outs}];
-
-/// Evaluates: `inputs[k]` holds `INPUT_SIZES[k]` numbers, `outputs[k]` `OUTPUT_SIZES[k]`,
+            r#"/// Evaluates: `inputs[k]` holds `INPUT_SIZES[k]` numbers, `outputs[k]` `OUTPUT_SIZES[k]`,
 /// `work` at least `WORK_SIZE`. Allocates nothing.
 pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> Result<(), &'static str> {{
     if inputs.len() != INPUT_SIZES.len() {{ return Err("wrong number of inputs"); }}
@@ -283,15 +402,13 @@ pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> 
     if inputs.iter().zip(INPUT_SIZES).any(|(x, n)| x.len() != n) {{ return Err("an input has the wrong length"); }}
     if outputs.iter().zip(OUTPUT_SIZES).any(|(y, n)| y.len() != n) {{ return Err("an output has the wrong length"); }}
     if work.len() < WORK_SIZE {{ return Err("the work vector is too short"); }}
-    for (k, x) in inputs.iter().enumerate() {{
-        work[INPUT_OFFSETS[k]..INPUT_OFFSETS[k] + x.len()].copy_from_slice(x);
-    }}
-    // SAFETY: the work vector holds WORK_SIZE numbers, the bound of every register.
-    unsafe {{ {main}(work.as_mut_ptr()) }};
-    for (k, y) in outputs.iter_mut().enumerate() {{
-        let n = y.len();
-        y.copy_from_slice(&work[OUTPUT_OFFSETS[k]..OUTPUT_OFFSETS[k] + n]);
-    }}
+    let mut x = [core::ptr::null::<f64>(); {ni}];
+    for (p, v) in x.iter_mut().zip(inputs) {{ *p = v.as_ptr(); }}
+    let mut y = [core::ptr::null_mut::<f64>(); {no}];
+    for (p, v) in y.iter_mut().zip(outputs.iter_mut()) {{ *p = v.as_mut_ptr(); }}
+    // SAFETY: every input and output has its length and the work vector holds WORK_SIZE
+    // numbers, the bound of every temporary.
+    unsafe {{ {main}(work.as_mut_ptr(), x.as_ptr(), y.as_ptr()) }};
     Ok(())
 }}
 }}
