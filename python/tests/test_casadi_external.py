@@ -1,8 +1,8 @@
 """symx's generated C (`Function::to_c`) loaded by CasADi's `external()`.
 
-`cargo run --release --example casadi_external` writes the C files of a small function (with
+`cargo run --release -p symnlp-examples --example casadi_external` writes the C files of a small function (with
 a sparse Jacobian output) and of the gap-crossing model's objective gradient, together with
-symx's own outputs at a test point (`examples/casadi_external.rs`). Each file is compiled by
+symx's own outputs at a test point (`examples/examples/casadi_external.rs`). Each file is compiled by
 the system's C compiler into a shared library, loaded with `casadi.external`, and evaluated
 by CasADi: the interface (names, sizes, sparsity) is the symx function's and the values are
 symx's bit for bit (the C performs the tape's IEEE operations in the tape's order and calls
@@ -37,7 +37,7 @@ def generated(tmp_path_factory):
     out = tmp_path_factory.mktemp("casadi_external")
     cargo = os.environ.get("CARGO", "cargo")
     subprocess.run(
-        [cargo, "run", "--release", "-q", "--example", "casadi_external", "--", str(out)],
+        [cargo, "run", "--release", "-q", "-p", "symnlp-examples", "--example", "casadi_external", "--", str(out)],
         cwd=ROOT,
         check=True,
     )

@@ -10,7 +10,7 @@
 //! `python/tests/test_casadi_external.py` compiles the C files with the system's C compiler,
 //! loads them with `casadi.external` and checks CasADi's results against symx's bit for bit.
 //!
-//! Run: `cargo run --release --example casadi_external -- <directory> [small|gap_grad_f]...`
+//! Run: `cargo run --release -p symnlp-examples --example casadi_external -- <directory> [small|gap_grad_f]...`
 //! (every function when none is named). In Python, after compiling `small.c` with
 //! `cc -std=c99 -shared -fPIC -o small.so small.c -lm`:
 //!
@@ -126,7 +126,7 @@ fn write(dir: &std::path::Path, case: &Case) -> Result<(), Box<dyn std::error::E
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let dir = std::path::PathBuf::from(args.next().ok_or(
-        "usage: cargo run --release --example casadi_external -- <directory> [small|gap_grad_f]...",
+        "usage: cargo run --release -p symnlp-examples --example casadi_external -- <directory> [small|gap_grad_f]...",
     )?);
     let mut names: Vec<String> = args.collect();
     if names.is_empty() {
