@@ -127,6 +127,28 @@ pub struct IterationRecord {
     pub ls: usize,
 }
 
+impl IterationRecord {
+    /// The row of a starting point: objective `objective`, every measure and step 0.
+    pub(crate) fn starting_point(objective: f64) -> IterationRecord {
+        IterationRecord {
+            iter: 0,
+            restoration: false,
+            objective,
+            inf_pr: 0.0,
+            inf_du: 0.0,
+            mu: 0.0,
+            d_norm: 0.0,
+            regularization: 0.0,
+            jacobian_regularization: 0.0,
+            augmented_weight: 0.0,
+            alpha_du: 0.0,
+            alpha_pr: 0.0,
+            alpha_pr_char: ' ',
+            ls: 0,
+        }
+    }
+}
+
 /// Counters and timers of a solve (filled by the solvers; fields may be added).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]

@@ -3,6 +3,7 @@
 //! `benches/reference/results/integrator_casadi.json`, CVODES at rtol 1e-12, atol 1e-14).
 use nlp::integrator::{Integrator, IntegratorError, IntegratorOptions, Method};
 use symx::{gradient, hessian, Function, Matrix, SymxError};
+use testkit::ode::van_der_pol;
 
 fn tight() -> IntegratorOptions {
     IntegratorOptions {
@@ -27,16 +28,6 @@ fn oscillator() -> Function {
 }
 
 /// Van der Pol ẋ₀ = x₁, ẋ₁ = μ(1 − x₀²)x₁ − x₀.
-fn van_der_pol() -> Function {
-    let x = Matrix::sym_vec("x", 2);
-    let mu = Matrix::sym_vec("mu", 1);
-    Function::new(
-        &[&x, &mu],
-        &[&[x[1], mu[0] * (1.0 - x[0].sq()) * x[1] - x[0]]],
-    )
-    .unwrap()
-}
-
 #[test]
 fn exponential_decay_matches_the_closed_form() {
     let int = Integrator::new(&decay(), 0.0, 3.0, tight()).unwrap();

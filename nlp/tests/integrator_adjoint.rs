@@ -3,30 +3,7 @@
 //! to rounding) and against central finite differences, for both methods.
 use nlp::integrator::{Integrator, IntegratorOptions, Method};
 use symx::{Expr, Function, Matrix};
-
-fn van_der_pol() -> Function {
-    let x = Matrix::sym_vec("x", 2);
-    let mu = Matrix::sym_vec("mu", 1);
-    Function::new(
-        &[&x, &mu],
-        &[&[x[1], mu[0] * (1.0 - x[0].sq()) * x[1] - x[0]]],
-    )
-    .unwrap()
-}
-
-fn robertson() -> Function {
-    let y = Matrix::sym_vec("y", 3);
-    let k = Matrix::sym_vec("k", 3);
-    Function::new(
-        &[&y, &k],
-        &[&[
-            -k[0] * y[0] + k[1] * y[1] * y[2],
-            k[0] * y[0] - k[1] * y[1] * y[2] - k[2] * y[1].sq(),
-            k[2] * y[1].sq(),
-        ]],
-    )
-    .unwrap()
-}
+use testkit::ode::{robertson, van_der_pol};
 
 /// A chain of `n` masses-free cells `ẋᵢ = a(xᵢ₋₁ − xᵢ) − 0.1xᵢ³` driven by `x₋₁ = u`,
 /// parameters `(a, u)`: many states, one output of interest (the last cell).

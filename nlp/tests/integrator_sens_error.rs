@@ -7,17 +7,7 @@
 //! −1.130265703754519). The same file records what CVODES itself gives at rtol 1e-6
 //! through CasADi's `jac:xf:x0` (9.1, with `fsens_err_con` true or false alike).
 use nlp::integrator::{Integrator, IntegratorOptions, Method};
-use symx::{Function, Matrix};
-
-fn van_der_pol() -> Function {
-    let x = Matrix::sym_vec("x", 2);
-    let mu = Matrix::sym_vec("mu", 1);
-    Function::new(
-        &[&x, &mu],
-        &[&[x[1], mu[0] * (1.0 - x[0].sq()) * x[1] - x[0]]],
-    )
-    .unwrap()
-}
+use testkit::ode::van_der_pol;
 
 /// The CVODES Jacobian ∂x(T)/∂(x0, p) (column-major) of `name` at rtol 1e-12.
 fn reference(name: &str) -> Vec<f64> {

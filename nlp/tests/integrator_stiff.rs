@@ -3,6 +3,7 @@
 //! kept in `benches/reference/results/integrator_casadi.json`) and finite differences.
 use nlp::integrator::{Integrator, IntegratorError, IntegratorOptions, Method};
 use symx::{Function, Matrix};
+use testkit::ode::{robertson, van_der_pol};
 
 fn options(rtol: f64, atol: f64) -> IntegratorOptions {
     IntegratorOptions {
@@ -21,30 +22,6 @@ fn linear_stiff() -> Function {
     let d = -(a[0] + b) * 0.5;
     let o = (b - a[0]) * 0.5;
     Function::new(&[&x, &a], &[&[d * x[0] + o * x[1], o * x[0] + d * x[1]]]).unwrap()
-}
-
-fn van_der_pol() -> Function {
-    let x = Matrix::sym_vec("x", 2);
-    let mu = Matrix::sym_vec("mu", 1);
-    Function::new(
-        &[&x, &mu],
-        &[&[x[1], mu[0] * (1.0 - x[0].sq()) * x[1] - x[0]]],
-    )
-    .unwrap()
-}
-
-fn robertson() -> Function {
-    let y = Matrix::sym_vec("y", 3);
-    let k = Matrix::sym_vec("k", 3);
-    Function::new(
-        &[&y, &k],
-        &[&[
-            -k[0] * y[0] + k[1] * y[1] * y[2],
-            k[0] * y[0] - k[1] * y[1] * y[2] - k[2] * y[1].sq(),
-            k[2] * y[1].sq(),
-        ]],
-    )
-    .unwrap()
 }
 
 const ROBERTSON_K: [f64; 3] = [0.04, 1e4, 3e7];

@@ -11,6 +11,7 @@
 //! | [`solve_problems`] | the scalable problems of `benches/solve.rs` (hanging chain, Van der Pol) |
 //! | [`hanging_chain`], [`quadrotor_ocp`] | the symbolic problems of `benches/symx_eval.rs` |
 //! | [`trees`] | random expression trees with an independent evaluator (property tests) |
+//! | [`ode`] | right-hand sides of the integrators' tests (Van der Pol, Robertson) |
 //! | [`special`] | special floating-point operands, the NaN-tolerant bit comparison (native evaluators against the tape) |
 //! | [`alloc`] | counting global allocators (allocation-free spans) |
 //! | [`corpus`] | the test corpus crate (optimal-control families, CUTEst-style problems), re-exported |
@@ -22,6 +23,7 @@ pub mod cart_pole_mpc;
 pub mod hanging_chain;
 pub mod hs;
 pub mod mpcc;
+pub mod ode;
 pub mod quadrotor_ocp;
 pub mod socp;
 pub mod solve_problems;

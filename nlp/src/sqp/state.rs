@@ -238,26 +238,6 @@ impl Curvature {
     }
 }
 
-/// The log row of the starting point (objective `objective` in the user's units).
-fn first_record(objective: f64) -> IterationRecord {
-    IterationRecord {
-        iter: 0,
-        restoration: false,
-        objective,
-        inf_pr: 0.0,
-        inf_du: 0.0,
-        mu: 0.0,
-        d_norm: 0.0,
-        regularization: 0.0,
-        jacobian_regularization: 0.0,
-        augmented_weight: 0.0,
-        alpha_du: 0.0,
-        alpha_pr: 0.0,
-        alpha_pr_char: ' ',
-        ls: 0,
-    }
-}
-
 impl<'a> SqpState<'a> {
     /// Lays out the solve (with the KKT matrix and QPs the workspace `ws` kept for this
     /// structure), scales the problem at the (clamped) starting point and evaluates it
@@ -280,7 +260,7 @@ impl<'a> SqpState<'a> {
             ..Stats::default()
         };
         let it = first_iterate(&mut sc, &shape, x, warm);
-        let record = first_record(sc.scaling.objective_to_user(it.f));
+        let record = IterationRecord::starting_point(sc.scaling.objective_to_user(it.f));
         let kept = ws.take(&shape, &geo, (o.qp_tol, o.qp_max_iter));
         let qp = kept.plain.unwrap_or_else(|| new_qp(&shape, &geo, o, false));
         SqpState {

@@ -314,24 +314,13 @@ impl<'p> Core<'p> {
             }
             println!(
                 "{}",
-                crate::log::Columns::Ipm.format(shared.stats.records.last().unwrap_or(
-                    &IterationRecord {
-                        iter: 0,
-                        restoration: false,
-                        objective: 0.0,
-                        inf_pr: 0.0,
-                        inf_du: 0.0,
-                        mu: 0.0,
-                        d_norm: 0.0,
-                        regularization: 0.0,
-                        jacobian_regularization: 0.0,
-                        augmented_weight: 0.0,
-                        alpha_du: 0.0,
-                        alpha_pr: 0.0,
-                        alpha_pr_char: ' ',
-                        ls: 0
-                    }
-                ))
+                crate::log::Columns::Ipm.format(
+                    shared
+                        .stats
+                        .records
+                        .last()
+                        .unwrap_or(&IterationRecord::starting_point(0.0))
+                )
             );
         }
     }
