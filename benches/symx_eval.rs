@@ -588,32 +588,46 @@ fn native_versus_tape(c: &mut Criterion, group: &str, fns: &Compiled, ins: [&[f6
 /// native`): tape vs JIT on the hanging chain (1000 links), the gap-crossing model and the
 /// quadrotor OCP at N = 320 (inlined RK4, the size).
 fn bench_native(c: &mut Criterion) {
-    if selected("native_chain/eval/hess_L") {
+    native_problems("native", NATIVE_STAGES, |group, fns, ins| {
+        native_versus_tape(c, group, fns, ins)
+    });
+}
+
+/// Builds each of the native groups' problems that the filter selects — `{prefix}_chain`
+/// (1000 links), `{prefix}_gap` (the gap-crossing model at its initial point) and
+/// `{prefix}_quadrotor` (`stages` stages, inlined RK4) — and runs `bench` on its group
+/// name, its compiled ∇f, J and H, and their inputs `[x, σ, λ]`.
+fn native_problems(
+    prefix: &str,
+    stages: usize,
+    mut bench: impl FnMut(&str, &Compiled, [&[f64]; 3]),
+) {
+    let group = |problem: &str| format!("{prefix}_{problem}");
+    if selected(&format!("{}/eval/hess_L", group("chain"))) {
         let (p, x0) = chain(LINKS);
         let fns = compile(&differentiate(p));
         let (x, sigma, lambda) = inputs(LINKS, &x0);
-        native_versus_tape(c, "native_chain", &fns, [&x, &sigma, &lambda]);
+        bench(&group("chain"), &fns, [&x, &sigma, &lambda]);
     }
-    if selected("native_gap/eval/hess_L") {
+    if selected(&format!("{}/eval/hess_L", group("gap"))) {
         let m = gap_model(&gap_scenario());
         let fns = compile(&differentiate(gap_symbolic(&m)));
         let compiled = m.problem.compile().unwrap();
         let mut x0 = vec![0.0; compiled.n()];
         compiled.initial_point(&mut x0);
         let (x, sigma, lambda) = inputs(compiled.m(), &x0);
-        native_versus_tape(c, "native_gap", &fns, [&x, &sigma, &lambda]);
+        bench(&group("gap"), &fns, [&x, &sigma, &lambda]);
     }
-    if selected("native_quadrotor/eval/hess_L") {
-        const STAGES: usize = NATIVE_STAGES;
-        let o = quadrotor_ocp::build(STAGES, false);
+    if selected(&format!("{}/eval/hess_L", group("quadrotor"))) {
+        let o = quadrotor_ocp::build(stages, false);
         let fns = compile(&differentiate(Symbolic {
             f: o.f,
             g: o.g,
             x: o.w,
         }));
-        let m = (STAGES + 1) * quadrotor_ocp::NX;
-        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(STAGES));
-        native_versus_tape(c, "native_quadrotor", &fns, [&x, &sigma, &lambda]);
+        let m = (stages + 1) * quadrotor_ocp::NX;
+        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(stages));
+        bench(&group("quadrotor"), &fns, [&x, &sigma, &lambda]);
     }
 }
 
@@ -889,36 +903,13 @@ fn bench_native_rust(c: &mut Criterion) {
     if !std::env::args().skip(1).any(|a| a.contains("native_rust")) {
         return;
     }
-    if selected("native_rust_chain/eval/hess_L") {
-        let (p, x0) = chain(LINKS);
-        let fns = compile(&differentiate(p));
-        let (x, sigma, lambda) = inputs(LINKS, &x0);
-        native_rust_versus_jit(c, "native_rust_chain", &fns, [&x, &sigma, &lambda]);
-    }
-    if selected("native_rust_gap/eval/hess_L") {
-        let m = gap_model(&gap_scenario());
-        let fns = compile(&differentiate(gap_symbolic(&m)));
-        let compiled = m.problem.compile().unwrap();
-        let mut x0 = vec![0.0; compiled.n()];
-        compiled.initial_point(&mut x0);
-        let (x, sigma, lambda) = inputs(compiled.m(), &x0);
-        native_rust_versus_jit(c, "native_rust_gap", &fns, [&x, &sigma, &lambda]);
-    }
-    if selected("native_rust_quadrotor/eval/hess_L") {
-        let stages = std::env::var("SYMX_NATIVE_RUST_STAGES")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(NATIVE_STAGES);
-        let o = quadrotor_ocp::build(stages, false);
-        let fns = compile(&differentiate(Symbolic {
-            f: o.f,
-            g: o.g,
-            x: o.w,
-        }));
-        let m = (stages + 1) * quadrotor_ocp::NX;
-        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(stages));
-        native_rust_versus_jit(c, "native_rust_quadrotor", &fns, [&x, &sigma, &lambda]);
-    }
+    let stages = std::env::var("SYMX_NATIVE_RUST_STAGES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(NATIVE_STAGES);
+    native_problems("native_rust", stages, |group, fns, ins| {
+        native_rust_versus_jit(c, group, fns, ins)
+    });
 }
 
 /// `native_compile` (`cargo bench --bench symx_eval -- native_compile`): the JIT's
