@@ -14,7 +14,8 @@
 //! - [`crossing`]: the crossing search's candidates (which move of each foot first lands
 //!   beyond a gap), [`crossing_search`]: solving them, on the plan's walking horizon;
 //! - [`frame`]: the translation to the start's frame every plan is solved in;
-//! - [`reach`]: geometric certificates that a goal is unreachable;
+//! - [`reach`]: geometric certificates that a goal is unreachable; [`footing`]: on a
+//!   height map, the cells no foot can stand on and whether the rest joins start and goal;
 //! - [`replan`]: re-planning the rest of a plan from a measured (perturbed) stance;
 //! - [`status`]: the typed outcome of planning (solved, gap not crossable, goal not
 //!   reached, solver failed, check failed) and its exit code;
@@ -36,6 +37,7 @@ pub mod convergence;
 pub mod crossing;
 pub mod crossing_search;
 pub mod export;
+pub mod footing;
 pub mod frame;
 pub mod gait;
 pub mod limits;

@@ -40,6 +40,7 @@
 //! ρ_h = 0.5954 m against ρ = 0.7571 m, 9 moves per foot instead of 8, 37 stances
 //! instead of 33.
 use crate::check::GOAL_TOL;
+use crate::footing::Unstandable;
 use crate::scenario::{Foot, Scenario};
 use crate::terrain::{self, Region, Terrain};
 use std::fmt;
@@ -74,13 +75,20 @@ pub struct Uncrossable {
     pub nearest: f64,
     /// The x range covered by the regions the foot can reach (m).
     pub reachable_x: [f64; 2],
-    /// The shortest horizontal distance from a reachable region to any other region
-    /// (m; ≥ reach), `None` when there is no other region.
+    /// A lower bound on the distance from a reachable region to any other region (m;
+    /// ≥ reach; 3-D where the terrain bounds its heights), `None` when there is no other
+    /// region.
     pub shortest_exit: Option<f64>,
+    /// On a height map: the cells no foot can stand on, which split its ground into
+    /// regions (`None` on the other terrains; [`crate::footing`]).
+    pub unstandable: Option<Unstandable>,
 }
 
 impl fmt::Display for Uncrossable {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(u) = &self.unstandable {
+            write!(f, "{u}; ")?;
+        }
         write!(
             f,
             "foot {} can stand only in x ∈ [{:.4}, {:.4}] m (the regions it can reach from its start)",
@@ -89,7 +97,7 @@ impl fmt::Display for Uncrossable {
         if let Some(d) = self.shortest_exit {
             write!(
                 f,
-                "; the next region is {d:.4} m away (3-D, rises and drops included), not less than the step reach {:.4} m",
+                "; the next region is at least {d:.4} m away (3-D, rises and drops included), not less than the step reach {:.4} m",
                 self.reach
             )?;
         }
@@ -240,7 +248,8 @@ fn reachable(terrain: &dyn Terrain, regions: &[Region], x: f64, y: f64, reach: f
 }
 
 /// A certificate that some foot cannot reach its goal, or `None` when every foot can
-/// (as far as this geometric test sees).
+/// (as far as this geometric test sees): on the terrain's regions, then, on a height map,
+/// on the ground a foot can stand on ([`crate::footing::uncrossable`]).
 pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
     let terrain = terrain::of(s);
     let terrain = &*terrain;
@@ -277,9 +286,10 @@ pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
             nearest,
             reachable_x,
             shortest_exit,
+            unstandable: None,
         });
     }
-    None
+    crate::footing::uncrossable(s)
 }
 
 /// Feet of a plan's last stance `last` that stop before a crossable keep-out zone: the

@@ -451,13 +451,15 @@ pub struct HeightMap {
 /// derivatives (a polynomial lies within the range of its Bernstein coefficients; Farin,
 /// *Curves and Surfaces for CAGD*, §5.3 and §16.2).
 #[derive(Clone, Debug)]
-struct CellBounds {
+pub(crate) struct CellBounds {
     /// The cell.
-    box_: Region,
+    pub(crate) box_: Region,
     /// `[min, max]` of the height over the cell (m), or a range holding them.
-    h: [f64; 2],
+    pub(crate) h: [f64; 2],
+    /// Ranges holding `∂h/∂x` and `∂h/∂y` over the cell.
+    pub(crate) grad: [[f64; 2]; 2],
     /// A bound on `‖∇h‖` over the cell.
-    slope: f64,
+    pub(crate) slope: f64,
 }
 
 /// `B[k][a] = C(k, a)/C(3, a)`: the power coefficient `a` of a cubic on [0, 1] contributes
@@ -488,26 +490,68 @@ fn bernstein_range(c: &[f64; 16], size: [f64; 2]) -> [f64; 2] {
     range
 }
 
+/// `Σ c[a + 4b] s^a t^b` as a polynomial of `(s − s0, t − t0)` (Taylor shift, exact up to
+/// rounding).
+fn shifted(c: &[f64; 16], [s0, t0]: [f64; 2]) -> [f64; 16] {
+    const BINOMIAL: [[f64; 4]; 4] = [
+        [1.0, 0.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0, 0.0],
+        [1.0, 2.0, 1.0, 0.0],
+        [1.0, 3.0, 3.0, 1.0],
+    ];
+    let shift4 = |v: [f64; 4], x0: f64| -> [f64; 4] {
+        std::array::from_fn(|k| {
+            (k..4)
+                .map(|a| BINOMIAL[a][k] * v[a] * x0.powi((a - k) as i32))
+                .sum()
+        })
+    };
+    let mut out = *c;
+    for b in 0..4 {
+        let row = shift4(std::array::from_fn(|a| out[a + 4 * b]), s0);
+        (0..4).for_each(|a| out[a + 4 * b] = row[a]);
+    }
+    for a in 0..4 {
+        let col = shift4(std::array::from_fn(|b| out[a + 4 * b]), t0);
+        (0..4).for_each(|b| out[a + 4 * b] = col[b]);
+    }
+    out
+}
+
+/// `∂/∂s` and `∂/∂t` of `Σ h[a + 4b] s^a t^b`, again as bicubics (top powers zero).
+fn partials(h: &[f64; 16]) -> [[f64; 16]; 2] {
+    let (mut hs, mut ht) = ([0.0; 16], [0.0; 16]);
+    for b in 0..4 {
+        for a in 0..3 {
+            hs[a + 4 * b] = (a + 1) as f64 * h[a + 1 + 4 * b];
+            ht[b + 4 * a] = (a + 1) as f64 * h[b + 4 * (a + 1)];
+        }
+    }
+    [hs, ht]
+}
+
+/// Ranges holding `∂h/∂x` and `∂h/∂y` over the box `[0, size[0]] × [0, size[1]]` of the
+/// cell polynomial `h`, and a bound on `‖∇h‖` there.
+pub(crate) fn gradient_bounds(h: &[f64; 16], size: [f64; 2]) -> ([[f64; 2]; 2], f64) {
+    let [hs, ht] = partials(h);
+    let abs_max = |r: [f64; 2]| r[0].abs().max(r[1].abs());
+    let grad = [bernstein_range(&hs, size), bernstein_range(&ht, size)];
+    (grad, abs_max(grad[0]).hypot(abs_max(grad[1])))
+}
+
 impl CellBounds {
     fn of(c: &[f64], corner: [f64; 2], size: [f64; 2]) -> CellBounds {
         let mut h = [0.0; 16];
         h.copy_from_slice(c);
-        // ∂/∂s and ∂/∂t, again as bicubics (their top powers zero).
-        let (mut hs, mut ht) = ([0.0; 16], [0.0; 16]);
-        for b in 0..4 {
-            for a in 0..3 {
-                hs[a + 4 * b] = (a + 1) as f64 * h[a + 1 + 4 * b];
-                ht[b + 4 * a] = (a + 1) as f64 * h[b + 4 * (a + 1)];
-            }
-        }
-        let abs_max = |r: [f64; 2]| r[0].abs().max(r[1].abs());
+        let (grad, slope) = gradient_bounds(&h, size);
         CellBounds {
             box_: Region {
                 x: [corner[0], corner[0] + size[0]],
                 y: [corner[1], corner[1] + size[1]],
             },
             h: bernstein_range(&h, size),
-            slope: abs_max(bernstein_range(&hs, size)).hypot(abs_max(bernstein_range(&ht, size))),
+            grad,
+            slope,
         }
     }
 }
@@ -528,6 +572,14 @@ const CATMULL_ROM: [[f64; 4]; 4] = [
 impl HeightMap {
     fn nx(&self) -> usize {
         self.heights.first().map_or(0, Vec::len)
+    }
+
+    /// Cells of the grid's rectangle along x and along y (one less than the nodes).
+    pub fn cell_counts(&self) -> [usize; 2] {
+        [
+            self.nx().saturating_sub(1),
+            self.heights.len().saturating_sub(1),
+        ]
     }
 
     /// Height of node `(i, j)`, ghost nodes (index −1 or n) included.
@@ -698,8 +750,9 @@ impl HeightMap {
         (xs, ys, coeffs)
     }
 
-    /// Bounds of the height and slope on each cell of the grid's rectangle (built once).
-    fn cells(&self) -> &[CellBounds] {
+    /// Bounds of the height and slope on each cell of the grid's rectangle (built once),
+    /// row by row ([`HeightMap::cell_counts`] cells per row and rows).
+    pub(crate) fn cells(&self) -> &[CellBounds] {
         self.bounds.get_or_init(|| {
             let (xs, ys, coeffs) = self.cell_polynomials();
             let (cx, n) = (xs.len() - 1, [self.nx() - 1, self.heights.len() - 1]);
@@ -714,6 +767,35 @@ impl HeightMap {
             }
             out
         })
+    }
+
+    /// For each cell of the grid's rectangle (the order of [`HeightMap::cells`]), the
+    /// gradient ranges and slope bound ([`gradient_bounds`]) of its `parts × parts`
+    /// sub-cells: tighter than the cell's own (a Bernstein range converges to the true
+    /// range quadratically in the box's size).
+    pub(crate) fn sub_cell_gradients(&self, parts: usize) -> Vec<Vec<([[f64; 2]; 2], f64)>> {
+        let (xs, ys, coeffs) = self.cell_polynomials();
+        let (cx, n) = (xs.len() - 1, self.cell_counts());
+        let first = (PAD + 1) as usize;
+        let mut out = Vec::with_capacity(n[0] * n[1]);
+        for l in first..first + n[1] {
+            for k in first..first + n[0] {
+                let mut c = [0.0; 16];
+                c.copy_from_slice(&coeffs[16 * (k + cx * l)..16 * (k + cx * l + 1)]);
+                let size = [
+                    (xs[k + 1] - xs[k]) / parts as f64,
+                    (ys[l + 1] - ys[l]) / parts as f64,
+                ];
+                let subs = (0..parts * parts)
+                    .map(|q| {
+                        let at = [(q % parts) as f64 * size[0], (q / parts) as f64 * size[1]];
+                        gradient_bounds(&shifted(&c, at), size)
+                    })
+                    .collect();
+                out.push(subs);
+            }
+        }
+        out
     }
 
     /// The cells of the grid's rectangle meeting region `r`, each with its box cut to `r`.
