@@ -306,25 +306,41 @@ fn motion_limits(
     coms: &[Matrix; 2],
 ) -> Result<(), BuildError> {
     let m = &s.motion;
+    body_height(pb, s, terrain, label, coms)?;
     for (j, (c, before)) in Biped::ALL.iter().zip(coms.iter().zip(previous)) {
-        if m.body_height_min.is_some() || m.body_height_max.is_some() {
-            let above = c[2] - terrain.height(c[0], c[1]);
-            let name = format!("motion body height {}, stance {label}", j.name());
-            pb.subject_to_named(
-                &name,
-                nlp::bounded(
-                    m.body_height_min.unwrap_or(f64::NEG_INFINITY),
-                    above,
-                    m.body_height_max.unwrap_or(f64::INFINITY),
-                ),
-            )?;
-        }
         if let Some(t) = m.com_travel_max {
             pb.subject_to_named(
                 &format!("motion CoM travel {}, stance {label}", j.name()),
                 (c - before).sumsqr().le(t * t),
             )?;
         }
+    }
+    Ok(())
+}
+
+/// The scenario's optional body-height limits ([`crate::scenario::MotionLimits`]) on
+/// both CoMs of stance `label`: `min ≤ z − h(x, y) ≤ max`. Nothing when neither is set.
+fn body_height(
+    pb: &mut Problem,
+    s: &Scenario,
+    terrain: &dyn Terrain,
+    label: usize,
+    coms: &[Matrix; 2],
+) -> Result<(), BuildError> {
+    let m = &s.motion;
+    if m.body_height_min.is_none() && m.body_height_max.is_none() {
+        return Ok(());
+    }
+    for (j, c) in Biped::ALL.iter().zip(coms) {
+        let above = c[2] - terrain.height(c[0], c[1]);
+        pb.subject_to_named(
+            &format!("motion body height {}, stance {label}", j.name()),
+            nlp::bounded(
+                m.body_height_min.unwrap_or(f64::NEG_INFINITY),
+                above,
+                m.body_height_max.unwrap_or(f64::INFINITY),
+            ),
+        )?;
     }
     Ok(())
 }
@@ -528,9 +544,11 @@ fn rigid_legs(
 pub const STANCE_FEET: &str = "stance feet";
 
 /// One stance with its feet given: the CoMs and forces that minimise the stance's terms
-/// of (1) subject to (2), (4) and (11), with the four footholds a parameter named
-/// [`STANCE_FEET`]. Variables: r_B, r_F, then F_BR, F_BL, F_FR, F_FL (18). The feet's own
-/// equations ((3), (5)–(9), the keep-out) are not in it: they involve only the footholds.
+/// of (1) subject to (2), (4), (11) and the scenario's body-height limits (`motion`, when
+/// set), with the four footholds a parameter named [`STANCE_FEET`]. Variables: r_B, r_F,
+/// then F_BR, F_BL, F_FR, F_FL (18). The feet's own equations ((3), (5)–(9), the
+/// keep-out) are not in it: they involve only the footholds; nor is the CoM travel limit,
+/// which links two stances (the schedule search checks it on the plan it proposes).
 pub fn build_stance(s: &Scenario, terrain: &dyn Terrain) -> Result<Problem, BuildError> {
     let mut pb = Problem::new();
     let label = 0;
@@ -554,6 +572,7 @@ pub fn build_stance(s: &Scenario, terrain: &dyn Terrain) -> Result<Problem, Buil
         )?;
     }
     rigid_legs(&mut pb, s, label, &coms, &feet)?;
+    body_height(&mut pb, s, terrain, label, &coms)?;
     let mut terms = Vec::new();
     stance_cost(s, &coms, &forces, &mut terms);
     pb.minimize(terms.into_iter().sum());

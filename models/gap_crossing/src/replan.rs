@@ -232,7 +232,8 @@ pub fn replan(
 
 /// [`replan`], then, with `improve`, the free gait's schedule search from the re-plan
 /// (the foot schedule of stances K.. may change; [`crate::solve::plan_warm`]); the best
-/// plan is kept, so it costs no more than [`replan`]'s.
+/// plan is kept, so it costs no more than [`replan`]'s. A scenario with a prescribed
+/// gait (`gait = "crawl"`) keeps its schedule: `improve` does nothing there.
 pub fn replan_with(
     file: &SolutionFile,
     stance: usize,
@@ -246,6 +247,8 @@ pub fn replan_with(
     let measured = measured_stance(&file.stances[k0], p);
     validate(file, stance, p, Some(&measured))?;
     let sub = measured_scenario(s, stance, &measured);
+    // The schedule search changes the schedule, which a prescribed gait forbids.
+    let improve = improve && s.gait == crate::scenario::Gait::Free;
     let schedule = schedule_of(&file.stances[k0..]);
     let mut guess = Plan {
         stances: file.stances[k0..].to_vec(),

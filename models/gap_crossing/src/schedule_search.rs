@@ -436,6 +436,9 @@ pub fn propose(
         })
         .collect();
     let new_plan = Plan { stances };
+    if !within_com_travel(s, &new_plan) {
+        return None;
+    }
     let cost = plan.cost(s);
     let gain = cost - new_plan.cost(s);
     if gain <= MIN_RELATIVE_GAIN * cost {
@@ -450,6 +453,21 @@ pub fn propose(
         gain,
         changed,
         evaluated,
+    })
+}
+
+/// Whether every CoM of `plan` moves at most the scenario's `motion.com_travel_max` per
+/// transition, within the checker's tolerance (true when no limit is set): the stance
+/// problems are solved one by one, so the limit, which links two stances, is checked on
+/// the path chosen.
+fn within_com_travel(s: &Scenario, plan: &Plan) -> bool {
+    let Some(t) = s.motion.com_travel_max else {
+        return true;
+    };
+    plan.stances.windows(2).all(|w| {
+        crate::scenario::Biped::ALL
+            .iter()
+            .all(|&j| dist2(w[0].com.get(j), w[1].com.get(j)).sqrt() <= t + crate::check::TOL)
     })
 }
 

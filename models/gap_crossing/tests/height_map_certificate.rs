@@ -90,7 +90,7 @@ fn a_ramp_too_steep_for_the_friction_is_certified() {
     assert_eq!(c.foot, Foot::BR, "{c}");
     assert!(c.unstandable.is_some());
     let exit = c.shortest_exit.unwrap();
-    assert!(exit >= 0.3 && exit < 0.45, "{c}");
+    assert!((0.3..0.45).contains(&exit), "{c}");
     assert!(c.nearest > c.need_within, "{c}");
     assert!(c.reachable_x[1] < 2.5, "{c}");
     let msg = c.to_string();
