@@ -475,6 +475,29 @@ mod tests {
         assert_eq!(uncrossable(&s), None);
     }
 
+    /// Stepping stones out of reach of each other: a start pad x ∈ [−0.5, 2.5] and a goal
+    /// pad from x = 2.5 + w on (y ∈ [−0.5, 1.5] both): with w = 0.35 m the front feet
+    /// cannot leave the start pad (the next stone is 0.35 m away, beyond the 0.3 m reach):
+    /// certified; with w = 0.29 m nothing is.
+    #[test]
+    fn stones_out_of_reach_of_each_other() {
+        let stones = |w: f64| -> Scenario {
+            let mut s = Scenario::default();
+            s.apply_overrides(&[&format!(
+                "terrain={{kind=\"stones\", stones=[[-0.5, 2.5, -0.5, 1.5], [{}, 9.0, -0.5, 1.5]]}}",
+                2.5 + w
+            )])
+            .unwrap();
+            s.validate().unwrap();
+            s
+        };
+        let c = uncrossable(&stones(0.35)).expect("certificate");
+        assert!((c.shortest_exit.unwrap() - 0.35).abs() < 1e-12, "{c}");
+        assert!(c.reachable_x == [-0.5, 2.5], "{c}");
+        assert!(c.to_string().contains("at least 0.3500 m away"), "{c}");
+        assert_eq!(uncrossable(&stones(0.29)), None);
+    }
+
     /// A keep-out typed as exactly the reach whose width rounds below it (2.74 − 2.5 +
     /// 0.06 = 0.2999999999999998 in binary) is not crossable; one 1e-4 m narrower is.
     #[test]
