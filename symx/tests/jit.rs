@@ -309,3 +309,40 @@ fn paired_lanes_match_the_tape_on_special_values() {
         }
     }
 }
+
+/// Constants as the first operand of `+` and `×` (the JIT swaps them to second place so
+/// that their load folds into the instruction, which must not change a bit): every special
+/// operand, NaNs of both signs and several payloads included, against ordinary, signed-zero,
+/// infinite and NaN constants (a NaN constant is never swapped, conservatively: with two
+/// NaN operands the result's payload depends on the order), alone and in paired lanes; and
+/// negations reusing the sign mask.
+#[test]
+fn constants_first_match_the_tape_on_special_values() {
+    let mut special = SPECIAL.to_vec();
+    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
+    special.push(f64::from_bits(0xfff8_0000_0000_0002));
+    special.push(-f64::NAN);
+    let n = special.len();
+    let x = Matrix::sym_vec("x", n);
+    let constants = [
+        2.5,
+        -0.0,
+        0.0,
+        f64::INFINITY,
+        f64::from_bits(0x7ff8_0000_0000_0003),
+        f64::from_bits(0xfff8_0000_0000_0004),
+    ];
+    let mut outs = Vec::new();
+    for &c in &constants {
+        let c = Expr::from(c);
+        // Consecutive alike instructions (paired into lanes) and a lone one.
+        outs.extend((0..n).map(|i| c * x[i]));
+        outs.extend((0..n).map(|i| c + x[i]));
+        outs.push(-(c * x[0]) + -(c + x[n - 1]));
+    }
+    let f = Function::new(&[&x], &[&outs]).unwrap();
+    for shift in 0..n {
+        let xs: Vec<f64> = (0..n).map(|i| special[(i + shift) % n]).collect();
+        same_bits(&f, &[&xs]);
+    }
+}

@@ -166,7 +166,10 @@ impl Jit {
         for c in &f.calls {
             callees.push(self.function(&c.function)?);
         }
-        let template = f.template.clone();
+        // The template and, after it, the sign mask that negations load (see
+        // [`Emitter::negate`]).
+        let mut template = f.template.clone();
+        template.push(-0.0);
         let constant = constants(f);
         let entries = |sizes: &[usize], offsets: &[usize]| {
             let mut of = vec![None; f.work_size];
@@ -244,7 +247,7 @@ impl Jit {
     ) -> Result<(), SymxError> {
         self.ctx.func.signature = self.signature();
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let params = prologue(&mut b, layout, true);
+        let params = prologue(&mut b, layout);
         let entry = params.entry;
         let mut e = Emitter::new(&mut b, &mut self.module, params, layout);
         e.template();
@@ -272,7 +275,7 @@ impl Jit {
     ) -> Result<(), SymxError> {
         self.ctx.func.signature = self.signature();
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let params = prologue(&mut b, layout, true);
+        let params = prologue(&mut b, layout);
         let mut e = Emitter::new(&mut b, &mut self.module, params, layout);
         if with_template {
             e.template();
@@ -315,11 +318,15 @@ struct Params {
     entry: [Value; 3],
     inputs: Vec<Value>,
     outputs: Vec<Value>,
+    /// The address of the function's template (constants are loaded from there): a block
+    /// parameter, kept in a register, where Cranelift would materialise a constant again
+    /// at every use.
+    template: Value,
 }
 
-/// The entry block of a machine-code function: with `with_bases` (always, today), the address of each
-/// input and output (from `args` and `res`, or in `w` when `args` is null), computed once.
-fn prologue(b: &mut FunctionBuilder, layout: &Layout, with_bases: bool) -> Params {
+/// The entry block of a machine-code function: the address of each input and output (from
+/// `args` and `res`, or in `w` when `args` is null) and of the template, computed once.
+fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
     let f = layout.f;
     let entry_block = b.create_block();
     b.append_block_params_for_function_params(entry_block);
@@ -332,17 +339,15 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout, with_bases: bool) -> Param
         entry: [w, args, res],
         inputs: Vec::new(),
         outputs: Vec::new(),
+        template: w,
     };
-    if !with_bases {
-        return params;
-    }
     let ptr = types::I64;
     let flags = MemFlags::trusted();
     let (n_in, n_out) = (f.input_offsets.len(), f.output_offsets.len());
     let direct = b.create_block();
     let in_w = b.create_block();
     let body = b.create_block();
-    for _ in 0..n_in + n_out {
+    for _ in 0..n_in + n_out + 1 {
         b.append_block_param(body, ptr);
     }
     b.ins().brif(args, direct, &[], in_w, &[]);
@@ -355,19 +360,22 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout, with_bases: bool) -> Param
     for k in 0..n_out {
         bases.push(b.ins().load(ptr, flags, res, 8 * k as i32).into());
     }
+    bases.push(b.ins().iconst(ptr, layout.template as i64).into());
     b.ins().jump(body, &bases);
     b.switch_to_block(in_w);
     b.seal_block(in_w);
     let offsets = f.input_offsets.iter().chain(&f.output_offsets);
-    let bases: Vec<_> = offsets
+    let mut bases: Vec<_> = offsets
         .map(|&at| b.ins().iadd_imm(w, 8 * at as i64).into())
         .collect();
+    bases.push(b.ins().iconst(ptr, layout.template as i64).into());
     b.ins().jump(body, &bases);
     b.switch_to_block(body);
     b.seal_block(body);
     let ps = b.block_params(body).to_vec();
     params.inputs = ps[..n_in].to_vec();
-    params.outputs = ps[n_in..].to_vec();
+    params.outputs = ps[n_in..n_in + n_out].to_vec();
+    params.template = ps[n_in + n_out];
     params
 }
 
@@ -495,6 +503,8 @@ struct Emitter<'a, 'b> {
     table: Option<SigRef>,
     copy: Option<SigRef>,
     slot: Option<StackSlot>,
+    /// The sign mask loaded by [`Emitter::negate`] and the instruction of its last use.
+    sign_mask: Option<(Value, usize)>,
 }
 
 type Unary = extern "C" fn(f64) -> f64;
@@ -521,6 +531,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
             table: None,
             copy: None,
             slot: None,
+            sign_mask: None,
         }
     }
 
@@ -556,11 +567,14 @@ impl<'a, 'b> Emitter<'a, 'b> {
             self.layout.constant[r as usize],
             self.layout.input_of[r as usize],
         ) {
-            (Some(c), _) => {
+            (Some(c), _) if c.is_nan() || c.to_bits() == 0 => {
                 let v = self.constant(c);
                 self.values.insert(r, (v, self.at));
                 return v;
             }
+            // Loaded afresh at every use (not kept in a register), so that the load folds
+            // into the arithmetic instruction as a memory operand.
+            (Some(_), _) => return self.template_load(r),
             // Inputs are never written by the tape: read from the caller's input.
             (None, Some((k, i))) => (self.params.inputs[k as usize], 8 * i as i32),
             (None, None) => (self.w, 8 * r as i32),
@@ -573,6 +587,46 @@ impl<'a, 'b> Emitter<'a, 'b> {
         };
         self.values.insert(r, (v, self.at));
         v
+    }
+
+    /// Constant register `r` loaded from the function's template, where it is kept (one
+    /// instruction, or none when the load folds into its user, instead of an integer
+    /// immediate moved to a float register).
+    fn template_load(&mut self, r: u32) -> Value {
+        let offset = 8 * (r as usize - self.layout.f.template_start) as i32;
+        self.template_entry(offset)
+    }
+
+    /// The number at byte `offset` of the function's template (as extended by
+    /// [`Jit::function`]).
+    fn template_entry(&mut self, offset: i32) -> Value {
+        let base = self.params.template;
+        let flags = MemFlags::trusted().with_readonly();
+        self.b.ins().load(types::F64, flags, base, offset)
+    }
+
+    /// `−a` (sign bit flipped, NaN included): `a` xor the sign mask, loaded from after the
+    /// template and kept in a register while used within [`WINDOW`] instructions
+    /// (Cranelift's own `fneg` builds the mask from an integer immediate every time).
+    fn negate(&mut self, a: Value) -> Value {
+        let mask = match self.sign_mask {
+            Some((m, last)) if self.at.saturating_sub(last) <= WINDOW => m,
+            _ => self.template_entry(8 * self.layout.f.template.len() as i32),
+        };
+        self.sign_mask = Some((mask, self.at));
+        if self.b.func.dfg.value_type(a) == types::F64X2 {
+            let masks = self.b.ins().splat(types::F64X2, mask);
+            self.b.ins().bxor(a, masks)
+        } else {
+            self.b.ins().bxor(a, mask)
+        }
+    }
+
+    /// Whether register `r` holds a constant other than NaN: a commutative operation
+    /// gives the same bits with its operands swapped when one of them is such a constant
+    /// (x86 returns the one NaN operand, quieted, whichever side it is on).
+    fn plain_constant(&self, r: u32) -> bool {
+        self.layout.constant[r as usize].is_some_and(|c| !c.is_nan())
     }
 
     /// Where register `r` would be loaded from by [`Emitter::operand`] at instruction `at`
@@ -641,13 +695,20 @@ impl<'a, 'b> Emitter<'a, 'b> {
             let op = f.tape[start + j].op;
             let (at1, at2) = (start + j, start + len + j);
             let commutative = matches!(op, Op::Add | Op::Mul);
-            let get = |e: &mut Self, p: usize| match ops[p] {
+            // Constants second (the same bits, see [`Emitter::plain_constant`]): a constant
+            // vector then folds into the instruction as a memory operand.
+            let plain = |e: &Self, o: &Operand| matches!(*o, Operand::External(r1, r2) if e.plain_constant(r1) && e.plain_constant(r2));
+            let swap = commutative && plain(self, &ops[0]);
+            let order = if swap { [1, 0] } else { [0, 1] };
+            // (A load may be folded, operands swapped, when the other operand cannot be NaN.)
+            let first = commutative && !plain(self, &ops[order[1]]);
+            let get = |e: &mut Self, p: usize| match ops[order[p]] {
                 Operand::Internal(m) => vectors[m],
-                Operand::External(r1, r2) => e.lanes((r1, at1), (r2, at2), p == 0 && commutative),
+                Operand::External(r1, r2) => e.lanes((r1, at1), (r2, at2), p == 0 && first),
             };
             let a = get(self, 0);
             let v = match op {
-                Op::Neg => self.b.ins().fneg(a),
+                Op::Neg => self.negate(a),
                 Op::Sq => self.b.ins().fmul(a, a),
                 Op::Sqrt => self.b.ins().sqrt(a),
                 Op::Abs => self.b.ins().fabs(a),
@@ -870,19 +931,20 @@ impl<'a, 'b> Emitter<'a, 'b> {
             return;
         }
         let commutative = matches!(ins.op, Op::Add | Op::Mul | Op::StrongMul);
-        let a = self.operand(ins.a, commutative);
-        let b = if ins.op.arity() >= 2 {
-            self.get(ins.b)
-        } else {
-            a
-        };
+        // `c ∘ x` as `x ∘ c` for a constant `c` (the same bits, see
+        // [`Emitter::plain_constant`]): the constant's load then folds into the instruction.
+        let swap = matches!(ins.op, Op::Add | Op::Mul) && self.plain_constant(ins.a);
+        let (ra, rb) = if swap { (ins.b, ins.a) } else { (ins.a, ins.b) };
+        // (A load may be folded, operands swapped, when the other operand cannot be NaN.)
+        let a = self.operand(ra, commutative && !self.plain_constant(rb));
+        let b = if ins.op.arity() >= 2 { self.get(rb) } else { a };
         let zero = || Ieee64::with_bits(0);
         let v = match ins.op {
             Op::Add => self.b.ins().fadd(a, b),
             Op::Sub => self.b.ins().fsub(a, b),
             Op::Mul => self.b.ins().fmul(a, b),
             Op::Div => self.b.ins().fdiv(a, b),
-            Op::Neg => self.b.ins().fneg(a),
+            Op::Neg => self.negate(a),
             Op::Sq => self.b.ins().fmul(a, a),
             Op::Sym => a,
             Op::Sqrt => self.b.ins().sqrt(a),
