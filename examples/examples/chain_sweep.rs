@@ -11,7 +11,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut pb = Problem::new();
     let (x, y) = (pb.variable("x", n + 1)?, pb.variable("y", n + 1)?);
     let p = pb.parameter("p", 3)?; // length, left and right end heights
-    pb.set_value(&p, &[1.5, 1.0, 0.5])?; // compiling needs values (changed below)
     pb.minimize(y.sum()); // potential energy of equal masses
     pb.subject_to_all([x[0].eq(0.0), x[n].eq(1.0), y[0].eq(p[1]), y[n].eq(p[2])])?;
     let link = p[0] / n as f64;

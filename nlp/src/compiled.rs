@@ -1,4 +1,5 @@
 //! [`Compiled`]: a problem differentiated and compiled once; the numeric NLP solvers consume.
+use crate::error::SolveError;
 use crate::numeric::{AffineCone, NumericNlp};
 use crate::parameter::{ParameterIndex, ParameterKey};
 use crate::problem::{row_name, Block, BuildError, ProblemParts};
@@ -22,6 +23,8 @@ pub struct Compiled {
     g_l: Vec<f64>,
     g_u: Vec<f64>,
     x0: Vec<f64>,
+    /// Parameter values; NaN for an entry never set (the setters accept finite values
+    /// only), which [`NumericNlp::check_ready`] reports before a solve.
     params: Vec<f64>,
     parameter_index: ParameterIndex,
     f_fn: Arc<Function>,
@@ -223,14 +226,21 @@ impl Compiled {
     }
 
     /// Sets all parameter entries at once (`p` as long as [`Compiled::parameter_values`],
-    /// finite: checked by the caller).
+    /// finite or NaN for an entry left unset: checked by the caller).
     pub(crate) fn set_parameter_vector(&mut self, p: &[f64]) {
         self.params.copy_from_slice(p);
     }
 
-    /// The values of all parameter entries, in declaration order.
+    /// The values of all parameter entries, in declaration order; NaN for an entry not
+    /// set yet (compiling does not require values, solving does).
     pub fn parameter_values(&self) -> &[f64] {
         &self.params
+    }
+
+    /// The first parameter entry without a value, by name (`None` when all are set).
+    pub fn unset_parameter(&self) -> Option<&str> {
+        let i = self.params.iter().position(|v| v.is_nan())?;
+        Some(self.parameter_index.name(i))
     }
 
     /// Replaces the initial guess (one finite value per variable, in variable order): the
@@ -323,6 +333,14 @@ impl NumericNlp for Compiled {
     }
     fn parameter_values(&self) -> &[f64] {
         &self.params
+    }
+    fn check_ready(&self) -> Result<(), SolveError> {
+        match self.unset_parameter() {
+            Some(name) => Err(SolveError::MissingParameterValue {
+                name: name.to_string(),
+            }),
+            None => Ok(()),
+        }
     }
     fn m(&self) -> usize {
         self.m

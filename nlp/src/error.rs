@@ -55,6 +55,13 @@ pub enum SolveError {
     /// A sparsity pattern or vector has the wrong dimensions or shape.
     #[error("wrong size: {0}")]
     WrongSize(String),
+    /// A parameter of the problem was never given a value (see
+    /// [`Compiled::set_value`](crate::Compiled::set_value)).
+    #[error("parameter '{name}' has no value (call set_value before solving)")]
+    MissingParameterValue {
+        /// The parameter entry.
+        name: String,
+    },
     /// An option value is invalid.
     #[error("invalid option '{field}': {reason}")]
     InvalidOption {

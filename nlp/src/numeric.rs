@@ -64,6 +64,11 @@ pub trait NumericNlp {
     fn parameter_values(&self) -> &[f64] {
         &[]
     }
+    /// Whether the problem can be evaluated (default: yes); checked before every solve.
+    /// A [`Compiled`](crate::Compiled) fails here while a parameter has no value.
+    fn check_ready(&self) -> Result<(), crate::SolveError> {
+        Ok(())
+    }
 }
 
 /// A second-order cone `‖v(x)‖ ≤ t(x)` whose entries are affine in x, exposed by

@@ -6,7 +6,10 @@
 //! vector, independent of symx's evaluator. Solver tolerances: the IPM stops at a scaled
 //! KKT error of 1e-8 (the default `tol`), so on these small, well-scaled problems optima
 //! are compared to 1e-6.
-use nlp::{bounded, BuildError, Compiled, Ipm, NumericNlp, Problem, Relation, Solution, Status};
+use nlp::{
+    bounded, BuildError, Compiled, Ipm, NumericNlp, Problem, Relation, Solution, SolveError,
+    Solver, Sqp, Status,
+};
 use symx::{Expr, Matrix};
 
 const INF: f64 = f64::INFINITY;
@@ -168,18 +171,54 @@ fn parameter_errors_name_the_culprit() {
     assert!(err.to_string().contains("'p[1]'"), "{err}");
     // Nothing was written by the failed calls.
     assert_eq!(c.parameter_values(), &[0.2, 0.4]);
+}
 
+/// Compiling needs no parameter values (as Opti); a solve with one unset fails naming it,
+/// by either back end and through `to_function`; setting it after compiling solves.
+#[test]
+fn parameters_unset_at_compile_fail_at_solve_naming_the_entry() {
     let mut unset = Problem::new();
     let y = unset.scalar_variable("y").unwrap();
     let q = unset.parameter("q", 2).unwrap();
-    unset.minimize((y - q[1]).sq());
+    unset.minimize((y - q[0] - q[1]).sq());
     unset.set_value(q[1], &[1.0]).unwrap();
+    let mut c = unset.compile().expect("compiles without q[0]");
+    assert_eq!(c.unset_parameter(), Some("q[0]"));
+    assert!(c.parameter_values()[0].is_nan());
+    let missing = SolveError::MissingParameterValue {
+        name: "q[0]".into(),
+    };
+    for solver in [&Ipm::default() as &dyn Solver, &Sqp::default()] {
+        assert_eq!(
+            solver.solve(&mut c).unwrap_err(),
+            missing,
+            "{}",
+            solver.name()
+        );
+    }
+    assert!(missing.to_string().contains("'q[0]'"), "{missing}");
+    // The problem still has no value for q[0]: reading an expression without a solution's
+    // parameters is refused, naming it.
     assert_eq!(
-        unset.compile().unwrap_err(),
+        unset.evaluate(&[y - q[0]], &[0.0]).unwrap_err(),
         BuildError::MissingParameterValue {
             name: "q[0]".into()
         }
     );
+    // A solver as a function of q[1] only still needs q[0].
+    let mut f = unset.to_function(&[&[q[1]]], &[&[y]]).unwrap();
+    let err = f.call(&[&[2.0]]).unwrap_err();
+    assert!(err.to_string().contains("'q[0]'"), "{err}");
+    // Set after compiling: y* = q0 + q1 = 0.5 + 1 (exact optimum of the square).
+    c.set_value(q[0], &[0.5]).unwrap();
+    assert_eq!(c.unset_parameter(), None);
+    let sol = solve(&mut c);
+    assert!((sol.x[0] - 1.5).abs() < 1e-6);
+    assert_eq!(sol.parameters, [0.5, 1.0]);
+    // Setting only a subset on the problem, then the rest on the compiled one by name.
+    let mut c2 = unset.compile().unwrap();
+    c2.set_value("q", &[2.0, 3.0]).unwrap();
+    assert!((solve(&mut c2).x[0] - 5.0).abs() < 1e-6);
 }
 
 #[test]

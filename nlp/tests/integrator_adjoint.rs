@@ -1,8 +1,9 @@
 //! Adjoint sensitivities (`Integrator::simulate_with_adjoint`): against the transpose of
 //! the forward sensitivities (the same derivative of the same numerical map, so equal up
-//! to rounding) and against central finite differences, for both methods.
+//! to rounding) and against central finite differences, for both methods; and as the
+//! reverse hook of the integrator's call node (`to_function`), used by reverse-mode AD.
 use nlp::integrator::{Integrator, IntegratorOptions, Method};
-use symx::{Expr, Function, Matrix};
+use symx::{gradient, hessian, jacobian, Expr, Function, Matrix};
 use testkit::ode::{robertson, van_der_pol};
 
 /// A chain of `n` masses-free cells `ẋᵢ = a(xᵢ₋₁ − xᵢ) − 0.1xᵢ³` driven by `x₋₁ = u`,
@@ -107,6 +108,86 @@ fn adjoint_matches_finite_differences() {
     }
 }
 
+/// `φ(x0, μ) = x₁(T)² + 3x₂(T)` through the integrator's call node, as a function of
+/// `(x0, μ)`: its gradient by reverse mode (`symx::gradient`, the node's reverse hook), its
+/// Jacobian row (`symx::jacobian`, the node's Jacobian) and its Hessian.
+fn phi_derivatives(int: &Integrator) -> (Function, Function, Function, Function) {
+    let node = int.to_function().unwrap();
+    let z = Matrix::sym_vec("z", 3);
+    let xf = node.apply(&[&z[..2], &z[2..]]).unwrap().remove(0);
+    let phi = xf[0].sq() + 3.0 * xf[1];
+    let value = Function::new(&[&z], &[&[phi]]).unwrap();
+    let grad = Function::new(&[&z], &[&gradient(phi, &z).unwrap()]).unwrap();
+    let jac = jacobian(&[phi], &z).unwrap().to_dense();
+    let row = Function::new(&[&z], &[&jac]).unwrap();
+    let hess = hessian(phi, &z).unwrap().to_dense();
+    let hess = Function::new(&[&z], &[&hess]).unwrap();
+    (value, grad, row, hess)
+}
+
+#[test]
+fn reverse_mode_through_the_node_uses_the_adjoint() {
+    let z = [2.0, 0.0, 1.0];
+    for method in [Method::Dopri5, Method::Sdirk4] {
+        let int = Integrator::new(&van_der_pol(), 0.0, 2.0, options(method, 1e-10)).unwrap();
+        let (value, grad, row, hess) = phi_derivatives(&int);
+        let g = grad.call(&[&z]).unwrap().remove(0);
+        let j = row.call(&[&z]).unwrap().remove(0);
+        // The gradient is the adjoint's row for the seed (2x₁(T), 3), bit for bit: the
+        // reverse sweep called the hook, not the Jacobian.
+        let (xf, _) = int.simulate(&z[..2], &z[2..]).unwrap();
+        let (_, adj) = int
+            .simulate_with_adjoint(&z[..2], &z[2..], &[2.0 * xf[0], 3.0])
+            .unwrap();
+        assert_eq!(g, adj, "{method:?}");
+        // The Jacobian row goes through the forward sensitivities: the same derivative to
+        // rounding (1e-10 relative, as the transpose test above).
+        let scale = j.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        for (a, b) in g.iter().zip(&j) {
+            assert!((a - b).abs() <= 1e-10 * scale, "{method:?}: {g:?} vs {j:?}");
+        }
+        // Central differences of φ with steps 1e-4 at rtol 1e-10: truncation ~1e-8,
+        // integration noise ~1e-10/1e-4 = 1e-6 relative, hence 1e-5.
+        let fd: Vec<f64> = (0..3)
+            .map(|k| {
+                let at = |d: f64| {
+                    let mut w = z;
+                    w[k] += d;
+                    value.call(&[&w]).unwrap()[0][0]
+                };
+                (at(1e-4) - at(-1e-4)) / 2e-4
+            })
+            .collect();
+        for (a, f) in g.iter().zip(&fd) {
+            assert!(
+                (a - f).abs() <= 1e-5 * scale,
+                "{method:?}: {g:?} vs fd {fd:?}"
+            );
+        }
+        // Second derivatives still work (the hook is differentiated as the product built
+        // from the Jacobian): against central differences of the gradient, 1e-4 relative
+        // (noise ~1e-10/1e-4 on a gradient of size ~10).
+        let h = hess.call(&[&z]).unwrap().remove(0);
+        let hscale = h.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        for k in 0..3 {
+            let at = |d: f64| {
+                let mut w = z;
+                w[k] += d;
+                grad.call(&[&w]).unwrap().remove(0)
+            };
+            let (up, down) = (at(1e-4), at(-1e-4));
+            for i in k..3 {
+                let fd = (up[i] - down[i]) / 2e-4;
+                assert!(
+                    (h[i + 3 * k] - fd).abs() <= 1e-4 * hscale,
+                    "{method:?}: H[{i},{k}] {} vs fd {fd}",
+                    h[i + 3 * k]
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn bad_seed_is_an_error() {
     let int = Integrator::new(&van_der_pol(), 0.0, 1.0, IntegratorOptions::default()).unwrap();
@@ -154,6 +235,51 @@ fn adjoint_cost_against_forward_on_a_chain() {
             tf[3],
             ta[3],
             tf[3] / ta[3]
+        );
+    }
+}
+
+/// The cost of the gradient of one output through the integrator's call node: reverse
+/// mode (the node's reverse hook, the adjoint) against the Jacobian row (the node's
+/// forward sensitivities, what reverse mode cost before the hook), on the 50-state chain.
+/// Medians of 7 interleaved repetitions; no assertion on times. Run with
+/// `cargo test --release -p nlp --test integrator_adjoint -- --ignored --nocapture node_`.
+#[test]
+#[ignore = "a measurement: run by hand"]
+fn node_gradient_cost_on_a_chain() {
+    let n = 50;
+    let mut z = vec![0.0; n];
+    z.extend([2.0, 1.0]);
+    for method in [Method::Dopri5, Method::Sdirk4] {
+        let int = Integrator::new(&chain(n), 0.0, 10.0, options(method, 1e-6)).unwrap();
+        let node = int.to_function().unwrap();
+        let w = Matrix::sym_vec("w", n + 2);
+        let out = node.apply(&[&w[..n], &w[n..]]).unwrap()[0][n - 1];
+        let grad = Function::new(&[&w], &[&gradient(out, &w).unwrap()]).unwrap();
+        let jac = jacobian(&[out], &w).unwrap().to_dense();
+        let row = Function::new(&[&w], &[&jac]).unwrap();
+        let (g, r) = (grad.call(&[&z]).unwrap(), row.call(&[&z]).unwrap());
+        let diff = g[0]
+            .iter()
+            .zip(&r[0])
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        let (mut tg, mut tr) = (Vec::new(), Vec::new());
+        for _ in 0..7 {
+            let t = std::time::Instant::now();
+            std::hint::black_box(grad.call(&[&z]).unwrap());
+            tg.push(t.elapsed().as_secs_f64());
+            let t = std::time::Instant::now();
+            std::hint::black_box(row.call(&[&z]).unwrap());
+            tr.push(t.elapsed().as_secs_f64());
+        }
+        tg.sort_by(f64::total_cmp);
+        tr.sort_by(f64::total_cmp);
+        println!(
+            "{method:?} chain {n}, node gradient: reverse (hook) {:.3e} s, Jacobian row {:.3e} s \
+             (medians of 7, interleaved), ratio {:.1}; max |difference| {diff:.1e}",
+            tg[3],
+            tr[3],
+            tr[3] / tg[3]
         );
     }
 }

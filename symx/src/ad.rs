@@ -42,6 +42,9 @@ pub(crate) struct Sweep {
     wrt_current: u32,
     cone: Vec<u32>,
     stack: Vec<u32>,
+    /// A single reverse sweep (not a Jacobian's row): call nodes whose callee has a
+    /// reverse hook call it even with constant seeds.
+    single: bool,
 }
 
 impl Sweep {
@@ -58,6 +61,7 @@ impl Sweep {
             wrt_current: 0,
             cone: Vec::new(),
             stack: Vec::new(),
+            single: false,
         }
     }
 
@@ -375,7 +379,9 @@ fn live_adjoint(s: &Sweep, o: u32) -> Option<u32> {
 ///   Jacobian's entries.
 /// * Other adjoints (e.g. multipliers in a Lagrangian gradient): one call of the callee's
 ///   vector-Jacobian product, so that differentiating again (a Hessian) needs only that
-///   function's Jacobian, not the callee's whole second-derivative tensor.
+///   function's Jacobian, not the callee's whole second-derivative tensor. So do constant
+///   adjoints in a single reverse sweep (a gradient) when the callee has a reverse hook
+///   (`Function::with_vjp`), cheaper than its Jacobian.
 fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
     let site = &g.calls[g.nodes[v as usize].args[0] as usize];
     let (function, inputs) = (site.function.clone(), site.inputs.clone());
@@ -390,7 +396,7 @@ fn reverse_call(g: &mut Graph, s: &mut Sweep, v: u32) {
     let constant = adj.iter().flatten().all(|&t| g.value(t).is_some());
     let wrt: Vec<bool> = inputs.iter().map(|&a| s.dep_all[a as usize]).collect();
     let jac = crate::call::call_jacobian(g, &function, &wrt);
-    if !gated && !constant {
+    if !gated && (!constant || (s.single && jac.hook)) {
         let mut args = inputs.clone();
         args.extend(adj.iter().map(|t| t.unwrap_or(ZERO)));
         let xbar = g.call(&jac.vjp, args);
@@ -600,6 +606,7 @@ pub fn reverse(outputs: &[Expr], inputs: &[Expr], seeds: &[Expr]) -> Result<Vec<
     let out = ids(outputs);
     checked(|g| {
         let mut s = Sweep::new(g.len());
+        s.single = true;
         s.set_wrt(&wrt);
         s.collect(g, &out, u32::MAX);
         for (&o, seed) in out.iter().zip(seeds) {

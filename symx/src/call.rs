@@ -63,6 +63,9 @@ pub(crate) struct CallJacobian {
     /// products are all guarded (`0 ⊛ NaN = 0`), so an adjoint that is exactly 0 never
     /// meets a NaN partial derivative.
     pub vjp: Arc<Function>,
+    /// Whether `vjp` is the callee's own reverse hook ([`Function::with_vjp`]), cheaper
+    /// than the Jacobian: a single reverse sweep then calls it even with constant seeds.
+    pub hook: bool,
     /// For each input entry `j`: `(output entry k, nonzero index)` of column `j`.
     pub by_input: Vec<Vec<(u32, u32)>>,
     /// For each output entry `k`: `(input entry j, nonzero index)` of row `k`.
@@ -272,6 +275,10 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
     if let Some(j) = cache(f).get(wrt) {
         return j.clone();
     }
+    // A reverse hook's call is differentiated as the tape function equal to it.
+    if let Some(equal) = f.external.as_ref().and_then(|e| e.derivative_as.clone()) {
+        return call_jacobian(g, &equal, wrt);
+    }
     // A lookup function (`InterpolantN`) has no graph form: its partial derivatives are
     // calls of the lookup functions of its derivative tables. An external function has
     // none either: its partial derivatives are the outputs of a call of its Jacobian
@@ -368,9 +375,15 @@ pub(crate) fn call_jacobian(g: &mut Graph, f: &Arc<Function>, wrt: &[bool]) -> A
     vf.input_names = f.input_names.clone();
     vf.input_names.push("adj".into());
     vf.output_names = vec!["adj_in".into()];
+    let vf = g.function_arc(&vf);
+    let hook = f.external.as_ref().and_then(|e| e.vjp.as_ref());
     let jac = Arc::new(CallJacobian {
         function: g.function_arc(&jf),
-        vjp: g.function_arc(&vf),
+        vjp: match hook {
+            Some(h) => g.function_arc(&Function::reverse_hook(h, &vf)),
+            None => vf,
+        },
+        hook: hook.is_some(),
         by_input,
         by_output,
     });

@@ -16,6 +16,10 @@
 //! its own, for a Hessian) is an error ([`SymxError::NoDerivative`]) from [`crate::jacobian`],
 //! [`crate::gradient`], [`crate::hessian`] and the other derivative builders.
 //!
+//! A reverse hook ([`Function::with_vjp`]) adds a user-computed vector–Jacobian product
+//! (say, an adjoint method), which a single reverse sweep (a gradient) calls instead of
+//! the Jacobian.
+//!
 //! External functions cannot be compiled to native code ([`Function::jit`],
 //! [`Function::to_rust`]): both refuse with an error naming the function.
 use crate::error::SymxError;
@@ -35,6 +39,13 @@ pub(crate) struct External {
     /// The structural Jacobian (`outputs × inputs`, entries stacked) and the function of
     /// the same inputs that returns its nonzeros (column-major).
     pub jacobian: Option<(Sparsity, Arc<Function>)>,
+    /// The reverse hook ([`Function::with_vjp`]): `x̄ = Jᵀȳ` computed by the user, a
+    /// function of the inputs and `ȳ`.
+    pub vjp: Option<Arc<Function>>,
+    /// Set on a reverse hook's own call: the tape function equal to it (the
+    /// vector–Jacobian product built from the Jacobian), which is differentiated in its
+    /// place.
+    pub derivative_as: Option<Arc<Function>>,
 }
 
 impl std::fmt::Debug for External {
@@ -47,7 +58,11 @@ impl std::fmt::Debug for External {
                 p.compute_nnz()
             ),
             None => write!(f, "External(no jacobian)"),
+        }?;
+        if let Some(v) = &self.vjp {
+            write!(f, " with reverse hook {}", v.name)?;
         }
+        Ok(())
     }
 }
 
@@ -144,6 +159,8 @@ impl Function {
                 n_in,
                 n_out,
                 jacobian: None,
+                vjp: None,
+                derivative_as: None,
             })),
         })
     }
@@ -223,9 +240,121 @@ impl Function {
                 n_in,
                 n_out,
                 jacobian: Some((pattern.clone(), Arc::new(jacobian.clone()))),
+                vjp: None,
+                derivative_as: None,
             })),
             ..self.clone()
         })
+    }
+
+    /// This external function (which has a Jacobian, [`Function::with_jacobian`]) with a
+    /// reverse hook: `vjp` takes the function's inputs plus one input `ȳ` (one entry per
+    /// output entry, stacked) and returns one output `x̄ = Jᵀȳ` (one entry per input
+    /// entry, stacked) — e.g. computed by an adjoint method at the cost of one backward
+    /// pass, where the Jacobian costs one forward pass per input entry.
+    ///
+    /// A single reverse sweep — [`crate::gradient`], [`crate::reverse`], and the
+    /// vector–Jacobian products with symbolic seeds inside Lagrangian gradients — then
+    /// calls `vjp` once per call node instead of the Jacobian. The rows of a Jacobian
+    /// whose adjoints at the node are constants (a Jacobian of the node's outputs) still
+    /// call the Jacobian function (once, shared by the rows), and forward sweeps
+    /// multiply by it; other adjoints always went through a vector–Jacobian product,
+    /// now the hook. Derivatives of the hook's own call are those of the
+    /// vector–Jacobian product built from the Jacobian, unless `vjp` has a Jacobian of
+    /// its own: a second derivative needs no more than it did without the hook.
+    /// The result is a new function (a new identity); a later [`Function::with_jacobian`]
+    /// removes the hook.
+    ///
+    /// `Err` if `self` is not external or has no Jacobian, or if the sizes do not match.
+    ///
+    /// ```
+    /// use symx::{gradient, sparsity::pattern_from_entries, Function, Matrix};
+    /// let f = Function::external("prod", &[("x", 2)], &[("y", 1)], |x, y| y[0] = x[0] * x[1]).unwrap();
+    /// let jac = Function::external("jac_prod", &[("x", 2)], &[("jac", 2)], |x, j| {
+    ///     j[0] = x[1];
+    ///     j[1] = x[0];
+    /// })
+    /// .unwrap();
+    /// // x̄ = ȳ·(x1, x0), computed directly
+    /// let vjp = Function::external("adj_prod", &[("x", 2), ("adj", 1)], &[("adj_in", 2)], |a, xb| {
+    ///     xb[0] = a[2] * a[1];
+    ///     xb[1] = a[2] * a[0];
+    /// })
+    /// .unwrap();
+    /// let f = f
+    ///     .with_jacobian(&pattern_from_entries(1, 2, [(0, 0), (0, 1)]), &jac)
+    ///     .unwrap()
+    ///     .with_vjp(&vjp)
+    ///     .unwrap();
+    /// let z = Matrix::sym_vec("z", 2);
+    /// let y = f.apply(&[&z]).unwrap()[0][0];
+    /// let g = Function::new(&[&z], &[&gradient(3.0 * y, &z).unwrap()]).unwrap();
+    /// assert_eq!(g.call(&[&[2.0, 5.0]]).unwrap()[0], vec![15.0, 6.0]);
+    /// ```
+    pub fn with_vjp(&self, vjp: &Function) -> Result<Function, SymxError> {
+        let Some(ext) = &self.external else {
+            return Err(SymxError::NotExternal {
+                name: self.name.clone(),
+            });
+        };
+        if ext.jacobian.is_none() {
+            return Err(SymxError::NoDerivative {
+                name: self.name.clone(),
+            });
+        }
+        let mut expected = self.input_sizes.clone();
+        expected.push(ext.n_out);
+        if vjp.input_sizes != expected {
+            return Err(SymxError::ArgumentCount {
+                what: "vector-Jacobian product inputs (the function's, then one per output entry)",
+                expected: expected.len(),
+                got: vjp.input_sizes.len(),
+            }
+            .or_lengths(&expected, &vjp.input_sizes));
+        }
+        if vjp.output_sizes != [ext.n_in] {
+            return Err(SymxError::Length {
+                what: "vector-Jacobian product output (one, an entry per input entry)",
+                index: 0,
+                expected: ext.n_in,
+                got: vjp.output_sizes.iter().sum(),
+            });
+        }
+        Ok(Function {
+            uid: next_uid(),
+            jacobians: Default::default(),
+            external: Some(Arc::new(External {
+                eval: ext.eval.clone(),
+                n_in: ext.n_in,
+                n_out: ext.n_out,
+                jacobian: ext.jacobian.clone(),
+                vjp: Some(Arc::new(vjp.clone())),
+                derivative_as: None,
+            })),
+            ..self.clone()
+        })
+    }
+
+    /// The function a reverse sweep calls for this external function's reverse hook:
+    /// `hook` itself, or (for an external hook without a Jacobian) `hook` differentiated
+    /// as `equal`, the vector–Jacobian product built from the Jacobian.
+    pub(crate) fn reverse_hook(hook: &Function, equal: &Arc<Function>) -> Function {
+        match &hook.external {
+            Some(ext) if ext.jacobian.is_none() => Function {
+                uid: next_uid(),
+                jacobians: Default::default(),
+                external: Some(Arc::new(External {
+                    eval: ext.eval.clone(),
+                    n_in: ext.n_in,
+                    n_out: ext.n_out,
+                    jacobian: None,
+                    vjp: None,
+                    derivative_as: Some(equal.clone()),
+                })),
+                ..hook.clone()
+            },
+            _ => hook.clone(),
+        }
     }
 
     /// Whether this function is external ([`Function::external`]).

@@ -1,6 +1,9 @@
 //! External functions as call nodes: evaluation, derivatives through user-supplied
 //! Jacobians (checked against central finite differences of the user's own evaluator),
-//! and the errors when a derivative or native code is impossible.
+//! the reverse hook (`with_vjp`) a gradient calls instead of the Jacobian, and the errors
+//! when a derivative or native code is impossible.
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use symx::sparsity::pattern_from_entries;
 use symx::{forward, gradient, hessian, jacobian, Function, Matrix, SymxError};
 
@@ -243,4 +246,188 @@ fn bad_jacobian_declarations_and_native_code_are_refused() {
     assert!(g.to_rust().unwrap_err().to_string().contains("'plant'"));
     assert!(g.to_c().unwrap_err().to_string().contains("'plant'"));
     assert!(Function::external("e", &[("x", 1), ("x", 2)], &[("y", 1)], |_, _| {}).is_err());
+}
+
+/// `x̄ = Jᵀȳ` of the plant, inputs `(x, p, ȳ)` stacked: written out from the same
+/// partial derivatives as `plant_jacobian`.
+fn plant_vjp(a: &[f64], xbar: &mut [f64]) {
+    let mut j = [0.0; 5];
+    plant_jacobian(&a[..3], &mut j);
+    let (y0, y1) = (a[3], a[4]);
+    xbar[0] = y0 * j[0] + y1 * j[1];
+    xbar[1] = y0 * j[2];
+    xbar[2] = y0 * j[3] + y1 * j[4];
+}
+
+/// The plant with Jacobians to `order` and a reverse hook, counting the calls of its
+/// first-order Jacobian and of the hook.
+fn hooked_plant(order: usize) -> (Function, Arc<AtomicUsize>, Arc<AtomicUsize>) {
+    let (jac_calls, vjp_calls) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
+    let counted = jac_calls.clone();
+    let nnz = plant_pattern().compute_nnz();
+    let mut jac = Function::external(
+        "jac_plant",
+        &[("x", 2), ("p", 1)],
+        &[("jac", nnz)],
+        move |x, j| {
+            counted.fetch_add(1, Ordering::Relaxed);
+            plant_jacobian(x, j)
+        },
+    )
+    .unwrap();
+    if order >= 2 {
+        let nnz2 = plant_jacobian_pattern().compute_nnz();
+        let second = Function::external(
+            "hess_plant",
+            &[("x", 2), ("p", 1)],
+            &[("jac", nnz2)],
+            plant_second,
+        )
+        .unwrap();
+        jac = jac
+            .with_jacobian(&plant_jacobian_pattern(), &second)
+            .unwrap();
+    }
+    let counted = vjp_calls.clone();
+    let vjp = Function::external(
+        "adj_plant",
+        &[("x", 2), ("p", 1), ("adj", 2)],
+        &[("adj_in", 3)],
+        move |a, xb| {
+            counted.fetch_add(1, Ordering::Relaxed);
+            plant_vjp(a, xb)
+        },
+    )
+    .unwrap();
+    let f = Function::external("plant", &[("x", 2), ("p", 1)], &[("y", 2)], plant)
+        .unwrap()
+        .with_jacobian(&plant_pattern(), &jac)
+        .unwrap()
+        .with_vjp(&vjp)
+        .unwrap();
+    (f, jac_calls, vjp_calls)
+}
+
+#[test]
+fn a_gradient_calls_the_reverse_hook_a_jacobian_the_jacobian() {
+    let (f, jac_calls, vjp_calls) = hooked_plant(2);
+    let calls = || {
+        (
+            jac_calls.load(Ordering::Relaxed),
+            vjp_calls.load(Ordering::Relaxed),
+        )
+    };
+    let z = Matrix::sym_vec("z", 2);
+    let s = composed_expr(&f, &z);
+    let g = Function::new(&[&z], &[&gradient(s, &z).unwrap()]).unwrap();
+    // A linear combination of the outputs: constant adjoints at the node, which a
+    // gradient sends through the hook too (before the hook: the Jacobian's entries).
+    let x = [z[0] * z[0], z[1]];
+    let y = f.apply(&[&x, &[z[0] * z[1]]]).unwrap().remove(0);
+    let lin = Function::new(&[&z], &[&gradient(2.0 * y[0] - y[1], &z).unwrap()]).unwrap();
+    // The Jacobian of the outputs (unit adjoints, row by row) calls the Jacobian.
+    let jy = jacobian(&y, &z).unwrap().to_dense();
+    let jy = Function::new(&[&z], &[&jy]).unwrap();
+    let h_hooked = hessian(s, &z).unwrap();
+    let h_plain = hessian(composed_expr(&external_plant(2), &z), &z).unwrap();
+    let hh = Function::new(&[&z], &[h_hooked.values()]).unwrap();
+    let hp = Function::new(&[&z], &[h_plain.values()]).unwrap();
+    for point in [[0.3, 1.2], [-0.7, 0.4]] {
+        let before = calls();
+        let grad = g.call(&[&point]).unwrap().remove(0);
+        assert_eq!(
+            calls(),
+            (before.0, before.1 + 1),
+            "the gradient: one hook call, no Jacobian"
+        );
+        let lg = lin.call(&[&point]).unwrap().remove(0);
+        assert_eq!(
+            calls(),
+            (before.0, before.1 + 2),
+            "constant adjoints: the hook"
+        );
+        let jac = jy.call(&[&point]).unwrap().remove(0);
+        assert_eq!(
+            calls(),
+            (before.0 + 1, before.1 + 2),
+            "a Jacobian: the Jacobian, no hook"
+        );
+        // Same partial derivatives, contracted in another order: equal to rounding
+        // (1e-12), against the Jacobian and central differences as in
+        // `gradient_and_jacobian_match_finite_differences`.
+        let fd = fd_gradient(composed, &point);
+        for i in 0..2 {
+            assert!(
+                (grad[i] - fd[i]).abs() < 1e-7 * (1.0 + fd[i].abs()),
+                "{grad:?} vs {fd:?}"
+            );
+            let by_jac = 2.0 * jac[2 * i] - jac[2 * i + 1];
+            assert!(
+                (lg[i] - by_jac).abs() < 1e-12 * (1.0 + by_jac.abs()),
+                "{lg:?} vs {jac:?}"
+            );
+        }
+        // Second derivatives are those without the hook, bit for bit.
+        assert_eq!(hh.call(&[&point]).unwrap(), hp.call(&[&point]).unwrap());
+    }
+}
+
+#[test]
+fn bad_reverse_hooks_are_refused() {
+    let vjp = Function::external(
+        "adj",
+        &[("x", 2), ("p", 1), ("adj", 2)],
+        &[("adj_in", 3)],
+        plant_vjp,
+    )
+    .unwrap();
+    // No Jacobian: the hook alone cannot give a Jacobian's rows or forward mode.
+    assert!(matches!(
+        external_plant(0).with_vjp(&vjp),
+        Err(SymxError::NoDerivative { name }) if name == "plant"
+    ));
+    let tape = Function::new(&[&Matrix::sym_vec("a", 1)], &[&[symx::Expr::from(1.0)]]).unwrap();
+    assert!(matches!(
+        tape.with_vjp(&vjp),
+        Err(SymxError::NotExternal { .. })
+    ));
+    let short = Function::external(
+        "adj",
+        &[("x", 2), ("p", 1), ("adj", 1)],
+        &[("adj_in", 3)],
+        |_, _| {},
+    )
+    .unwrap();
+    let err = external_plant(1).with_vjp(&short).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            SymxError::Length {
+                index: 2,
+                expected: 2,
+                got: 1,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let narrow = Function::external(
+        "adj",
+        &[("x", 2), ("p", 1), ("adj", 2)],
+        &[("adj_in", 2)],
+        |_, _| {},
+    )
+    .unwrap();
+    let err = external_plant(1).with_vjp(&narrow).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            SymxError::Length {
+                expected: 3,
+                got: 2,
+                ..
+            }
+        ),
+        "{err}"
+    );
 }

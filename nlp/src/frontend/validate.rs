@@ -16,7 +16,8 @@ pub(crate) struct Validated {
     pub x0: Vec<f64>,
 }
 
-/// Checks, in this order: the Jacobian pattern is m×n, the Hessian pattern n×n with
+/// Checks, in this order: the problem is ready ([`NumericNlp::check_ready`], e.g. every
+/// parameter has a value), the Jacobian pattern is m×n, the Hessian pattern n×n with
 /// entries in the lower triangle only, every cone row is a row of g, no bound is NaN,
 /// +∞ below or −∞ above, every lower bound is at most its upper bound, the warm start
 /// (if any) has the problem's sizes, and the starting point is finite. The error names
@@ -37,6 +38,7 @@ pub(crate) fn validate_into(
     warm: Option<&Solution>,
     v: &mut Validated,
 ) -> Result<(), SolveError> {
+    nlp.check_ready()?;
     let n = nlp.n();
     let m = nlp.m();
     let jac = nlp.jac_g_sparsity();

@@ -253,9 +253,16 @@ impl Integrator {
     /// with either method: each evaluator keeps a pool of buffers (stages, LU factors),
     /// one set per concurrent caller (results do not depend on which set is used). With
     /// [`IntegratorOptions::sensitivity_error_control`], `xf` is computed together with
-    /// the first-order sensitivities, on the steps of its Jacobian. Reverse products
-    /// through the node come from its Jacobian (the forward sensitivities), not from
-    /// [`Integrator::simulate_with_adjoint`]: symx's external node takes a Jacobian.
+    /// the first-order sensitivities, on the steps of its Jacobian.
+    ///
+    /// Reverse mode through the node — a gradient ([`symx::gradient`], the objective's
+    /// gradient of a `Problem`), a vector–Jacobian product ([`symx::reverse`]) — calls
+    /// its reverse hook ([`symx::Function::with_vjp`]):
+    /// [`Integrator::simulate_with_adjoint`], one backward pass whatever `nx + np`, where
+    /// the Jacobian integrates `nx + np` sensitivity columns. The Jacobian of the node's
+    /// outputs (a shooting constraint's) and forward mode use the Jacobian. Under `sensitivity_error_control` the node has
+    /// no hook (the adjoint would not take the steps `xf` is computed on). The adjoint
+    /// evaluation allocates (its step record), unlike the node's other evaluators.
     ///
     /// ```
     /// use nlp::integrator::{Integrator, IntegratorOptions};
@@ -335,7 +342,34 @@ impl Integrator {
                 }
             });
         }
-        Ok(function.expect("ORDER + 1 levels built"))
+        let function = function.expect("ORDER + 1 levels built");
+        if self.options.sensitivity_error_control {
+            // `xf` then rides on the sensitivities' steps, which the adjoint does not take.
+            return Ok(function);
+        }
+        Ok(function.with_vjp(&Integrator::adjoint_function(int)?)?)
+    }
+
+    /// `(x0, p, v) → vᵀ ∂x(tf)/∂(x0, p)` by [`Integrator::simulate_with_adjoint`], as an
+    /// external function: the reverse hook of [`Integrator::to_function`]'s node (NaN
+    /// where the integration fails, as the node's other evaluators).
+    fn adjoint_function(int: Arc<Integrator>) -> Result<Function, IntegratorError> {
+        int.vjp()?; // built now, so that an error shows here
+        let (nx, m) = (int.nx, int.nx + int.np);
+        let eval = move |a: &[f64], out: &mut [f64]| match int.simulate_with_adjoint(
+            &a[..nx],
+            &a[nx..m],
+            &a[m..],
+        ) {
+            Ok((_, row)) => out.copy_from_slice(&row),
+            Err(_) => out.fill(f64::NAN),
+        };
+        Ok(Function::external(
+            "adj_integrator",
+            &[("x0", nx), ("p", m - nx), ("adj", nx)],
+            &[("adj_in", m)],
+            eval,
+        )?)
     }
 
     fn check_args(&self, x0: &[f64], p: &[f64]) -> Result<(), IntegratorError> {

@@ -522,6 +522,15 @@ impl Problem {
             .collect())
     }
 
+    /// The parameter values with NaN for an entry never set: what a [`Compiled`] starts
+    /// from (its setters accept finite values only, so NaN marks "unset" there).
+    pub(super) fn parameter_vector_or_unset(&self) -> Vec<f64> {
+        self.parameter_values
+            .iter()
+            .map(|v| v.unwrap_or(f64::NAN))
+            .collect()
+    }
+
     pub(super) fn parameter_vector(&self) -> Result<Vec<f64>, BuildError> {
         self.parameter_values
             .iter()
@@ -552,8 +561,27 @@ impl Problem {
     /// Differentiates and compiles the problem once: evaluators for f, ∇f, g, the sparse
     /// Jacobian of g and the sparse Lagrangian Hessian, with fixed sparsity. Simple bounds
     /// are detected here when [`Problem::set_detect_simple_bounds`] is on.
+    ///
+    /// Parameters need no value yet (as with CasADi's Opti, values are checked at solve):
+    /// set them on the [`Compiled`] with [`Compiled::set_value`]. A solve while one is
+    /// still unset fails with [`SolveError::MissingParameterValue`](crate::SolveError)
+    /// naming it.
+    ///
+    /// ```
+    /// use nlp::{Ipm, Problem, SolveError, Solver};
+    /// let mut pb = Problem::new();
+    /// let x = pb.scalar_variable("x")?;
+    /// let p = pb.scalar_parameter("p")?;
+    /// pb.minimize((x - p).sq());
+    /// let mut compiled = pb.compile()?; // p has no value yet
+    /// let err = Ipm::default().solve(&mut compiled).unwrap_err();
+    /// assert_eq!(err, SolveError::MissingParameterValue { name: "p".into() });
+    /// compiled.set_value(p, &[3.0])?;
+    /// assert!((Ipm::default().solve(&mut compiled)?.x[0] - 3.0).abs() < 1e-8);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn compile(&self) -> Result<Compiled, BuildError> {
-        let params = self.parameter_vector()?;
+        let params = self.parameter_vector_or_unset();
         let f = self.objective();
         // Name the culprit of a free symbol before the bulk compilation.
         self.function(&[f], "the objective")?;

@@ -155,7 +155,7 @@ impl Problem {
             outputs: outputs_fn,
             derivatives,
             x0: self.initial.clone(),
-            p0: self.parameter_vector()?,
+            p0: self.parameter_vector_or_unset(),
             last: None,
         })
     }
