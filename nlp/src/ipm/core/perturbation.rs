@@ -291,7 +291,7 @@ mod tests {
         let dc = 1e-8 * mu.powf(0.25);
         let mut p = Perturbation::default();
         for k in 1..=3 {
-            assert_eq!(p.jac_degenerate, false, "before singular system {k}");
+            assert!(!p.jac_degenerate, "before singular system {k}");
             assert_eq!(p.singular_system(&o, mu), dc);
         }
         assert!(p.jac_degenerate);
