@@ -60,7 +60,7 @@ pub fn diagnose(sol: &Solution) -> Diagnosis {
             d.regularized += 1;
             d.max_regularization = d.max_regularization.max(r.regularization);
         }
-        if r.jacobian_regularization > 0.0 {
+        if r.jacobian_regularization() > 0.0 {
             d.jacobian_regularized += 1;
             d.first_jacobian_regularized.get_or_insert(r.iter);
         }
@@ -81,7 +81,7 @@ pub fn diagnose(sol: &Solution) -> Diagnosis {
     }
     if let Some(last) = sol.stats.records.last() {
         d.final_objective = last.objective;
-        d.final_mu = last.mu;
+        d.final_mu = last.mu().unwrap_or(0.0);
         d.final_inf_pr = last.inf_pr;
         d.final_inf_du = last.inf_du;
     }

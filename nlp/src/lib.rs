@@ -57,6 +57,6 @@ pub use options::{
     QualityFunctionBalancingTerm, QualityFunctionCentrality, QualityFunctionNorm, ScalingMethod,
 };
 pub use sensitivity::{ParametricSensitivity, Sensitivity, SensitivityError};
-pub use solution::{IterationRecord, Solution, Stats, Status};
+pub use solution::{BackendColumns, IterationRecord, Solution, Stats, Status};
 pub use solution_file::{SolutionFileError, SOLUTION_FILE_VERSION};
 pub use sqp::{HessianApproximation, Rti, RtiError, Sqp, SqpOptions};

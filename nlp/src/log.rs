@@ -2,90 +2,63 @@
 
 use std::fmt::Write;
 
-use crate::solution::{IterationRecord, Solution};
+use crate::solution::{BackendColumns, IterationRecord, Solution};
 
-/// The columns of one back end's iteration table. Both tables share IPOPT's layout; the
-/// fifth column is the back end's own: the interior point's barrier parameter μ, or the
-/// SQP's augmented weight ρ_a (its records carry μ = 0).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Columns {
-    /// IPOPT's: `lg(mu)` is log10 μ, `lg(rg)` log10 δ_w, `alpha_du`, `alpha_pr`.
-    Ipm,
-    /// The SQP's: `lg(ra)` is log10 ρ_a ("-" when 0), `lg(rg)` log10 of the Hessian
-    /// shift, `alpha_du` and `alpha_pr` its line search's step.
-    Sqp,
-}
-
-impl Columns {
-    /// The back end that wrote `r`: the interior point's μ is always positive, the SQP
-    /// writes μ = 0.
-    pub(crate) fn of(r: &IterationRecord) -> Columns {
-        if r.mu > 0.0 {
-            Columns::Ipm
-        } else {
-            Columns::Sqp
+/// The header line of a table of rows with columns `backend`: IPOPT's layout, the fifth
+/// column the back end's own (`lg(mu)`: log10 μ of the interior point; `lg(ra)`: log10 ρ_a
+/// of the SQP, "-" when 0). `lg(rg)` is log10 of the Hessian regularisation, `alpha_du`
+/// and `alpha_pr` the step sizes.
+pub(crate) fn header(backend: &BackendColumns) -> &'static str {
+    match backend {
+        BackendColumns::Ipm { .. } => {
+            "iter    objective    inf_pr   inf_du lg(mu)  ||d||  lg(rg) alpha_du alpha_pr  ls"
         }
-    }
-
-    /// The header line.
-    pub(crate) fn header(self) -> &'static str {
-        match self {
-            Columns::Ipm => {
-                "iter    objective    inf_pr   inf_du lg(mu)  ||d||  lg(rg) alpha_du alpha_pr  ls"
-            }
-            Columns::Sqp => {
-                "iter    objective    inf_pr   inf_du lg(ra)  ||d||  lg(rg) alpha_du alpha_pr  ls"
-            }
+        BackendColumns::Sqp { .. } => {
+            "iter    objective    inf_pr   inf_du lg(ra)  ||d||  lg(rg) alpha_du alpha_pr  ls"
         }
-    }
-
-    /// One row: `r` in these columns.
-    pub(crate) fn format(self, r: &IterationRecord) -> String {
-        let lg = |v: f64| {
-            if v > 0.0 {
-                format!("{:6.1}", v.log10())
-            } else {
-                "     -".to_string()
-            }
-        };
-        let own = match self {
-            Columns::Ipm => r.mu,
-            Columns::Sqp => r.augmented_weight,
-        };
-        format!(
-            "{:4}{} {:14.7e} {:8.2e} {:8.2e} {} {:8.2e} {} {:8.2e} {:8.2e}{} {:2}",
-            r.iter,
-            if r.restoration { 'r' } else { ' ' },
-            r.objective,
-            r.inf_pr,
-            r.inf_du,
-            lg(own),
-            r.d_norm,
-            lg(r.regularization),
-            r.alpha_du,
-            r.alpha_pr,
-            r.alpha_pr_char,
-            r.ls
-        )
     }
 }
 
-/// One formatted table row in the columns of the back end that wrote it
-/// ([`Columns::of`]).
+/// One formatted table row, in the columns of the back end that wrote it
+/// ([`IterationRecord::backend`]).
 pub fn format_record(r: &IterationRecord) -> String {
-    Columns::of(r).format(r)
+    let lg = |v: f64| {
+        if v > 0.0 {
+            format!("{:6.1}", v.log10())
+        } else {
+            "     -".to_string()
+        }
+    };
+    let own = match r.backend {
+        BackendColumns::Ipm { mu, .. } => mu,
+        BackendColumns::Sqp { augmented_weight } => augmented_weight,
+    };
+    format!(
+        "{:4}{} {:14.7e} {:8.2e} {:8.2e} {} {:8.2e} {} {:8.2e} {:8.2e}{} {:2}",
+        r.iter,
+        if r.restoration { 'r' } else { ' ' },
+        r.objective,
+        r.inf_pr,
+        r.inf_du,
+        lg(own),
+        r.d_norm,
+        lg(r.regularization),
+        r.alpha_du,
+        r.alpha_pr,
+        r.alpha_pr_char,
+        r.ls
+    )
 }
 
 /// The whole table (header every 10 rows, as IPOPT does) in the columns of the back end
 /// that wrote the records.
 pub fn format_table(records: &[IterationRecord]) -> String {
     let mut s = String::new();
-    let columns = records.first().map_or(Columns::Ipm, Columns::of);
     for (k, r) in records.iter().enumerate() {
         if k % 10 == 0 {
-            let _ = writeln!(s, "{}", columns.header());
+            let _ = writeln!(s, "{}", header(&r.backend));
         }
-        let _ = writeln!(s, "{}", columns.format(r));
+        let _ = writeln!(s, "{}", format_record(r));
     }
     s
 }
@@ -127,41 +100,49 @@ pub fn format_summary(sol: &Solution) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{format_record, format_table};
+    use crate::solution::{BackendColumns, IterationRecord};
 
-    fn record(mu: f64, augmented_weight: f64) -> IterationRecord {
+    fn record(backend: BackendColumns) -> IterationRecord {
         IterationRecord {
             iter: 3,
-            restoration: false,
-            objective: 1.5,
+            d_norm: 0.5,
             inf_pr: 1e-3,
             inf_du: 2e-4,
-            mu,
-            d_norm: 0.5,
-            regularization: 0.0,
-            jacobian_regularization: 0.0,
-            augmented_weight,
             alpha_du: 1.0,
             alpha_pr: 0.5,
             alpha_pr_char: 'f',
             ls: 2,
+            ..IterationRecord::starting_point(1.5, backend)
         }
     }
 
     /// Each back end's table shows its own fifth column under its own name: μ for the
-    /// IPM, ρ_a for the SQP (whose records carry μ = 0).
+    /// IPM, ρ_a for the SQP, whatever the values.
     #[test]
     fn each_back_end_prints_its_own_column() {
-        let ipm = format_table(&[record(1e-2, 0.0)]);
-        assert!(ipm.starts_with("iter") && ipm.contains("lg(mu)"), "{ipm}");
-        assert!(ipm.contains("  -2.0"), "lg(mu) = log10(1e-2): {ipm}");
-        let sqp = format_table(&[record(0.0, 1e3)]);
+        let ipm = record(BackendColumns::Ipm {
+            mu: 1e-2,
+            jacobian_regularization: 1e3,
+        });
+        let table = format_table(&[ipm]);
+        assert!(
+            table.starts_with("iter") && table.contains("lg(mu)"),
+            "{table}"
+        );
+        assert!(table.contains("  -2.0"), "lg(mu) = log10(1e-2): {table}");
+        // δ_c is not printed (as in IPOPT).
+        assert!(!table.contains("   3.0"), "{table}");
+        let sqp = format_table(&[record(BackendColumns::Sqp {
+            augmented_weight: 1e3,
+        })]);
         assert!(sqp.contains("lg(ra)") && !sqp.contains("lg(mu)"), "{sqp}");
         assert!(sqp.contains("   3.0"), "lg(ra) = log10(1e3): {sqp}");
-        // An IPM record never shows ρ_a, an SQP record never μ.
-        let both = record(1e-2, 1e3);
-        assert_eq!(Columns::of(&both), Columns::Ipm);
-        assert!(!Columns::Ipm.format(&both).contains("   3.0"));
-        assert!(Columns::Sqp.format(&record(0.0, 0.0)).contains("     -"));
+        // A zero ρ_a (no convexification) is "-", not a guess at another back end.
+        let plain = record(BackendColumns::Sqp {
+            augmented_weight: 0.0,
+        });
+        assert!(format_table(&[plain]).contains("lg(ra)"));
+        assert!(format_record(&plain).contains("     -"));
     }
 }

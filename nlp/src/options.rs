@@ -753,7 +753,8 @@ impl IpmOptions {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::IpmOptions;
+    use crate::error::SolveError;
 
     /// Each relation between options, broken alone, is refused and named: one case per
     /// concern of `validate`.

@@ -24,7 +24,7 @@ pub fn gradient_scale_up(grad_max: f64, min_gradient: f64, max_value: f64) -> f6
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{gradient_scale, gradient_scale_up};
 
     #[test]
     fn scales() {

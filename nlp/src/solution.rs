@@ -77,9 +77,10 @@ impl Status {
 }
 
 /// One row of the IPOPT-style iteration table. The columns both back ends fill mean the
-/// same in both; `mu` and `jacobian_regularization` are the interior point's (0 in the
-/// SQP's rows), `augmented_weight` the SQP's (0 in the interior point's rows).
+/// same in both; [`IterationRecord::backend`] holds the columns of the back end that
+/// wrote the row (μ for the interior point, ρ_a for the SQP).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(into = "RecordFields", from = "RecordFields")]
 pub struct IterationRecord {
     /// Iteration number. The counter runs on through a restoration phase (IPOPT's
     /// convention): the outer iteration whose line search failed gives its number to the
@@ -97,22 +98,13 @@ pub struct IterationRecord {
     /// (IPOPT prints the scaled value; the two differ when the objective is scaled). In
     /// restoration: the restoration problem's, as in IPOPT.
     pub inf_du: f64,
-    /// Barrier parameter μ of the interior point (printed as lg(mu)); 0 in the SQP's rows.
-    pub mu: f64,
     /// Max-norm of the primal step.
     pub d_norm: f64,
-    /// Hessian regularisation δ_w used for the step (0: none; printed as lg(rg)).
+    /// Hessian regularisation used for the step (0: none; printed as lg(rg)): the
+    /// interior point's δ_w, the SQP's Hessian shift.
     pub regularization: f64,
-    /// Jacobian regularisation δ_c of the equality rows used for the step (0: none; the
-    /// interior point's IPOPT perturbation, not printed in the table, as in IPOPT; the SQP
-    /// leaves it 0). Absent in records serialised before it existed (read as 0).
-    #[serde(default)]
-    pub jacobian_regularization: f64,
-    /// The SQP's augmented weight ρ_a of its convexified Hessian (0: none; printed in the
-    /// lg(mu) column of the SQP's table); 0 in the interior point's rows. Absent in records
-    /// serialised before it existed (read as 0).
-    #[serde(default)]
-    pub augmented_weight: f64,
+    /// The columns of the back end that wrote the row.
+    pub backend: BackendColumns,
     /// Dual step size.
     pub alpha_du: f64,
     /// Primal step size.
@@ -127,24 +119,165 @@ pub struct IterationRecord {
     pub ls: usize,
 }
 
+/// The columns of an [`IterationRecord`] that only one back end has; the fifth column of
+/// its table (lg(mu) or lg(ra)) is the first field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BackendColumns {
+    /// The interior point's (`Ipm`).
+    Ipm {
+        /// Barrier parameter μ (printed as lg(mu)).
+        mu: f64,
+        /// Jacobian regularisation δ_c of the equality rows used for the step (0: none;
+        /// not printed in the table, as in IPOPT).
+        jacobian_regularization: f64,
+    },
+    /// The SQP's (`Sqp`).
+    Sqp {
+        /// Augmented weight ρ_a of its convexified Hessian (0: none; printed as lg(ra)).
+        augmented_weight: f64,
+    },
+}
+
 impl IterationRecord {
-    /// The row of a starting point: objective `objective`, every measure and step 0.
-    pub(crate) fn starting_point(objective: f64) -> IterationRecord {
+    /// The row of a starting point: objective `objective`, every measure and step 0, the
+    /// back end's columns `backend`.
+    pub(crate) fn starting_point(objective: f64, backend: BackendColumns) -> IterationRecord {
         IterationRecord {
             iter: 0,
             restoration: false,
             objective,
             inf_pr: 0.0,
             inf_du: 0.0,
-            mu: 0.0,
             d_norm: 0.0,
             regularization: 0.0,
-            jacobian_regularization: 0.0,
-            augmented_weight: 0.0,
+            backend,
             alpha_du: 0.0,
             alpha_pr: 0.0,
             alpha_pr_char: ' ',
             ls: 0,
+        }
+    }
+
+    /// The interior point's barrier parameter μ; `None` in an SQP row.
+    pub fn mu(&self) -> Option<f64> {
+        match self.backend {
+            BackendColumns::Ipm { mu, .. } => Some(mu),
+            BackendColumns::Sqp { .. } => None,
+        }
+    }
+
+    /// The interior point's Jacobian regularisation δ_c (0 in an SQP row, which has
+    /// none).
+    pub fn jacobian_regularization(&self) -> f64 {
+        match self.backend {
+            BackendColumns::Ipm {
+                jacobian_regularization,
+                ..
+            } => jacobian_regularization,
+            BackendColumns::Sqp { .. } => 0.0,
+        }
+    }
+
+    /// The SQP's augmented weight ρ_a; `None` in an interior-point row.
+    pub fn augmented_weight(&self) -> Option<f64> {
+        match self.backend {
+            BackendColumns::Sqp { augmented_weight } => Some(augmented_weight),
+            BackendColumns::Ipm { .. } => None,
+        }
+    }
+}
+
+/// The back end named in a stored record.
+#[derive(Clone, Copy, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum Backend {
+    Ipm,
+    Sqp,
+}
+
+/// An [`IterationRecord`] as a solution file (version 1) stores it: flat, with the
+/// columns of both back ends (the other back end's as 0) and `backend` naming the one
+/// that wrote it. Files written before `backend` existed have none: their SQP rows
+/// carry μ = 0 and the interior point's μ > 0, which tells them apart.
+#[derive(Serialize, Deserialize)]
+struct RecordFields {
+    iter: usize,
+    restoration: bool,
+    objective: f64,
+    inf_pr: f64,
+    inf_du: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    backend: Option<Backend>,
+    mu: f64,
+    d_norm: f64,
+    regularization: f64,
+    #[serde(default)]
+    jacobian_regularization: f64,
+    #[serde(default)]
+    augmented_weight: f64,
+    alpha_du: f64,
+    alpha_pr: f64,
+    alpha_pr_char: char,
+    ls: usize,
+}
+
+impl From<IterationRecord> for RecordFields {
+    fn from(r: IterationRecord) -> RecordFields {
+        let (backend, mu, jacobian_regularization, augmented_weight) = match r.backend {
+            BackendColumns::Ipm {
+                mu,
+                jacobian_regularization,
+            } => (Backend::Ipm, mu, jacobian_regularization, 0.0),
+            BackendColumns::Sqp { augmented_weight } => (Backend::Sqp, 0.0, 0.0, augmented_weight),
+        };
+        RecordFields {
+            iter: r.iter,
+            restoration: r.restoration,
+            objective: r.objective,
+            inf_pr: r.inf_pr,
+            inf_du: r.inf_du,
+            backend: Some(backend),
+            mu,
+            d_norm: r.d_norm,
+            regularization: r.regularization,
+            jacobian_regularization,
+            augmented_weight,
+            alpha_du: r.alpha_du,
+            alpha_pr: r.alpha_pr,
+            alpha_pr_char: r.alpha_pr_char,
+            ls: r.ls,
+        }
+    }
+}
+
+impl From<RecordFields> for IterationRecord {
+    fn from(f: RecordFields) -> IterationRecord {
+        let backend = match f.backend {
+            Some(b) => b,
+            None if f.mu > 0.0 => Backend::Ipm,
+            None => Backend::Sqp,
+        };
+        IterationRecord {
+            iter: f.iter,
+            restoration: f.restoration,
+            objective: f.objective,
+            inf_pr: f.inf_pr,
+            inf_du: f.inf_du,
+            d_norm: f.d_norm,
+            regularization: f.regularization,
+            backend: match backend {
+                Backend::Ipm => BackendColumns::Ipm {
+                    mu: f.mu,
+                    jacobian_regularization: f.jacobian_regularization,
+                },
+                Backend::Sqp => BackendColumns::Sqp {
+                    augmented_weight: f.augmented_weight,
+                },
+            },
+            alpha_du: f.alpha_du,
+            alpha_pr: f.alpha_pr,
+            alpha_pr_char: f.alpha_pr_char,
+            ls: f.ls,
         }
     }
 }

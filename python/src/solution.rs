@@ -95,9 +95,12 @@ fn record_dict<'py>(py: Python<'py>, r: &nlp::IterationRecord) -> PyResult<Bound
     d.set_item("objective", r.objective)?;
     d.set_item("inf_pr", r.inf_pr)?;
     d.set_item("inf_du", r.inf_du)?;
-    d.set_item("lg_mu", r.mu.log10())?;
-    d.set_item("mu", r.mu)?;
-    d.set_item("augmented_weight", r.augmented_weight)?;
+    // The keys of both back ends, the other back end's as 0 (as before the records said
+    // which back end wrote them).
+    let mu = r.mu().unwrap_or(0.0);
+    d.set_item("lg_mu", mu.log10())?;
+    d.set_item("mu", mu)?;
+    d.set_item("augmented_weight", r.augmented_weight().unwrap_or(0.0))?;
     d.set_item("d_norm", r.d_norm)?;
     d.set_item("regularization", r.regularization)?;
     d.set_item("alpha_du", r.alpha_du)?;

@@ -103,7 +103,7 @@ impl Convergence {
                     objective: r.objective,
                     inf_pr: r.inf_pr,
                     residual_10: phase.residuals.get(k).copied(),
-                    mu: r.mu,
+                    mu: r.mu().unwrap_or(0.0),
                 });
             }
         }

@@ -324,7 +324,9 @@ impl<'a> ScaledNlp<'a> {
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {
-    use super::*;
+    use super::ScaledNlp;
+    use crate::numeric::NumericNlp;
+    use crate::solution::Stats;
     use crate::{Problem, Relation};
 
     /// f = 3x₀² + x₁, g₀ = x₀x₁ = 1, g₁ = 100x₀ + x₁ ≤ 500; derivatives by hand at

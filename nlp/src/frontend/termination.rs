@@ -84,7 +84,9 @@ impl Termination {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{KktResiduals, Termination};
+    use crate::frontend::CommonOptions;
+    use crate::solution::Status;
 
     fn res(overall: f64, dual: f64, primal: f64, compl: f64) -> KktResiduals {
         KktResiduals {

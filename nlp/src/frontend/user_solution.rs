@@ -225,8 +225,9 @@ fn cone_terms(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{user_solution, ScaledNlp, UserPoint};
     use crate::frontend::validate::validate;
+    use crate::solution::Status;
     use crate::{Problem, Relation};
 
     /// min (x₀ − 1)² + x₁² s.t. x₀ + x₁ ≥ 0, x₁ fixed at 2. Measures by hand at two points.

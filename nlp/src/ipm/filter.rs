@@ -162,7 +162,8 @@ impl Acceptance {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{Acceptance, Filter};
+    use crate::options::IpmOptions;
 
     #[test]
     fn filter_dominance() {

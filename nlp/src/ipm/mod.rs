@@ -233,6 +233,7 @@ fn iterate(
         in_resto: false,
         scaling: &scaling,
         mu_strategy: opts.effective_mu_strategy(),
+        failed_search: None,
     };
     let (hess, jac) = (red.hess_l_sparsity(), red.jac_g_sparsity());
     let (structure, buffers) = match kept.take() {

@@ -304,7 +304,9 @@ impl MuUpdate {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{loqo_mu, mu_floor, mu_floor_adaptive, probing_mu, tau, AdaptiveMode, MuUpdate};
+    use crate::ipm::quality::{Norms, Pairs, QualityData, QualitySettings};
+    use crate::options::{IpmOptions, MuStrategy};
 
     #[test]
     fn floors_and_tau() {

@@ -144,7 +144,10 @@ impl StopTest {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{scaled_error, Stop, StopTest};
+    use crate::frontend::KktResiduals;
+    use crate::options::IpmOptions;
+    use crate::solution::Status;
 
     /// eq. (5) on a hand-made iterate: y = (3), z_L = (1, ·), z_U = (·, 5) (bounds
     /// x₀ ≥ l, x₁ ≤ u). With s_max = 1: s_d = max(1, 9/3) = 3, s_c = max(1, 6/2) = 3;

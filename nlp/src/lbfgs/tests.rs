@@ -1,10 +1,14 @@
 //! Checks of the compact forms against the textbook recursions, and of the low-rank KKT
 //! solve and inertia against a dense matrix.
 
-use super::*;
+use super::{dot, norm2, LimitedMemory, Settings, UpdateKind};
 use crate::kkt::LowRankKkt;
+use crate::kkt::{Kkt, LowRankTerm};
+use crate::options::{LimitedMemoryInit, LimitedMemoryUpdate};
 use crate::test_support::{pattern, Rng};
 use faer::linalg::solvers::Solve;
+use faer::sparse::SymbolicSparseColMat;
+use faer::Mat;
 use faer::Side;
 
 fn settings(update: LimitedMemoryUpdate, max_history: usize) -> Settings {

@@ -73,7 +73,7 @@ use crate::frontend::user_solution::conclude;
 use crate::frontend::validate::validate;
 use crate::frontend::{Solver, Termination};
 use crate::numeric::NumericNlp;
-use crate::solution::{IterationRecord, Solution};
+use crate::solution::{BackendColumns, IterationRecord, Solution};
 
 pub use options::{HessianApproximation, SqpOptions};
 pub use rti::{Feedback, Rti, RtiError, RtiResidual};
@@ -205,11 +205,11 @@ fn iterate(
             objective: 0.0,
             inf_pr: 0.0,
             inf_du: 0.0,
-            mu: 0.0,
             d_norm: ls.d_norm,
             regularization: delta,
-            jacobian_regularization: 0.0,
-            augmented_weight: s.curv.rho_a_last,
+            backend: BackendColumns::Sqp {
+                augmented_weight: s.curv.rho_a_last,
+            },
             alpha_du: ls.alpha,
             alpha_pr: ls.alpha,
             alpha_pr_char: if ls.soc_used {

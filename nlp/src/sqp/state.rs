@@ -25,7 +25,7 @@ use crate::frontend::{KktResiduals, Termination};
 use crate::kkt::Kkt;
 use crate::numeric::NumericNlp;
 use crate::scaling::gradient_scale;
-use crate::solution::{IterationRecord, Solution, Stats, Status};
+use crate::solution::{BackendColumns, IterationRecord, Solution, Stats, Status};
 
 /// The Hessian term B of the QP and how it was convexified.
 pub(super) struct Curvature {
@@ -260,7 +260,12 @@ impl<'a> SqpState<'a> {
             ..Stats::default()
         };
         let it = first_iterate(&mut sc, &shape, x, warm);
-        let record = IterationRecord::starting_point(sc.scaling.objective_to_user(it.f));
+        let record = IterationRecord::starting_point(
+            sc.scaling.objective_to_user(it.f),
+            BackendColumns::Sqp {
+                augmented_weight: 0.0,
+            },
+        );
         let kept = ws.take(&shape, &geo, (o.qp_tol, o.qp_max_iter));
         let qp = kept.plain.unwrap_or_else(|| new_qp(&shape, &geo, o, false));
         SqpState {
@@ -317,7 +322,7 @@ impl<'a> SqpState<'a> {
         self.stats.records.push(self.record);
         if o.print_level >= 5 {
             if iter % 10 == 0 {
-                println!("{}", crate::log::Columns::Sqp.header());
+                println!("{}", crate::log::header(&self.record.backend));
             }
             println!("{}", crate::log::format_record(&self.record));
         }

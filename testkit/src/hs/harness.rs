@@ -174,7 +174,7 @@ impl Run {
                 "matches": self.matched(sol.objective),
                 "constr_viol": sol.constr_viol,
                 "delta_w_iterations": sol.stats.records.iter().filter(|r| r.regularization > 0.0).count(),
-                "delta_c_iterations": sol.stats.records.iter().filter(|r| r.jacobian_regularization > 0.0).count(),
+                "delta_c_iterations": sol.stats.records.iter().filter(|r| r.jacobian_regularization() > 0.0).count(),
                 "seconds": self.solve_seconds,
                 "compile_seconds": self.compile_seconds,
                 "message": sol.message,

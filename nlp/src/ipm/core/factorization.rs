@@ -55,8 +55,8 @@ impl Core<'_> {
         res: &Result<f64, crate::kkt::KktError>,
         singular_ratio: f64,
     ) -> bool {
-        self.pert.delta_c == 0.0
-            && self.pert.delta_w == 0.0
+        self.pert.delta_c() == 0.0
+            && self.pert.delta_w() == 0.0
             && self.mu_update.mu() <= QUALITY_MU_MAX
             && self.count.quality_retries < QUALITY_RETRIES
             && matches!(res, Ok(r) if *r > singular_ratio)
@@ -77,7 +77,7 @@ impl Core<'_> {
         let (n, m) = (self.lay.n, self.lay.m);
         self.count.quality_retries += 1;
         self.kw.reg_scale = QUALITY_REG_SCALE;
-        let fact = self.factor_kkt(shared, delta_w, self.pert.delta_c);
+        let fact = self.factor_kkt(shared, delta_w, self.pert.delta_c());
         self.kw.reg_scale = 1.0;
         if !matches!(fact, Ok(i) if i.positive == n && i.negative == m && i.zero == 0) {
             return None;

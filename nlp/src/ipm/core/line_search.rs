@@ -30,7 +30,11 @@ impl Core<'_> {
         let here = Merit {
             theta: one_norm(&self.it.c),
             phi: self.barrier(&self.it.w, self.it.f, self.mu_update.mu()),
-            gpd: self.barrier_dir_deriv(&self.dir.dw),
+            gpd: self.barrier_at(self.mu_update.mu()).dir_deriv(
+                &self.it.w,
+                &self.it.grad[..self.lay.n],
+                &self.dir.dw,
+            ),
         };
         let alpha_max = self.max_step_primal(&self.dir.dw, self.mu_update.tau());
         let alpha_min = self.accept.alpha_min(here.theta, here.gpd);

@@ -1,4 +1,5 @@
-//! Error measures (IPOPT's scaled optimality error) and the barrier function.
+//! Error measures (IPOPT's scaled optimality error) and the barrier function on the
+//! core's bounds.
 
 #![allow(
     clippy::needless_range_loop,
@@ -8,7 +9,7 @@
 
 use super::vectors::inf_norm;
 use super::Core;
-use crate::ipm::barrier::barrier_value;
+use crate::ipm::barrier::Barrier;
 use crate::ipm::termination::scaled_error;
 
 impl Core<'_> {
@@ -104,39 +105,20 @@ impl Core<'_> {
 
     // ------------------------------------------------------------------ barrier function
 
-    pub(super) fn barrier(&self, w: &[f64], f: f64, mu: f64) -> f64 {
-        barrier_value(
-            w,
-            f,
+    /// The barrier function at barrier parameter `mu` on this problem's bounds.
+    pub(super) fn barrier_at(&self, mu: f64) -> Barrier<'_> {
+        Barrier {
             mu,
-            self.opts.kappa_d,
-            &self.lay.wl,
-            &self.lay.wu,
-            &self.lay.has_l,
-            &self.lay.has_u,
-        )
+            kappa_d: self.opts.kappa_d,
+            wl: &self.lay.wl,
+            wu: &self.lay.wu,
+            has_l: &self.lay.has_l,
+            has_u: &self.lay.has_u,
+        }
     }
 
-    pub(super) fn barrier_dir_deriv(&self, dw: &[f64]) -> f64 {
-        let mu = self.mu_update.mu();
-        let kd = self.opts.kappa_d * mu;
-        let mut d = 0.0;
-        for j in 0..self.lay.nw {
-            let mut gj = if j < self.lay.n { self.it.grad[j] } else { 0.0 };
-            if self.lay.has_l[j] {
-                gj -= mu / (self.it.w[j] - self.lay.wl[j]);
-                if !self.lay.has_u[j] {
-                    gj += kd;
-                }
-            }
-            if self.lay.has_u[j] {
-                gj += mu / (self.lay.wu[j] - self.it.w[j]);
-                if !self.lay.has_l[j] {
-                    gj -= kd;
-                }
-            }
-            d += gj * dw[j];
-        }
-        d
+    /// φ_μ at `(w, f)`.
+    pub(super) fn barrier(&self, w: &[f64], f: f64, mu: f64) -> f64 {
+        self.barrier_at(mu).value(w, f)
     }
 }

@@ -17,9 +17,10 @@ use crate::ipm::error::CoreError;
 use crate::ipm::filter::{Acceptance, Filter};
 use crate::ipm::mu_update::MuUpdate;
 use crate::ipm::reduced::IpmProblem;
+use crate::ipm::restoration::handoff::{refusal, Ended, Entry, Next};
 use crate::ipm::termination::StopTest;
 use crate::options::{IpmOptions, MuStrategy};
-use crate::solution::{IterationRecord, Stats, Status};
+use crate::solution::{BackendColumns, IterationRecord, Stats, Status};
 
 mod buffers;
 mod direction;
@@ -57,11 +58,10 @@ pub(crate) struct Shared<'c> {
     pub observer: Option<Observer<'c>>,
 }
 
-/// A restoration phase run from a core's current iterate: `Ok` to continue from the
-/// restored point, else the solve's final outcome. [`Core::run`] takes it as an argument
-/// (`ipm::restoration::restore`) because the restoration phase drives a core itself:
-/// the core does not depend on it.
-pub(crate) type Restorer = fn(&mut Core<'_>, &mut Shared) -> Result<(), Outcome>;
+/// A restoration phase run from a core's state: it ends with what the core does next.
+/// [`Core::run`] takes it as an argument (`ipm::restoration::restore`) because the
+/// restoration phase drives a core itself: the core knows only the hand-over types.
+pub(crate) type Restorer = fn(Entry<'_>, &mut Shared) -> Ended;
 
 /// What one iteration of [`Core::run`] leads to.
 enum Iteration {
@@ -69,8 +69,12 @@ enum Iteration {
     Continue,
     /// The solve ended.
     Finished(Outcome),
-    /// No step was taken, for the given reason: a restoration phase starts.
-    Restore(&'static str),
+    /// No step was taken, for reason `why`: a restoration phase starts (the filter
+    /// already holds the current point if `filter_augmented`).
+    Restore {
+        why: &'static str,
+        filter_augmented: bool,
+    },
 }
 
 /// How to start the iteration.
@@ -102,6 +106,9 @@ pub(crate) struct Setup<'s> {
     /// termination tests).
     pub scaling: &'s Scaling,
     pub mu_strategy: MuStrategy,
+    /// The failed outer line search (α_pr, trial count) a restoration run shows in its
+    /// first log row; `None` outside restoration.
+    pub failed_search: Option<(f64, usize)>,
 }
 
 /// How a run ended; its final point is the core's iterate ([`Core::iterate`], or
@@ -123,10 +130,6 @@ struct Counters {
     resto_calls: usize,
     /// Accepted steps in a row with α_pr < `tiny_alpha`.
     tiny_alpha_run: usize,
-    /// In IPOPT's soft restoration phase: the number of its iterations so far.
-    soft_resto: Option<usize>,
-    /// The filter already holds the current point (a soft restoration was tried).
-    filter_has_current: bool,
     /// Refactorisations with lowered static regularisation after a failed refinement
     /// (see `Core::solve_with_higher_quality`).
     quality_retries: usize,
@@ -149,6 +152,9 @@ pub(crate) struct Core<'p> {
     c_soc: Vec<f64>,
     kw: KktWork,
     pert: Perturbation,
+    /// In IPOPT's soft restoration phase: the number of its iterations so far (read and
+    /// written in `soft_resto.rs` only).
+    soft_resto: Option<usize>,
     count: Counters,
     /// The barrier parameter μ, τ and the adaptive rule's state.
     mu_update: MuUpdate,
@@ -210,6 +216,7 @@ impl<'p> Core<'p> {
             c_soc,
             kw: kw.expect("Buffers::prepare builds the KKT work"),
             pert: Perturbation::default(),
+            soft_resto: None,
             count: Counters::default(),
             mu_update: MuUpdate::new(
                 setup.mu_init,
@@ -232,7 +239,7 @@ impl<'p> Core<'p> {
                     .recalc_y
                     .unwrap_or(opts.hessian_approximation == crate::IpmHessian::LimitedMemory),
             scaling,
-            resto_start: None,
+            resto_start: setup.failed_search,
         })
     }
 
@@ -286,11 +293,12 @@ impl<'p> Core<'p> {
             objective,
             inf_pr,
             inf_du: dual,
-            mu: self.mu_update.mu(),
             d_norm,
-            regularization: self.pert.delta_w,
-            jacobian_regularization: self.pert.delta_c,
-            augmented_weight: 0.0,
+            regularization: self.pert.delta_w(),
+            backend: BackendColumns::Ipm {
+                mu: self.mu_update.mu(),
+                jacobian_regularization: self.pert.delta_c(),
+            },
             alpha_du,
             alpha_pr,
             alpha_pr_char: ch,
@@ -305,23 +313,14 @@ impl<'p> Core<'p> {
         if self.setup_in_resto {
             shared.stats.restoration_iterations += 1;
         }
-        if self.pert.delta_w > shared.stats.max_regularization {
-            shared.stats.max_regularization = self.pert.delta_w;
+        if self.pert.delta_w() > shared.stats.max_regularization {
+            shared.stats.max_regularization = self.pert.delta_w();
         }
-        if self.opts.print_level >= 5 {
+        if let (true, Some(rec)) = (self.opts.print_level >= 5, shared.stats.records.last()) {
             if shared.stats.records.len() % 10 == 1 {
-                println!("{}", crate::log::Columns::Ipm.header());
+                println!("{}", crate::log::header(&rec.backend));
             }
-            println!(
-                "{}",
-                crate::log::Columns::Ipm.format(
-                    shared
-                        .stats
-                        .records
-                        .last()
-                        .unwrap_or(&IterationRecord::starting_point(0.0))
-                )
-            );
+            println!("{}", crate::log::format_record(rec));
         }
     }
 
@@ -392,22 +391,24 @@ impl<'p> Core<'p> {
         let mut pending_resto = self.opts.start_with_resto && !self.setup_in_resto;
         self.termination.start(shared.iter);
         loop {
-            self.count.filter_has_current = false;
             let e0 = match self.stop_test(shared) {
                 Ok(e0) => e0,
                 Err(out) => return out,
             };
             // Why the restoration phase below starts (or, where it cannot, the solve ends).
-            let why = if std::mem::take(&mut pending_resto) {
-                "line search failed"
+            let (why, filter_augmented) = if std::mem::take(&mut pending_resto) {
+                ("line search failed", false)
             } else {
                 match self.iterate_once(shared, e0) {
                     Iteration::Continue => continue,
                     Iteration::Finished(out) => return out,
-                    Iteration::Restore(why) => why,
+                    Iteration::Restore {
+                        why,
+                        filter_augmented,
+                    } => (why, filter_augmented),
                 }
             };
-            if let Some(out) = self.restoration_phase(shared, why, restore) {
+            if let Some(out) = self.restoration_phase(shared, why, filter_augmented, restore) {
                 return out;
             }
         }
@@ -446,7 +447,10 @@ impl<'p> Core<'p> {
                 false,
             ));
         }
-        Iteration::Restore("line search failed")
+        Iteration::Restore {
+            why: "line search failed",
+            filter_augmented: false,
+        }
     }
 
     /// Takes the full step when the direction is tiny relative to the iterate; `None`
@@ -460,7 +464,7 @@ impl<'p> Core<'p> {
         if !(tiny && self.take_full_step()) {
             return None;
         }
-        self.count.soft_resto = None;
+        self.end_soft_resto();
         self.count.tiny_count += 1;
         let (_, eu) = self.errors(0.0, false);
         self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
@@ -476,7 +480,9 @@ impl<'p> Core<'p> {
 
     /// The line search along the direction and its record.
     fn step_by_line_search(&mut self, shared: &mut Shared, d_norm: f64) -> Iteration {
-        match self.search_step(shared) {
+        let search = self.search_step(shared);
+        let filter_augmented = search.filter_augmented();
+        match search {
             LineSearch::Accepted {
                 alpha_pr,
                 alpha_du,
@@ -495,7 +501,10 @@ impl<'p> Core<'p> {
                 // Treated as a failed line search (the step is kept): the
                 // restoration's first row shows α_pr 0, 'R', ls 0.
                 self.resto_start = Some((0.0, 0));
-                Iteration::Restore("tiny_alpha_max_iter steps in a row with alpha_pr < tiny_alpha")
+                Iteration::Restore {
+                    why: "tiny_alpha_max_iter steps in a row with alpha_pr < tiny_alpha",
+                    filter_augmented,
+                }
             }
             LineSearch::Failed { alpha_pr, trials } => {
                 // The restoration phase's first row reports the failed line search
@@ -503,38 +512,30 @@ impl<'p> Core<'p> {
                 // trial steps).
                 shared.iter -= 1;
                 self.resto_start = Some((alpha_pr, trials + 1));
-                Iteration::Restore("line search failed")
+                Iteration::Restore {
+                    why: "line search failed",
+                    filter_augmented,
+                }
             }
         }
     }
 
-    /// A restoration phase started because of `why`; `None` when the solve continues
-    /// from the restored point, else the final outcome (also when no restoration phase
-    /// can run: inside one, or without constraints).
+    /// A restoration phase started because of `why` (the filter already holds the
+    /// current point if `filter_augmented`); `None` when the solve continues from the
+    /// restored point, else the final outcome (also when no restoration phase can run:
+    /// inside one, or without constraints).
     fn restoration_phase(
         &mut self,
         shared: &mut Shared,
         why: &str,
+        filter_augmented: bool,
         restore: Restorer,
     ) -> Option<Outcome> {
-        if self.setup_in_resto {
-            return Some(self.outcome(
-                Status::RestorationFailed,
-                format!("{why} in restoration"),
-                false,
-            ));
-        }
-        if self.lay.m == 0 {
-            let status = if self.termination.last_was_acceptable() {
-                Status::SolvedToAcceptableLevel
-            } else {
-                Status::SearchDirectionBecomesTooSmall
-            };
-            return Some(self.outcome(
-                status,
-                format!("{why} for a problem without constraints"),
-                false,
-            ));
+        let last_acceptable = self.termination.last_was_acceptable();
+        if let Some((status, message)) =
+            refusal(self.setup_in_resto, self.lay.m, last_acceptable, why)
+        {
+            return Some(self.outcome(status, message, false));
         }
         self.count.resto_calls += 1;
         // The restoration phase's first row takes the next iteration number (IPOPT's
@@ -542,19 +543,39 @@ impl<'p> Core<'p> {
         shared.iter += 1;
         // Augment the filter with the current iterate (Wächter & Biegler, Alg. A step A-9)
         // unless the soft restoration attempt did.
-        if !std::mem::take(&mut self.count.filter_has_current) {
+        if !filter_augmented {
             let theta = one_norm(&self.it.c);
             let phi = self.barrier(&self.it.w, self.it.f, self.mu_update.mu());
             self.accept.augment(&mut self.filter, theta, phi);
         }
-        match restore(self, shared) {
-            Ok(()) => {
-                self.count.soft_resto = None;
-                self.pert.delta_w_last = 0.0;
+        let entry = Entry {
+            nlp: &mut *self.nlp,
+            lay: &self.lay,
+            it: &self.it,
+            mu: self.mu_update.mu(),
+            opts: &self.opts,
+            filter: &self.filter,
+            theta_max: self.accept.theta_max,
+            scaling: &self.scaling,
+            failed_search: self.resto_start.take(),
+        };
+        let mut ended = restore(entry, shared);
+        let moved = ended.point.take().map(|w| {
+            self.restart_from(&w)
+                .map(|()| self.scaling.max_row_to_user(&self.it.c))
+                .map_err(|e| e.to_string())
+        });
+        match ended.next(moved, self.opts.constr_viol_tol) {
+            Next::Resume { reset_filter } => {
+                if reset_filter {
+                    self.filter.reset();
+                }
+                self.end_soft_resto();
+                self.pert.forget_last_delta_w();
                 self.count.tiny_count = 0;
                 None
             }
-            Err(out) => Some(out),
+            Next::Stop { status, message } => Some(self.outcome(status, message, false)),
         }
     }
 
@@ -576,65 +597,10 @@ impl<'p> Core<'p> {
         false
     }
 
-    // ------------------------------------------------------------------ for restoration
+    // ------------------------------------------------------------------ results
 
-    /// The layout and bounds of w.
-    pub(crate) fn layout(&self) -> &Layout {
-        &self.lay
-    }
-
-    /// The current iterate.
+    /// The current iterate (a run's final point once it ended).
     pub(crate) fn iterate(&self) -> &Iterate {
         &self.it
-    }
-
-    /// The current barrier parameter μ.
-    pub(crate) fn mu(&self) -> f64 {
-        self.mu_update.mu()
-    }
-
-    /// The options of this run.
-    pub(crate) fn options(&self) -> &IpmOptions {
-        &self.opts
-    }
-
-    /// The problem being solved.
-    pub(crate) fn problem(&self) -> &dyn IpmProblem {
-        &*self.nlp
-    }
-
-    /// The problem being solved, for a nested restoration problem that evaluates it.
-    pub(crate) fn problem_mut(&mut self) -> &mut dyn IpmProblem {
-        &mut *self.nlp
-    }
-
-    /// The filter (restoration accepts only points acceptable to it).
-    pub(crate) fn filter(&self) -> &Filter {
-        &self.filter
-    }
-
-    /// Empties the filter.
-    pub(crate) fn reset_filter(&mut self) {
-        self.filter.reset();
-    }
-
-    /// Takes the failed line search that starts a restoration phase (see `resto_start`).
-    pub(crate) fn take_resto_start(&mut self) -> Option<(f64, usize)> {
-        self.resto_start.take()
-    }
-
-    /// Sets the failed line search to report in the first log row.
-    pub(crate) fn set_resto_start(&mut self, v: Option<(f64, usize)>) {
-        self.resto_start = v;
-    }
-
-    /// θ_max of the filter (the largest constraint violation accepted).
-    pub(crate) fn theta_max(&self) -> f64 {
-        self.accept.theta_max
-    }
-
-    /// The scaling of the problem (objective and rows), for the user's units.
-    pub(crate) fn scaling(&self) -> &Scaling {
-        &self.scaling
     }
 }

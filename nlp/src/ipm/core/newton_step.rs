@@ -9,7 +9,6 @@
 
 use std::time::Instant;
 
-use super::perturbation::Perturbation;
 use super::vectors::all_finite;
 use super::Core;
 use super::Shared;
@@ -82,12 +81,12 @@ impl Core<'_> {
             // (IPOPT's IncreaseQuality); if that fails too, the singular-matrix
             // treatment below refactorises.
             shared.stats.factor_seconds += t.elapsed().as_secs_f64();
-            if let Some(r) = self.solve_with_higher_quality(shared, self.pert.delta_w) {
+            if let Some(r) = self.solve_with_higher_quality(shared, self.pert.delta_w()) {
                 res = if r <= singular_ratio { Ok(r) } else { res };
             }
             t = Instant::now();
         }
-        if self.pert.delta_c == 0.0 && !matches!(res, Ok(r) if r <= singular_ratio) {
+        if self.pert.delta_c() == 0.0 && !matches!(res, Ok(r) if r <= singular_ratio) {
             // The system without the static regularisation is (numerically) singular:
             // a rank-deficient Jacobian of the equality rows with inconsistent
             // linearised constraints. Take IPOPT's regularised step: refactorise with
@@ -104,9 +103,8 @@ impl Core<'_> {
             }
         } else {
             shared.stats.factor_seconds += t.elapsed().as_secs_f64();
-            if self.pert.delta_c == 0.0 && !soc {
-                self.pert.singular_iters = 0;
-                self.pert.jac_determined = true;
+            if self.pert.delta_c() == 0.0 && !soc {
+                self.pert.solved_without_delta_c();
             }
         }
         res.is_ok()
@@ -117,19 +115,15 @@ impl Core<'_> {
     fn solve_regularised(&mut self, shared: &mut Shared) -> Option<Result<f64, KktError>> {
         let (n, m) = (self.lay.n, self.lay.m);
         let singular_ratio = self.opts.singular_residual_ratio();
-        self.pert.singular_iters += 1;
-        if self.pert.singular_iters >= 3 && !self.pert.jac_determined {
-            self.pert.jac_degenerate = true;
-        }
-        self.pert.delta_c = Perturbation::delta_cd(&self.opts, self.mu_update.mu());
-        let dw = self.pert.delta_w;
-        let ok = matches!(self.factor_kkt(shared, dw, self.pert.delta_c),
+        let delta_c = self.pert.singular_system(&self.opts, self.mu_update.mu());
+        let dw = self.pert.delta_w();
+        let ok = matches!(self.factor_kkt(shared, dw, delta_c),
                 Ok(i) if i.positive == n && i.negative == m && i.zero == 0);
         if !ok {
             // Should not happen (δ_c does not change the inertia); fall back to
             // the statically regularised system as it is.
-            self.pert.delta_c = 0.0;
-            if self.factor_kkt(shared, dw, self.pert.delta_c).is_err() {
+            self.pert.drop_delta_c();
+            if self.factor_kkt(shared, dw, self.pert.delta_c()).is_err() {
                 return None;
             }
         }
@@ -137,20 +131,19 @@ impl Core<'_> {
         self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
         let mut res = self.kw.solve_rhs();
         shared.stats.factor_seconds += t.elapsed().as_secs_f64();
-        let mut dw = self.pert.delta_w;
+        let mut dw = self.pert.delta_w();
         while ok && !matches!(res, Ok(r) if r <= singular_ratio) {
             // Still singular (singular reduced Hessian): IPOPT increases δ_w.
             dw = self.pert.next_delta_w(&self.opts, dw);
             if dw > self.opts.max_hessian_perturbation {
                 return None;
             }
-            match self.factor_kkt(shared, dw, self.pert.delta_c) {
+            match self.factor_kkt(shared, dw, self.pert.delta_c()) {
                 Ok(i) if i.positive == n && i.negative == m && i.zero == 0 => {}
                 Ok(_) => continue,
                 Err(_) => continue,
             }
-            self.pert.delta_w = dw;
-            self.pert.delta_w_last = dw;
+            self.pert.raise_delta_w(dw);
             let t = Instant::now();
             self.kw.rhs.copy_from_slice(&self.kw.rhs_copy);
             res = self.kw.solve_rhs();

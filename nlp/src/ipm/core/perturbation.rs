@@ -33,24 +33,69 @@ impl Factored {
 #[derive(Default)]
 pub(super) struct Perturbation {
     /// δ_w of the current factorisation.
-    pub(super) delta_w: f64,
+    delta_w: f64,
     /// The last nonzero δ_w (0 if none was needed yet, or after a restoration phase).
-    pub(super) delta_w_last: f64,
+    delta_w_last: f64,
     /// δ_c of the current factorisation.
-    pub(super) delta_c: f64,
+    delta_c: f64,
     /// δ_c is applied from the start (after three singular iterations in a row).
-    pub(super) jac_degenerate: bool,
+    jac_degenerate: bool,
     /// Iterations in a row whose unregularised system was singular.
-    pub(super) singular_iters: usize,
+    singular_iters: usize,
     /// Iterations in a row that needed δ_w > 0.
-    pub(super) perturbed_iters: usize,
+    perturbed_iters: usize,
     /// A step was solved without δ_c: the Jacobian is not degenerate, and
     /// `jac_degenerate` can no longer be set (IPOPT's PDPerturbationHandler decides
     /// degeneracy once, in the first iterations: "Nj" in its info string).
-    pub(super) jac_determined: bool,
+    jac_determined: bool,
 }
 
 impl Perturbation {
+    /// δ_w of the current factorisation.
+    pub(super) fn delta_w(&self) -> f64 {
+        self.delta_w
+    }
+
+    /// δ_c of the current factorisation.
+    pub(super) fn delta_c(&self) -> f64 {
+        self.delta_c
+    }
+
+    /// A restoration phase moved the iterate: the next δ_w starts afresh (from
+    /// `first_hessian_perturbation`).
+    pub(super) fn forget_last_delta_w(&mut self) {
+        self.delta_w_last = 0.0;
+    }
+
+    /// A step was solved without δ_c: the Jacobian is not degenerate (decided for good).
+    pub(super) fn solved_without_delta_c(&mut self) {
+        self.singular_iters = 0;
+        self.jac_determined = true;
+    }
+
+    /// The unregularised system was singular (IPOPT's regularised step): counts the
+    /// singular iteration, marks the Jacobian degenerate at the third in a row unless
+    /// it was found regular before, and returns δ_c(μ), the δ_c to refactorise with.
+    pub(super) fn singular_system(&mut self, o: &IpmOptions, mu: f64) -> f64 {
+        self.singular_iters += 1;
+        if self.singular_iters >= 3 && !self.jac_determined {
+            self.jac_degenerate = true;
+        }
+        self.delta_c = Self::delta_cd(o, mu);
+        self.delta_c
+    }
+
+    /// The factorisation with δ_c failed: go on without it.
+    pub(super) fn drop_delta_c(&mut self) {
+        self.delta_c = 0.0;
+    }
+
+    /// δ_w raised by the regularised step is the current (and last) δ_w.
+    pub(super) fn raise_delta_w(&mut self, delta_w: f64) {
+        self.delta_w = delta_w;
+        self.delta_w_last = delta_w;
+    }
+
     /// δ_c = jacobian_regularization_value · μ^jacobian_regularization_exponent.
     pub(super) fn delta_cd(opts: &IpmOptions, mu: f64) -> f64 {
         opts.jacobian_regularization_value * mu.powf(opts.jacobian_regularization_exponent)
@@ -136,7 +181,8 @@ impl Perturbation {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{Factored, Perturbation};
+    use crate::options::IpmOptions;
 
     /// Runs one correction whose factorisation has the right inertia once δ_w ≥
     /// `needed` (singular below it when `singular`), returning the trials (δ_w, δ_c).
@@ -233,6 +279,42 @@ mod tests {
             }
         });
         assert!(close(&seen, &[(0.0, 0.0), (1e-4, 0.0)]));
+    }
+
+    /// IPOPT's degeneracy decision: three singular systems in a row before any step was
+    /// solved without δ_c mark the Jacobian degenerate (δ_c from the first trial on);
+    /// once a step was solved without δ_c, singular systems no longer do.
+    #[test]
+    fn three_singular_systems_in_a_row_mark_the_jacobian_degenerate() {
+        let o = IpmOptions::default();
+        let mu: f64 = 1e-4;
+        let dc = 1e-8 * mu.powf(0.25);
+        let mut p = Perturbation::default();
+        for k in 1..=3 {
+            assert!(!p.jac_degenerate, "before singular system {k}");
+            assert_eq!(p.singular_system(&o, mu), dc);
+        }
+        assert!(p.jac_degenerate);
+        let (_, seen) = trials(&mut p, &o, mu, 0.0, false);
+        assert!(close(&seen, &[(0.0, dc)]), "{seen:?}");
+        let mut q = Perturbation::default();
+        q.singular_system(&o, mu);
+        q.solved_without_delta_c();
+        for _ in 0..5 {
+            q.singular_system(&o, mu);
+        }
+        assert!(
+            !q.jac_degenerate,
+            "decided regular once a step needed no δ_c"
+        );
+        q.drop_delta_c();
+        assert_eq!(q.delta_c(), 0.0);
+        // A raised δ_w is the next iteration's κ_w⁻·δ_w_last start; forgetting it
+        // (after a restoration phase) restarts from first_hessian_perturbation.
+        q.raise_delta_w(0.9);
+        assert_eq!(q.next_delta_w(&o, 0.0), 0.3);
+        q.forget_last_delta_w();
+        assert_eq!(q.next_delta_w(&o, 0.0), o.first_hessian_perturbation);
     }
 
     /// After `perturbation_skip_zero_after` perturbed iterations in a row the δ_w = 0

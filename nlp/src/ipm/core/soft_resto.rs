@@ -111,23 +111,27 @@ impl Core<'_> {
 }
 
 impl Core<'_> {
+    /// Leaves the soft restoration phase (a tiny step or a restoration phase moved the
+    /// iterate).
+    pub(super) fn end_soft_resto(&mut self) {
+        self.soft_resto = None;
+    }
+
     /// The line search of one iteration inside IPOPT's soft restoration logic: in the
     /// soft restoration phase one soft step replaces the line search; otherwise a
     /// failed line search (outside the restoration phase) tries a soft step before it
-    /// is reported. A `Failed` result starts the restoration phase; whether the filter
-    /// already holds the current point is left in `count.filter_has_current`.
+    /// is reported. A `Failed` result starts the restoration phase; the filter then
+    /// holds the current point ([`LineSearch::filter_augmented`]).
     pub(super) fn search_step(&mut self, shared: &mut Shared) -> LineSearch {
-        self.count.filter_has_current = false;
-        let (failed, count) = match self.count.soft_resto {
+        let (failed, count) = match self.soft_resto {
             Some(k) => {
                 // The filter got the point where the soft phase started.
-                self.count.filter_has_current = true;
                 let failed = LineSearch::Failed {
                     alpha_pr: 0.0,
                     trials: 0,
                 };
                 if k + 1 > self.opts.max_soft_resto_iters {
-                    self.count.soft_resto = None;
+                    self.end_soft_resto();
                     return failed;
                 }
                 (failed, k + 1)
@@ -141,7 +145,6 @@ impl Core<'_> {
                 let theta = one_norm(&self.it.c);
                 let phi = self.barrier(&self.it.w, self.it.f, self.mu_update.mu());
                 self.accept.augment(&mut self.filter, theta, phi);
-                self.count.filter_has_current = true;
                 (ls, 0)
             }
         };
@@ -151,7 +154,7 @@ impl Core<'_> {
         };
         match self.try_soft_resto_step() {
             Some(step) => {
-                self.count.soft_resto = (!step.original).then_some(count);
+                self.soft_resto = (!step.original).then_some(count);
                 LineSearch::Accepted {
                     alpha_pr: step.alpha,
                     alpha_du: step.alpha,
@@ -162,7 +165,7 @@ impl Core<'_> {
                 }
             }
             None => {
-                self.count.soft_resto = None;
+                self.end_soft_resto();
                 failed
             }
         }

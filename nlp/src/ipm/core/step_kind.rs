@@ -48,3 +48,40 @@ pub(super) enum LineSearch {
     /// Every step size down to α_min was rejected; `alpha_pr` is the last one tried.
     Failed { alpha_pr: f64, trials: usize },
 }
+
+impl LineSearch {
+    /// The filter already holds the current point (or the soft restoration phase's start
+    /// point), so a restoration phase starting now does not add it again: true after a
+    /// failed search (`Core::search_step` augments the filter before it reports one)
+    /// and after a soft restoration step (taken only once the filter was augmented).
+    pub(super) fn filter_augmented(&self) -> bool {
+        match self {
+            LineSearch::Failed { .. } => true,
+            LineSearch::Accepted { kind, .. } => matches!(kind, StepKind::Soft { .. }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{LineSearch, StepKind};
+
+    #[test]
+    fn only_failed_searches_and_soft_steps_leave_the_point_in_the_filter() {
+        let accepted = |kind| LineSearch::Accepted {
+            alpha_pr: 1.0,
+            alpha_du: 1.0,
+            kind,
+            trials: 1,
+        };
+        assert!(!accepted(StepKind::new(true, false)).filter_augmented());
+        assert!(!accepted(StepKind::new(false, true)).filter_augmented());
+        assert!(accepted(StepKind::Soft { original: false }).filter_augmented());
+        assert!(accepted(StepKind::Soft { original: true }).filter_augmented());
+        let failed = LineSearch::Failed {
+            alpha_pr: 0.0,
+            trials: 3,
+        };
+        assert!(failed.filter_augmented());
+    }
+}

@@ -3,7 +3,10 @@
 //! definition (IPOPT's CalculateQualityFunction with the default 2-norm-squared, no
 //! centrality or balancing term).
 
-use super::*;
+use super::{Norms, Pairs, QualityData, QualitySettings};
+use crate::options::{
+    QualityFunctionBalancingTerm, QualityFunctionCentrality, QualityFunctionNorm,
+};
 use crate::test_support::Rng;
 
 /// A random iterate with Newton-like steps: the affine step solves s·dz + z·ds = −s·z

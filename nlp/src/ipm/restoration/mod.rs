@@ -14,13 +14,17 @@
 use faer::sparse::SymbolicSparseColMat;
 
 use crate::frontend::scaled::Scaling;
-use crate::ipm::barrier::barrier_value;
-use crate::ipm::core::{Buffers, Core, Layout, Outcome, Setup, Shared, Start};
+use crate::ipm::barrier::Barrier;
+use crate::ipm::core::{Buffers, Core, Iterate, Layout, Setup, Shared, Start};
 use crate::ipm::filter::Filter;
 use crate::ipm::reduced::IpmProblem;
 use crate::numeric::NumericNlp;
 use crate::options::{IpmOptions, MuStrategy};
 use crate::solution::Status;
+
+pub(crate) mod handoff;
+
+use handoff::{Ended, Entry};
 
 struct Resto<'a> {
     outer: &'a mut dyn IpmProblem,
@@ -195,39 +199,38 @@ impl IpmProblem for Resto<'_> {
         }
         self.wbuf[..n].copy_from_slice(x);
         self.wbuf[n..].copy_from_slice(s);
-        let phi = barrier_value(
-            &self.wbuf,
-            f,
-            self.mu_outer,
-            self.kappa_d,
-            &self.wl,
-            &self.wu,
-            &self.has_l,
-            &self.has_u,
-        );
+        let barrier = Barrier {
+            mu: self.mu_outer,
+            kappa_d: self.kappa_d,
+            wl: &self.wl,
+            wu: &self.wu,
+            has_l: &self.has_l,
+            has_u: &self.has_u,
+        };
+        let phi = barrier.value(&self.wbuf, f);
         phi.is_finite() && self.filter.acceptable(theta, phi)
     }
 }
 
-/// Runs a restoration phase from the outer core's current iterate. On success the outer
-/// core continues from the restored point; otherwise the final outcome is returned.
-pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Outcome> {
-    let (n, m) = (core.layout().n, core.layout().m);
-    let opts = core.options().clone();
-    let mu = core.mu().max(inf_norm(&core.iterate().c));
+/// Runs a restoration phase from the outer iteration's state `outer`; the outer
+/// iteration goes on as [`Ended::next`] says.
+pub(crate) fn restore(outer: Entry<'_>, shared: &mut Shared) -> Ended {
+    let (n, m) = (outer.lay.n, outer.lay.m);
+    let opts = outer.opts.clone();
+    let mu = outer.mu.max(inf_norm(&outer.it.c));
     let rho = opts.resto_penalty_parameter;
-    let (pv, nv) = initial_p_n(&core.iterate().c, mu, rho);
+    let (pv, nv) = initial_p_n(&outer.it.c, mu, rho);
     // Full inner iterate: w = [x, p, n, s].
-    let mut w = core.iterate().w[..n].to_vec();
+    let mut w = outer.it.w[..n].to_vec();
     w.extend_from_slice(&pv);
     w.extend_from_slice(&nv);
-    w.extend_from_slice(&core.iterate().w[n..]);
-    let [zl, zu] = resto_bound_multipliers(core, &pv, &nv, mu, rho);
+    w.extend_from_slice(&outer.it.w[n..]);
+    let [zl, zu] = resto_bound_multipliers(outer.lay, outer.it, &pv, &nv, mu, rho);
     // IPOPT's first 'r' row reports the failed line search of the outer iteration
     // (alpha_pr, 'R', ls).
-    let resto_start = core.take_resto_start();
+    let failed_search = outer.failed_search;
     let x0 = w[..n + 2 * m].to_vec();
-    let mut resto = resto_problem(core, &opts, x0, mu);
+    let mut resto = resto_problem(outer, &opts, x0, mu);
     let unscaled = Scaling::unscaled(m);
     let setup = Setup {
         mu_init: mu,
@@ -235,15 +238,22 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         in_resto: true,
         scaling: &unscaled,
         mu_strategy: MuStrategy::Monotone,
+        failed_search,
     };
     let mut inner_opts = opts.clone();
     inner_opts.acceptable_iter = 0;
     inner_opts.start_with_resto = false;
     let mut inner = match Core::new(&mut resto, &inner_opts, &setup, Buffers::default()) {
         Ok(c) => c,
-        Err(e) => return Err(core.outcome(Status::RestorationFailed, e.to_string(), false)),
+        Err(e) => {
+            return Ended {
+                status: Status::RestorationFailed,
+                message: e.to_string(),
+                converged: false,
+                point: None,
+            }
+        }
     };
-    inner.set_resto_start(resto_start);
     let y0 = vec![0.0; m];
     let start = Start::Exact {
         w: &w,
@@ -251,32 +261,24 @@ pub(crate) fn restore(core: &mut Core<'_>, shared: &mut Shared) -> Result<(), Ou
         zl: &zl,
         zu: &zu,
     };
-    let (outcome, w_o) = run_inner(&mut inner, shared, start, n, m);
-    drop(inner);
-    drop(resto);
-    continue_after(core, outcome, &w_o, opts.constr_viol_tol)
+    run_inner(&mut inner, shared, start, n, m)
 }
 
-/// The restoration problem around the outer core's current iterate, starting at
-/// `x0 = [x, p, n]` with barrier parameter `mu`; it evaluates through the outer problem.
-fn resto_problem<'a>(
-    core: &'a mut Core<'_>,
-    opts: &IpmOptions,
-    x0: Vec<f64>,
-    mu: f64,
-) -> Resto<'a> {
-    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+/// The restoration problem around the outer iterate, starting at `x0 = [x, p, n]` with
+/// barrier parameter `mu`; it evaluates through the outer problem.
+fn resto_problem<'a>(outer: Entry<'a>, opts: &IpmOptions, x0: Vec<f64>, mu: f64) -> Resto<'a> {
+    let lay = outer.lay;
+    let (n, m, ni) = (lay.n, lay.m, lay.ni);
     let xr: Vec<f64> = x0[..n].to_vec();
     let dr2: Vec<f64> = xr
         .iter()
         .map(|x| (1.0f64).min(1.0 / x.abs()).powi(2))
         .collect();
-    let jac_o = core.problem().jac_g_sparsity().clone();
+    let jac_o = outer.nlp.jac_g_sparsity().clone();
     let nnz_j_orig = jac_o.row_idx().len();
-    let (jac, hess, hmap, hdiag) = resto_patterns(&jac_o, core.problem().hess_l_sparsity(), n, m);
-    let hbuf_len = core.problem().hess_l_sparsity().row_idx().len();
-    let ([x_l, x_u], [g_l, g_u]) = resto_bounds(core.layout());
-    let lay = core.layout();
+    let (jac, hess, hmap, hdiag) = resto_patterns(&jac_o, outer.nlp.hess_l_sparsity(), n, m);
+    let hbuf_len = outer.nlp.hess_l_sparsity().row_idx().len();
+    let ([x_l, x_u], [g_l, g_u]) = resto_bounds(lay);
     Resto {
         n,
         m,
@@ -302,34 +304,43 @@ fn resto_problem<'a>(
         has_l: lay.has_l.clone(),
         has_u: lay.has_u.clone(),
         kappa_d: opts.kappa_d,
-        mu_outer: core.mu(),
-        filter: core.filter().clone(),
-        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&core.iterate().c))
+        mu_outer: outer.mu,
+        filter: outer.filter.clone(),
+        inf_pr_target: (opts.required_infeasibility_reduction * inf_norm(&outer.it.c))
             .max(opts.tol.min(opts.constr_viol_tol)),
-        theta_max: core.theta_max(),
+        theta_max: outer.theta_max,
         gbuf: vec![0.0; m],
         wbuf: vec![0.0; n + ni],
-        outer_scaling: core.scaling().clone(),
-        outer: core.problem_mut(),
+        outer_scaling: outer.scaling.clone(),
+        outer: outer.nlp,
     }
 }
 
-/// The inner core's solve from `start`, and its final point mapped back to the outer
-/// variables: `x = w[..n]`, `s = w[n+2m..]`.
+/// The inner core's solve from `start`, with its final point mapped back to the outer
+/// variables: `x = w[..n]`, `s = w[n+2m..]` (none after an invalid number: the outer
+/// iteration then stays where it is).
 fn run_inner(
     inner: &mut Core<'_>,
     shared: &mut Shared,
     start: Start<'_>,
     n: usize,
     m: usize,
-) -> (Outcome, Vec<f64>) {
+) -> Ended {
     // The inner core never restores (it is the restoration phase); `restore` stands
     // for the argument.
     let outcome = inner.run(shared, start, restore);
-    let w_inner = &inner.iterate().w;
-    let mut w_o = w_inner[..n].to_vec();
-    w_o.extend_from_slice(&w_inner[n + 2 * m..]);
-    (outcome, w_o)
+    let point = (outcome.status != Status::InvalidNumberDetected).then(|| {
+        let w_inner = &inner.iterate().w;
+        let mut w_o = w_inner[..n].to_vec();
+        w_o.extend_from_slice(&w_inner[n + 2 * m..]);
+        w_o
+    });
+    Ended {
+        status: outcome.status,
+        message: outcome.message,
+        converged: outcome.resto_converged,
+        point,
+    }
 }
 
 /// The initial elastic variables `p, n` for constraint values `c`: IPOPT's closed
@@ -371,83 +382,34 @@ fn resto_bounds(lay: &Layout) -> ([Vec<f64>; 2], [Vec<f64>; 2]) {
     ([x_l, x_u], [g_l, g_u])
 }
 
-/// The inner start's bound multipliers `[z_L, z_U]` on `w = [x, p, n, s]`: the outer
-/// ones capped at `ρ` for x and s, `μ/p` and `μ/n` for the elastic variables.
+/// The inner start's bound multipliers `[z_L, z_U]` on `w = [x, p, n, s]` from the outer
+/// iterate `it`: its own capped at `ρ` for x and s, `μ/p` and `μ/n` for the elastic
+/// variables.
 fn resto_bound_multipliers(
-    core: &Core<'_>,
+    lay: &Layout,
+    it: &Iterate,
     pv: &[f64],
     nv: &[f64],
     mu: f64,
     rho: f64,
 ) -> [Vec<f64>; 2] {
-    let (n, m, ni) = (core.layout().n, core.layout().m, core.layout().ni);
+    let (n, m, ni) = (lay.n, lay.m, lay.ni);
     let nwi = n + 2 * m + ni;
     let mut zl = vec![0.0; nwi];
     let mut zu = vec![0.0; nwi];
     for j in 0..n {
-        zl[j] = core.iterate().zl[j].min(rho);
-        zu[j] = core.iterate().zu[j].min(rho);
+        zl[j] = it.zl[j].min(rho);
+        zu[j] = it.zu[j].min(rho);
     }
     for i in 0..m {
         zl[n + i] = mu / pv[i];
         zl[n + m + i] = mu / nv[i];
     }
     for k in 0..ni {
-        zl[n + 2 * m + k] = core.iterate().zl[n + k].min(rho);
-        zu[n + 2 * m + k] = core.iterate().zu[n + k].min(rho);
+        zl[n + 2 * m + k] = it.zl[n + k].min(rho);
+        zu[n + 2 * m + k] = it.zu[n + k].min(rho);
     }
     [zl, zu]
-}
-
-/// The outer core after a restoration phase that ended with `outcome` at the point `w_o`
-/// (original x and s): Ok to continue from `w_o`, or the final outcome of the solve.
-fn continue_after(
-    core: &mut Core<'_>,
-    outcome: Outcome,
-    w_o: &[f64],
-    constr_viol_tol: f64,
-) -> Result<(), Outcome> {
-    let fail = |core: &Core<'_>, status: Status, msg: String| core.outcome(status, msg, false);
-    match outcome.status {
-        Status::SolveSucceeded => {
-            if let Err(e) = core.restart_from(w_o) {
-                return Err(fail(core, Status::RestorationFailed, e.to_string()));
-            }
-            if outcome.resto_converged {
-                // The restoration problem converged: a minimiser of the infeasibility.
-                let viol = core.scaling().max_row_to_user(&core.iterate().c);
-                if viol > constr_viol_tol {
-                    return Err(fail(
-                        core,
-                        Status::InfeasibleProblemDetected,
-                        format!(
-                            "restoration converged to a point of local infeasibility (constraint violation {viol:.3e})"
-                        ),
-                    ));
-                }
-                // Feasible but not acceptable to the filter: restart the filter.
-                core.reset_filter();
-            }
-            Ok(())
-        }
-        // The solve ends at the restoration's point (for a user stop: the iterate the
-        // callback saw); a failed evaluation there is reported in the message.
-        Status::MaximumIterationsExceeded | Status::MaximumWallTimeExceeded => {
-            let message = restart_message(core, w_o, outcome.message);
-            Err(fail(core, outcome.status, message))
-        }
-        Status::UserRequestedStop => {
-            let message = restart_message(core, w_o, outcome.message);
-            Err(fail(core, outcome.status, message))
-        }
-        Status::InvalidNumberDetected => {
-            Err(fail(core, Status::RestorationFailed, outcome.message))
-        }
-        _ => {
-            let message = restart_message(core, w_o, outcome.message);
-            Err(fail(core, Status::RestorationFailed, message))
-        }
-    }
 }
 
 /// (Jacobian pattern, Hessian pattern, hmap, hdiag) of the restoration problem.
@@ -513,16 +475,6 @@ fn resto_patterns(
     }
     let hess = SymbolicSparseColMat::new_checked(n + 2 * m, n + 2 * m, hcp, None, hri);
     (jac, hess, hmap, hdiag)
-}
-
-/// Moves the outer core to the restoration's point `w_o`; the message of the ending
-/// solve, with the evaluation failure there appended if there was one.
-fn restart_message(core: &mut Core<'_>, w_o: &[f64], message: String) -> String {
-    match core.restart_from(w_o) {
-        Ok(()) => message,
-        Err(e) if message.is_empty() => e.to_string(),
-        Err(e) => format!("{message}; {e}"),
-    }
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
