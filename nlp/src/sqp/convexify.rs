@@ -4,7 +4,58 @@
 use super::geometry::Geometry;
 use super::iterate::Mult;
 use super::options::SqpOptions;
+use super::shape::Shape;
+use crate::frontend::scaled::refill;
 use crate::kkt::Kkt;
+
+/// The Hessian term B of the QP and how it was convexified.
+pub(super) struct Curvature {
+    /// Lower-triangular ∇²L values.
+    pub hv: Vec<f64>,
+    /// Dense B, column-major (BFGS only; empty otherwise).
+    pub bfgs: Vec<f64>,
+    /// ρ_a on the active rows, 0 elsewhere.
+    pub row_weight: Vec<f64>,
+    /// ρ_a on the active bounds, 0 elsewhere.
+    pub bound_weight: Vec<f64>,
+    pub rho_a_last: f64,
+    pub delta_last: f64,
+    /// Proximal shift added after rejected or heavily cut steps.
+    pub extra_shift: f64,
+}
+
+impl Curvature {
+    /// No curvature yet: B = I for BFGS, no weights, no shifts.
+    pub(super) fn new(shape: &Shape) -> Curvature {
+        let mut c = Curvature {
+            hv: Vec::new(),
+            bfgs: Vec::new(),
+            row_weight: Vec::new(),
+            bound_weight: Vec::new(),
+            rho_a_last: 0.0,
+            delta_last: 0.0,
+            extra_shift: 0.0,
+        };
+        c.reset(shape);
+        c
+    }
+
+    /// Back to [`Curvature::new`]'s state for `shape`, in these vectors.
+    pub(super) fn reset(&mut self, shape: &Shape) {
+        let n = shape.n;
+        refill(&mut self.hv, shape.hp.row_idx().len(), 0.0);
+        self.bfgs.clear();
+        if shape.dense {
+            self.bfgs
+                .extend((0..n * n).map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 }));
+        }
+        refill(&mut self.row_weight, shape.m, 0.0);
+        refill(&mut self.bound_weight, n, 0.0);
+        self.rho_a_last = 0.0;
+        self.delta_last = 0.0;
+        self.extra_shift = 0.0;
+    }
+}
 
 /// Which rows of g and which variable bounds count as active for the
 /// augmented-Lagrangian convexification: equality rows, and inequality rows and bounds

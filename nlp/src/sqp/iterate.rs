@@ -68,6 +68,15 @@ pub(super) struct Iterate {
     pub have_mult: bool,
 }
 
+/// A trial point x + αd clamped to the bounds, evaluated (scaled).
+#[derive(Default)]
+pub(super) struct TrialPoint {
+    pub x: Vec<f64>,
+    pub f: f64,
+    pub g: Vec<f64>,
+    pub cone: Vec<f64>,
+}
+
 /// KKT errors of a (scaled) iterate.
 pub(super) struct Errors {
     /// Scaled overall error (IPOPT's E_0 with s_d, s_c).

@@ -9,36 +9,17 @@ use std::time::Instant;
 use clarabel::solver::SolverStatus;
 
 use super::bfgs::quad;
+use super::iterate::TrialPoint;
 use super::qp::QpResult;
 use super::state::{eval_g, SqpState};
+use super::workspace::ModelBuffers;
 use crate::frontend::scaled::refill;
-
-/// A trial point x + αd clamped to the bounds, evaluated (scaled).
-#[derive(Default)]
-pub(super) struct TrialPoint {
-    pub x: Vec<f64>,
-    pub f: f64,
-    pub g: Vec<f64>,
-    pub cone: Vec<f64>,
-}
 
 /// An accepted trial point with the QP result that led to it when that is the
 /// second-order correction's (`None`: the step's own QP result).
 pub(super) struct Trial {
     pub point: TrialPoint,
     pub soc: Option<QpResult>,
-}
-
-/// The vectors of the line search's model and second-order correction, kept between
-/// iterations.
-#[derive(Default)]
-pub(super) struct ModelBuffers {
-    jd: Vec<f64>,
-    cd: Vec<f64>,
-    lin_g: Vec<f64>,
-    lin_c: Vec<f64>,
-    gh: Vec<f64>,
-    chat: Vec<f64>,
 }
 
 /// Outcome of the line search.

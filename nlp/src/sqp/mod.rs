@@ -136,14 +136,14 @@ impl Sqp {
     /// still allocates. The iterates are those of a fresh solver's `solve_warm`.
     /// On error `out` is left unspecified.
     /// ```
-    /// use nlp::{Problem, Sqp};
+    /// use nlp::{Problem, Relation, Sqp};
     ///
     /// let mut pb = Problem::new();
     /// let x = pb.variable("x", 2).unwrap();
     /// let p = pb.parameter("p", 1).unwrap();
     /// pb.set_value(&p, &[0.0]).unwrap();
     /// pb.minimize((x[0] - p[0]).sq() + (x[1] - 2.0).sq());
-    /// pb.subject_to(x[0] + x[1] >= 1.0);
+    /// pb.subject_to((x[0] - x[1]).le(10.0)).unwrap();
     /// let mut nlp = pb.compile().unwrap();
     /// let sqp = Sqp::default();
     /// let mut sol = sqp.solve(&mut nlp).unwrap();

@@ -8,6 +8,7 @@
 
 use std::time::Instant;
 
+pub(super) use super::convexify::Curvature;
 use super::convexify::{active_sets_into, Convexify};
 use super::geometry::Geometry;
 use super::iterate::{Iterate, Mult};
@@ -26,22 +27,6 @@ use crate::kkt::Kkt;
 use crate::numeric::NumericNlp;
 use crate::scaling::gradient_scale;
 use crate::solution::{IterationRecord, Solution, Stats, Status};
-
-/// The Hessian term B of the QP and how it was convexified.
-pub(super) struct Curvature {
-    /// Lower-triangular ∇²L values.
-    pub hv: Vec<f64>,
-    /// Dense B, column-major (BFGS only; empty otherwise).
-    pub bfgs: Vec<f64>,
-    /// ρ_a on the active rows, 0 elsewhere.
-    pub row_weight: Vec<f64>,
-    /// ρ_a on the active bounds, 0 elsewhere.
-    pub bound_weight: Vec<f64>,
-    pub rho_a_last: f64,
-    pub delta_last: f64,
-    /// Proximal shift added after rejected or heavily cut steps.
-    pub extra_shift: f64,
-}
 
 /// Work counters for `Stats`.
 #[derive(Default)]
@@ -257,39 +242,6 @@ fn empty_iterate() -> Iterate {
         cv: Vec::new(),
         mult: Mult::zeros(0, 0, 0),
         have_mult: false,
-    }
-}
-
-impl Curvature {
-    /// No curvature yet: B = I for BFGS, no weights, no shifts.
-    pub(super) fn new(shape: &Shape) -> Curvature {
-        let mut c = Curvature {
-            hv: Vec::new(),
-            bfgs: Vec::new(),
-            row_weight: Vec::new(),
-            bound_weight: Vec::new(),
-            rho_a_last: 0.0,
-            delta_last: 0.0,
-            extra_shift: 0.0,
-        };
-        c.reset(shape);
-        c
-    }
-
-    /// Back to [`Curvature::new`]'s state for `shape`, in these vectors.
-    fn reset(&mut self, shape: &Shape) {
-        let n = shape.n;
-        refill(&mut self.hv, shape.hp.row_idx().len(), 0.0);
-        self.bfgs.clear();
-        if shape.dense {
-            self.bfgs
-                .extend((0..n * n).map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 }));
-        }
-        refill(&mut self.row_weight, shape.m, 0.0);
-        refill(&mut self.bound_weight, n, 0.0);
-        self.rho_a_last = 0.0;
-        self.delta_last = 0.0;
-        self.extra_shift = 0.0;
     }
 }
 

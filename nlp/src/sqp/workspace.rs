@@ -19,14 +19,12 @@ use std::sync::Mutex;
 use faer::sparse::SymbolicSparseColMat;
 
 use super::active_set::Scratch as ActiveSetScratch;
-use super::convexify::ConvexifyScratch;
+use super::convexify::{ConvexifyScratch, Curvature};
 use super::geometry::Geometry;
-use super::iterate::Iterate;
-use super::line_search::{ModelBuffers, TrialPoint};
+use super::iterate::{Iterate, TrialPoint};
 use super::polish::WorkingSet;
 use super::qp::{Qp, QpResult};
 use super::shape::Shape;
-use super::state::Curvature;
 use crate::frontend::scaled::{NormScratch, ScaledBuffers};
 use crate::frontend::user_solution::FinalScratch;
 use crate::frontend::validate::Validated;
@@ -135,6 +133,18 @@ pub(super) struct StepBuffers {
     pub model: ModelBuffers,
     /// The cone multipliers in the user's units.
     pub z_cone_user: Vec<f64>,
+}
+
+/// The vectors of the line search's model and second-order correction, kept between
+/// iterations.
+#[derive(Default)]
+pub(super) struct ModelBuffers {
+    pub jd: Vec<f64>,
+    pub cd: Vec<f64>,
+    pub lin_g: Vec<f64>,
+    pub lin_c: Vec<f64>,
+    pub gh: Vec<f64>,
+    pub chat: Vec<f64>,
 }
 
 /// What a solve starts from: the kept KKT matrix and QPs of its structure, if any, and
