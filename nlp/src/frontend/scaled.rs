@@ -120,8 +120,10 @@ pub(crate) struct ScaledBuffers {
 /// Scratch of [`ScaledNlp::unscaled_gradient_norms_into`]; `rmax` holds its result.
 #[derive(Default)]
 pub(crate) struct NormScratch {
-    grad: Vec<f64>,
-    jv: Vec<f64>,
+    /// The unscaled ∇f at the point (the SQP's first iterate reuses it).
+    pub grad: Vec<f64>,
+    /// The unscaled Jacobian values at the point (empty without rows).
+    pub jv: Vec<f64>,
     /// The unscaled max-norm of each row of the Jacobian over the kept columns.
     pub rmax: Vec<f64>,
 }
