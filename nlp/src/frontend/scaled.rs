@@ -120,8 +120,10 @@ pub(crate) struct ScaledBuffers {
 /// Scratch of [`ScaledNlp::unscaled_gradient_norms_into`]; `rmax` holds its result.
 #[derive(Default)]
 pub(crate) struct NormScratch {
-    grad: Vec<f64>,
-    jv: Vec<f64>,
+    /// The unscaled ∇f at the point (the SQP's first iterate reuses it).
+    pub grad: Vec<f64>,
+    /// The unscaled Jacobian values at the point (empty without rows).
+    pub jv: Vec<f64>,
     /// The unscaled max-norm of each row of the Jacobian over the kept columns.
     pub rmax: Vec<f64>,
 }
@@ -150,6 +152,7 @@ pub(crate) struct ScaledNlp<'a> {
 
 impl<'a> ScaledNlp<'a> {
     /// The unscaled problem (all factors 1).
+    #[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
     pub fn new(user: &'a mut dyn NumericNlp) -> Self {
         Self::with_buffers(user, ScaledBuffers::default())
     }
@@ -260,6 +263,7 @@ impl<'a> ScaledNlp<'a> {
     /// columns in `cols` (all when `None`) and of each row of the Jacobian over the same
     /// columns (the Jacobian is not evaluated when there are no rows). A row with a
     /// non-finite entry reports NaN (the gradient-based rule then leaves it unscaled).
+    #[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
     pub fn unscaled_gradient_norms(&mut self, x: &[f64], cols: Option<&[bool]>) -> (f64, Vec<f64>) {
         let mut scratch = NormScratch::default();
         let gmax = self.unscaled_gradient_norms_into(x, cols, &mut scratch);

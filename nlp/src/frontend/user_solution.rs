@@ -12,6 +12,7 @@ use crate::numeric::AffineCone;
 use crate::solution::{Solution, Stats, Status};
 
 /// The final point and multipliers in the user's numbering and units.
+#[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
 pub(crate) struct UserPoint {
     pub x: Vec<f64>,
     pub lambda: Vec<f64>,
@@ -62,6 +63,7 @@ fn viol(v: f64, lo: f64, hi: f64) -> f64 {
 /// in the user's units. A fixed variable's bound multipliers absorb its gradient of the
 /// Lagrangian (only z_L − z_U is determined there). A cone's smooth row reports the
 /// cone's multiplier z_t. `stats` are left at their defaults.
+#[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
 pub(crate) fn user_solution(
     sc: &mut ScaledNlp<'_>,
     b: &Validated,

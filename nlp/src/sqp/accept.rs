@@ -3,7 +3,6 @@
 //! reacting to a rejected step (a stop, or a shifted Hessian next time).
 
 use super::bfgs::bfgs_update;
-use super::iterate::Mult;
 use super::line_search::{LineSearch, Trial};
 use super::qp::QpResult;
 use super::state::{eval_jac, SqpState};
@@ -35,14 +34,21 @@ impl SqpState<'_> {
         let c = &mut self.curv;
         c.extra_shift = (c.extra_shift * 10.0).max(1e-2 * (1.0 + delta));
         // Multipliers of the QP are still the best estimate.
-        self.it.mult = Mult::from_qp(res);
+        self.it.mult.set_from_qp(res);
         self.it.have_mult = true;
         None
     }
 
-    /// Takes the accepted trial point: adapts the proximal shift to the step length,
-    /// evaluates the derivatives there and updates a BFGS matrix.
-    pub fn accept(&mut self, trial: Trial, ls: &LineSearch) -> Result<(), StepError> {
+    /// Takes the accepted trial point (whose QP result is `trial.soc` or else `res`):
+    /// adapts the proximal shift to the step length, evaluates the derivatives there and
+    /// updates a BFGS matrix. The trial's vectors (holding the old point) and its QP
+    /// result go back to the buffers.
+    pub fn accept(
+        &mut self,
+        trial: Trial,
+        ls: &LineSearch,
+        res: &QpResult,
+    ) -> Result<(), StepError> {
         self.ls_failures = 0;
         // Levenberg–Marquardt-like safeguard: a heavily cut step means the model is
         // poor at this length, so the next step is shortened by a proximal shift
@@ -56,13 +62,18 @@ impl SqpState<'_> {
         } else if ls.alpha == 1.0 {
             c.extra_shift = 0.0;
         }
+        let Trial { mut point, soc } = trial;
         let (it, shape, cone_row) = (&mut self.it, &self.shape, &self.geo.cone_row);
-        let x_old = std::mem::replace(&mut it.x, trial.x);
-        it.f = trial.f;
-        it.g = trial.g;
-        it.cone = trial.cone;
-        it.mult = Mult::from_qp(&trial.res);
+        std::mem::swap(&mut it.x, &mut point.x);
+        it.f = point.f;
+        std::mem::swap(&mut it.g, &mut point.g);
+        std::mem::swap(&mut it.cone, &mut point.cone);
+        it.mult.set_from_qp(soc.as_ref().unwrap_or(res));
         it.have_mult = true;
+        if let Some(r) = soc {
+            self.steps.results.push(r);
+        }
+        let x_old = &point.x;
         // ∇L at the old point with the new multipliers (BFGS only).
         let mut l_old = vec![0.0; if shape.dense { shape.n } else { 0 }];
         if shape.dense {
@@ -76,10 +87,11 @@ impl SqpState<'_> {
         if shape.dense {
             let mut l_new = vec![0.0; shape.n];
             it.lagrangian_gradient(shape, cone_row, &it.mult, &mut l_new);
-            let s: Vec<f64> = it.x.iter().zip(&x_old).map(|(a, b)| a - b).collect();
+            let s: Vec<f64> = it.x.iter().zip(x_old).map(|(a, b)| a - b).collect();
             let y: Vec<f64> = l_new.iter().zip(&l_old).map(|(a, b)| a - b).collect();
             bfgs_update(&mut self.curv.bfgs, &s, &y);
         }
+        self.steps.points.push(point);
         Ok(())
     }
 }

@@ -30,9 +30,11 @@ use faer::sparse::SymbolicSparseColMat;
 
 use super::iterate::Mult;
 use super::polish::{
-    equality_qp_step, jac_times, solve_working_set, stationarity, Side, WorkingSet,
+    equality_qp_step_into, jac_times_into, solve_working_set_into, stationarity_into, EqScratch,
+    Side, WorkingSet,
 };
 use super::qp::{QpData, QpResult};
+use crate::frontend::scaled::refill;
 use crate::kkt::Kkt;
 
 /// Why the active-set method gave up on a QP (the caller falls back to clarabel); as
@@ -56,9 +58,6 @@ pub(super) struct Solved {
     pub res: QpResult,
     pub working_set: WorkingSet,
     pub iterations: usize,
-    /// The largest |λ_i| of the rows: the solution is the elastic QP's (zero elastic
-    /// variables) only for ρ ≥ this (see [`penalty_for`]).
-    pub max_multiplier: f64,
 }
 
 /// The ℓ1 penalty for which a QP solution with multipliers up to `max_multiplier` is
@@ -85,36 +84,43 @@ pub(super) fn penalty_for(
 /// previous QP): equality rows and fixed variables always; an inequality side or a
 /// bound when its multiplier has the side's sign and exceeds its slack.
 pub(super) fn guess(p: &QpData, mult: &Mult) -> WorkingSet {
+    let mut w = WorkingSet {
+        rows: Vec::new(),
+        vars: Vec::new(),
+    };
+    guess_into(p, mult, &mut w);
+    w
+}
+
+/// [`guess`] into `w` (resized; no allocation once its vectors have grown to the sizes).
+pub(super) fn guess_into(p: &QpData, mult: &Mult, w: &mut WorkingSet) {
     let (n, m) = (p.x.len(), p.g.len());
-    let rows = (0..m)
-        .map(|i| {
-            let l = mult.lambda[i];
-            if p.g_l[i] == p.g_u[i] {
-                Side::Both
-            } else if p.g_u[i].is_finite() && l > 0.0 && l > p.g_u[i] - p.g[i] {
-                Side::Upper
-            } else if p.g_l[i].is_finite() && l < 0.0 && -l > p.g[i] - p.g_l[i] {
-                Side::Lower
-            } else {
-                Side::Free
-            }
-        })
-        .collect();
-    let vars = (0..n)
-        .map(|j| {
-            let (zl, zu) = (mult.z_l[j], mult.z_u[j]);
-            if p.x_l[j] == p.x_u[j] {
-                Side::Both
-            } else if p.x_u[j].is_finite() && zu > 0.0 && zu > p.x_u[j] - p.x[j] {
-                Side::Upper
-            } else if p.x_l[j].is_finite() && zl > 0.0 && zl > p.x[j] - p.x_l[j] {
-                Side::Lower
-            } else {
-                Side::Free
-            }
-        })
-        .collect();
-    WorkingSet { rows, vars }
+    w.rows.clear();
+    w.rows.extend((0..m).map(|i| {
+        let l = mult.lambda[i];
+        if p.g_l[i] == p.g_u[i] {
+            Side::Both
+        } else if p.g_u[i].is_finite() && l > 0.0 && l > p.g_u[i] - p.g[i] {
+            Side::Upper
+        } else if p.g_l[i].is_finite() && l < 0.0 && -l > p.g[i] - p.g_l[i] {
+            Side::Lower
+        } else {
+            Side::Free
+        }
+    }));
+    w.vars.clear();
+    w.vars.extend((0..n).map(|j| {
+        let (zl, zu) = (mult.z_l[j], mult.z_u[j]);
+        if p.x_l[j] == p.x_u[j] {
+            Side::Both
+        } else if p.x_u[j].is_finite() && zu > 0.0 && zu > p.x_u[j] - p.x[j] {
+            Side::Upper
+        } else if p.x_l[j].is_finite() && zl > 0.0 && zl > p.x[j] - p.x_l[j] {
+            Side::Lower
+        } else {
+            Side::Free
+        }
+    }));
 }
 
 /// Whether `w` fits the problem of `p` (sizes, and fixed entries where `p` has them).
@@ -141,55 +147,117 @@ fn hash_of(w: &WorkingSet) -> u64 {
 pub(super) fn solve(
     kkt: &mut Kkt,
     p: &QpData,
-    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    pats: (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
     start: WorkingSet,
-    (max_iter, n_elastic): (usize, usize),
+    limits: (usize, usize),
     n_fact: &mut usize,
     factored: bool,
 ) -> Result<Solved, Failure> {
+    let mut w = start;
+    let mut res = QpResult::empty();
+    let mut scratch = Scratch::default();
+    let found = solve_in(
+        kkt,
+        p,
+        pats,
+        (&mut w, &mut res),
+        limits,
+        (n_fact, factored),
+        &mut scratch,
+    )?;
+    Ok(Solved {
+        res,
+        working_set: w,
+        iterations: found.iterations,
+    })
+}
+
+/// The work vectors of [`solve_in`], kept between QPs (no allocation once they have
+/// grown to the sizes and the most iterations seen).
+#[derive(Default)]
+pub(super) struct Scratch {
+    /// Hashes of the working sets met.
+    seen: Vec<u64>,
+    changes: Vec<Change>,
+    eq: EqScratch,
+    d: Vec<f64>,
+    lambda: Vec<f64>,
+    s: Vec<f64>,
+    jd: Vec<f64>,
+}
+
+/// What [`solve_in`] reports besides the result: the active-set iterations (=
+/// factorisations) and the largest |λ_i| of the rows: the solution is the elastic QP's
+/// (zero elastic variables) only for ρ ≥ this (see [`penalty_for`]).
+pub(super) struct Found {
+    pub iterations: usize,
+    pub max_multiplier: f64,
+}
+
+/// [`solve`] in place: the working set `w` is the start and ends as the solution's (on
+/// failure: the last one tried), the result is written into `res` (its vectors reused),
+/// the work vectors are `scratch`'s. `(n_fact, factored)` as in [`solve`].
+pub(super) fn solve_in(
+    kkt: &mut Kkt,
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    (w, res): (&mut WorkingSet, &mut QpResult),
+    (max_iter, n_elastic): (usize, usize),
+    (n_fact, factored): (&mut usize, bool),
+    scratch: &mut Scratch,
+) -> Result<Found, Failure> {
     let (n, m) = (p.x.len(), p.g.len());
-    if kkt.n() != n || kkt.m() != m || !fits(&start, p) {
+    if kkt.n() != n || kkt.m() != m || !fits(w, p) {
         return Err(Failure::Shape);
     }
-    let mut w = start;
+    let Scratch {
+        seen,
+        changes,
+        eq,
+        d,
+        lambda,
+        s,
+        jd,
+    } = scratch;
     // Hashes of the working sets met (a deterministic SipHash; two different sets with
     // the same hash would only end the method early, never change its result).
-    let mut seen: Vec<u64> = Vec::new();
-    let mut changes: Vec<Change> = Vec::new();
+    seen.clear();
+    changes.clear();
     // After a repeated working set, one change per iteration (the largest violation).
     let mut one_at_a_time = false;
     for iteration in 1..=max_iter {
-        let step = if factored && iteration == 1 {
-            solve_working_set(kkt, p, &w)
+        let solved = if factored && iteration == 1 {
+            solve_working_set_into(kkt, p, w, eq, (d, lambda))
         } else {
-            equality_qp_step(kkt, p, &w, n_fact)
+            equality_qp_step_into(kkt, p, w, n_fact, eq, (d, lambda))
         };
-        let (d, lambda) = step.ok_or(Failure::EqualityQp)?;
-        let s = stationarity(p, (jp, hp), &d, &lambda);
-        let jd = jac_times(p, jp, &d);
-        let step = Step {
-            d: &d,
-            lambda: &lambda,
-            s: &s,
-            jd: &jd,
-        };
-        sign_test(p, &w, &step, &mut changes);
+        if !solved {
+            return Err(Failure::EqualityQp);
+        }
+        stationarity_into(p, (jp, hp), d, lambda, s);
+        jac_times_into(p, jp, d, jd);
+        let step = Step { d, lambda, s, jd };
+        sign_test(p, w, &step, changes);
         if changes.is_empty() {
-            let solved = kkt_point(p, w, step, (iteration, n_elastic))?;
-            return Ok(solved);
+            let max_multiplier = kkt_point(p, w, step, n_elastic, res)?;
+            res.iterations = iteration as u32;
+            return Ok(Found {
+                iterations: iteration,
+                max_multiplier,
+            });
         }
         if one_at_a_time {
-            keep_largest(&mut changes);
+            keep_largest(changes);
         }
-        seen.push(hash_of(&w));
-        for &(k, side, _) in &changes {
+        seen.push(hash_of(w));
+        for &(k, side, _) in changes.iter() {
             if k < m {
                 w.rows[k] = side;
             } else {
                 w.vars[k - m] = side;
             }
         }
-        if seen.contains(&hash_of(&w)) {
+        if seen.contains(&hash_of(w)) {
             if one_at_a_time {
                 return Err(Failure::Cycle);
             }
@@ -271,16 +339,18 @@ fn keep_largest(changes: &mut Vec<Change>) {
     changes.truncate(1);
 }
 
-/// The QP's solution from the step of W that passed the sign test, if the equality QP
-/// was solved accurately (free variables stationary, the rows of W met);
-/// `Err(EqualityQp)` otherwise. `iteration`: the active-set iterations so far;
-/// `n_elastic`: the length of the (zero) elastic part.
+/// The QP's solution from the step of W that passed the sign test, written into `res`
+/// (status `Solved`; its `iterations` are left to the caller), if the equality QP was
+/// solved accurately (free variables stationary, the rows of W met): returns the largest
+/// |λ_i| of the rows; `Err(EqualityQp)` otherwise. `n_elastic`: the length of the (zero)
+/// elastic part.
 fn kkt_point(
     p: &QpData,
-    w: WorkingSet,
+    w: &WorkingSet,
     st: Step,
-    (iteration, n_elastic): (usize, usize),
-) -> Result<Solved, Failure> {
+    n_elastic: usize,
+    res: &mut QpResult,
+) -> Result<f64, Failure> {
     let (n, m) = (p.x.len(), p.g.len());
     let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let met = |i: usize| {
@@ -296,33 +366,26 @@ fn kkt_point(
     {
         return Err(Failure::EqualityQp);
     }
-    let z_w: Vec<f64> = (0..m).map(|i| p.row_weight[i] * st.jd[i]).collect();
-    let lambda_qp: Vec<f64> = (0..m).map(|i| st.lambda[i] - z_w[i]).collect();
-    let max_multiplier = lambda_qp.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let mut z_l = vec![0.0; n];
-    let mut z_u = vec![0.0; n];
+    res.d.clear();
+    res.d.extend_from_slice(st.d);
+    refill(&mut res.e, n_elastic, 0.0);
+    res.z_w.clear();
+    res.z_w.extend((0..m).map(|i| p.row_weight[i] * st.jd[i]));
+    res.lambda.clear();
+    res.lambda
+        .extend((0..m).map(|i| st.lambda[i] - p.row_weight[i] * st.jd[i]));
+    let max_multiplier = res.lambda.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    refill(&mut res.z_l, n, 0.0);
+    refill(&mut res.z_u, n, 0.0);
     for j in 0..n {
         if w.vars[j] != Side::Free {
-            z_l[j] = st.s[j].max(0.0);
-            z_u[j] = (-st.s[j]).max(0.0);
+            res.z_l[j] = st.s[j].max(0.0);
+            res.z_u[j] = (-st.s[j]).max(0.0);
         }
     }
-    Ok(Solved {
-        res: QpResult {
-            d: st.d.to_vec(),
-            e: vec![0.0; n_elastic],
-            lambda: lambda_qp,
-            z_l,
-            z_u,
-            z_cone: Vec::new(),
-            z_w,
-            status: clarabel::solver::SolverStatus::Solved,
-            iterations: iteration as u32,
-        },
-        working_set: w,
-        iterations: iteration,
-        max_multiplier,
-    })
+    res.z_cone.clear();
+    res.status = clarabel::solver::SolverStatus::Solved;
+    Ok(max_multiplier)
 }
 
 #[cfg(test)]

@@ -4,7 +4,58 @@
 use super::geometry::Geometry;
 use super::iterate::Mult;
 use super::options::SqpOptions;
+use super::shape::Shape;
+use crate::frontend::scaled::refill;
 use crate::kkt::Kkt;
+
+/// The Hessian term B of the QP and how it was convexified.
+pub(super) struct Curvature {
+    /// Lower-triangular ∇²L values.
+    pub hv: Vec<f64>,
+    /// Dense B, column-major (BFGS only; empty otherwise).
+    pub bfgs: Vec<f64>,
+    /// ρ_a on the active rows, 0 elsewhere.
+    pub row_weight: Vec<f64>,
+    /// ρ_a on the active bounds, 0 elsewhere.
+    pub bound_weight: Vec<f64>,
+    pub rho_a_last: f64,
+    pub delta_last: f64,
+    /// Proximal shift added after rejected or heavily cut steps.
+    pub extra_shift: f64,
+}
+
+impl Curvature {
+    /// No curvature yet: B = I for BFGS, no weights, no shifts.
+    pub(super) fn new(shape: &Shape) -> Curvature {
+        let mut c = Curvature {
+            hv: Vec::new(),
+            bfgs: Vec::new(),
+            row_weight: Vec::new(),
+            bound_weight: Vec::new(),
+            rho_a_last: 0.0,
+            delta_last: 0.0,
+            extra_shift: 0.0,
+        };
+        c.reset(shape);
+        c
+    }
+
+    /// Back to [`Curvature::new`]'s state for `shape`, in these vectors.
+    pub(super) fn reset(&mut self, shape: &Shape) {
+        let n = shape.n;
+        refill(&mut self.hv, shape.hp.row_idx().len(), 0.0);
+        self.bfgs.clear();
+        if shape.dense {
+            self.bfgs
+                .extend((0..n * n).map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 }));
+        }
+        refill(&mut self.row_weight, shape.m, 0.0);
+        refill(&mut self.bound_weight, n, 0.0);
+        self.rho_a_last = 0.0;
+        self.delta_last = 0.0;
+        self.extra_shift = 0.0;
+    }
+}
 
 /// Which rows of g and which variable bounds count as active for the
 /// augmented-Lagrangian convexification: equality rows, and inequality rows and bounds
@@ -21,25 +72,42 @@ pub(super) fn active_sets(
     g: &[f64],
     mult: &Mult,
 ) -> (Vec<bool>, Vec<bool>) {
+    let mut active = (Vec::new(), Vec::new());
+    active_sets_into(geo, x, g, mult, &mut active);
+    active
+}
+
+/// [`active_sets`] into `(rows, bounds)` (resized; no allocation once grown to m and n).
+pub(super) fn active_sets_into(
+    geo: &Geometry,
+    x: &[f64],
+    g: &[f64],
+    mult: &Mult,
+    (rows, bounds): &mut (Vec<bool>, Vec<bool>),
+) {
     const TOL: f64 = 1e-6;
     // "Nearly at the bound": a multiplier left on a row the iterate has moved away from
     // (e.g. the share ρ_a·J_i d of the last step) must not keep the row active.
     let near = |a: f64, b: f64| (a - b).abs() <= 1e-3 * (1.0 + b.abs());
-    let rows = (0..g.len())
-        .map(|i| {
-            !geo.cone_row[i]
-                && (geo.g_l[i] == geo.g_u[i]
-                    || (geo.g_u[i].is_finite() && mult.lambda[i] > TOL && near(g[i], geo.g_u[i]))
-                    || (geo.g_l[i].is_finite() && mult.lambda[i] < -TOL && near(g[i], geo.g_l[i])))
-        })
-        .collect();
-    let bounds = (0..x.len())
-        .map(|j| {
-            (geo.x_l[j].is_finite() && mult.z_l[j] > TOL && near(x[j], geo.x_l[j]))
-                || (geo.x_u[j].is_finite() && mult.z_u[j] > TOL && near(x[j], geo.x_u[j]))
-        })
-        .collect();
-    (rows, bounds)
+    rows.clear();
+    rows.extend((0..g.len()).map(|i| {
+        !geo.cone_row[i]
+            && (geo.g_l[i] == geo.g_u[i]
+                || (geo.g_u[i].is_finite() && mult.lambda[i] > TOL && near(g[i], geo.g_u[i]))
+                || (geo.g_l[i].is_finite() && mult.lambda[i] < -TOL && near(g[i], geo.g_l[i])))
+    }));
+    bounds.clear();
+    bounds.extend((0..x.len()).map(|j| {
+        (geo.x_l[j].is_finite() && mult.z_l[j] > TOL && near(x[j], geo.x_l[j]))
+            || (geo.x_u[j].is_finite() && mult.z_u[j] > TOL && near(x[j], geo.x_u[j]))
+    }));
+}
+
+/// The diagonals of the inertia tests, kept between tests (no allocation once grown).
+#[derive(Default)]
+pub(super) struct ConvexifyScratch {
+    dx: Vec<f64>,
+    dc: Vec<f64>,
 }
 
 /// Finds B = H + δI + ρ_a·(J_Aᵀ J_A + I_bounds) positive definite, where A are the active
@@ -90,24 +158,29 @@ impl Convexify<'_> {
     /// Whether B = H + δI + ρ·(J_AᵀJ_A + I_b) is positive definite: the inertia of
     /// `[H + δI + ρ·I_b, J_Aᵀ; J_A, −I/ρ]` is (n, m) (inactive rows decoupled by a huge
     /// diagonal). Counts the factorisation in `n_fact`.
-    fn positive_definite(&mut self, delta: f64, rho: f64, n_fact: &mut usize) -> bool {
+    fn positive_definite(
+        &mut self,
+        delta: f64,
+        rho: f64,
+        n_fact: &mut usize,
+        scratch: &mut ConvexifyScratch,
+    ) -> bool {
         let (n, m) = (self.kkt.n(), self.kkt.m());
         *n_fact += 1;
         let active_b = self.active_b;
         let active_r = self.active_r;
-        let dx: Vec<f64> = (0..n)
-            .map(|j| delta + if active_b[j] { rho } else { 0.0 })
-            .collect();
-        let dc: Vec<f64> = (0..m)
-            .map(|i| {
-                if rho > 0.0 && active_r[i] {
-                    1.0 / rho
-                } else {
-                    1e20
-                }
-            })
-            .collect();
-        matches!(self.kkt.factorize(self.hv, &dx, self.jv, &dc),
+        let ConvexifyScratch { dx, dc } = scratch;
+        dx.clear();
+        dx.extend((0..n).map(|j| delta + if active_b[j] { rho } else { 0.0 }));
+        dc.clear();
+        dc.extend((0..m).map(|i| {
+            if rho > 0.0 && active_r[i] {
+                1.0 / rho
+            } else {
+                1e20
+            }
+        }));
+        matches!(self.kkt.factorize(self.hv, dx, self.jv, dc),
             Ok(i) if i.positive == n && i.negative == m)
     }
 
@@ -117,18 +190,31 @@ impl Convexify<'_> {
     /// into `delta_last` made one cut step damp the next iterations through the δ/3
     /// memory, see `SqpState::convexify`).
     pub fn run(
-        mut self,
+        self,
         o: &SqpOptions,
         delta_last: f64,
         rho_last: f64,
         n_fact: &mut usize,
     ) -> Option<(f64, f64)> {
-        if rho_last == 0.0 && self.positive_definite(0.0, 0.0, n_fact) {
+        let last = (delta_last, rho_last);
+        self.run_in(o, last, n_fact, &mut ConvexifyScratch::default())
+    }
+
+    /// [`Convexify::run`] with the diagonals of the tests in `scratch`'s vectors;
+    /// `(delta_last, rho_last)` as there.
+    pub fn run_in(
+        mut self,
+        o: &SqpOptions,
+        (delta_last, rho_last): (f64, f64),
+        n_fact: &mut usize,
+        sc: &mut ConvexifyScratch,
+    ) -> Option<(f64, f64)> {
+        if rho_last == 0.0 && self.positive_definite(0.0, 0.0, n_fact, sc) {
             return Some((0.0, 0.0));
         }
         let any_active = self.active_r.iter().chain(self.active_b).any(|&a| a);
         if !any_active {
-            let mut test = |d| self.positive_definite(d, 0.0, n_fact);
+            let mut test = |d| self.positive_definite(d, 0.0, n_fact, sc);
             return shift_search(o, delta_last, &mut test, true).map(|d| (d, 0.0));
         }
         // The cheapest guess first: the last iteration's weight (or a tenth of it).
@@ -137,7 +223,7 @@ impl Convexify<'_> {
         } else {
             1.0
         };
-        if self.positive_definite(0.0, rho0, n_fact) {
+        if self.positive_definite(0.0, rho0, n_fact, sc) {
             return Some((0.0, rho0));
         }
         // δ for the reduced Hessian: the test in the limit ρ_a = rho_max is IPOPT's
@@ -146,13 +232,13 @@ impl Convexify<'_> {
         // shift of the full-space Hessian (ρ_a = 0) would also pay for curvature across
         // the constraints, which the augmented term supplies for free.
         let rho_max = o.max_augmented_weight;
-        let mut test = |d| self.positive_definite(d, rho_max, n_fact);
+        let mut test = |d| self.positive_definite(d, rho_max, n_fact, sc);
         let delta = shift_search(o, delta_last, &mut test, true)?;
         // Then the smallest weight ρ_a (×10 from rho0) that makes B itself positive
         // definite; rho_max passed above.
         let mut rho = if delta == 0.0 { rho0 * 10.0 } else { rho0 };
         while rho < rho_max {
-            if self.positive_definite(delta, rho, n_fact) {
+            if self.positive_definite(delta, rho, n_fact, sc) {
                 return Some((delta, rho));
             }
             rho *= 10.0;

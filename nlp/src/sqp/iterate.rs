@@ -32,13 +32,19 @@ impl Mult {
     /// The QP's multipliers; with the augmented term ½ρ_a‖J_A d‖² the row multiplier is
     /// λ_i + ρ_a·J_i d (the dual of `J_i d − w_i = 0`), which tends to λ_i as d → 0.
     pub fn from_qp(r: &QpResult) -> Mult {
-        let lambda = r.lambda.iter().zip(&r.z_w).map(|(l, w)| l + w).collect();
-        Mult {
-            lambda,
-            z_l: r.z_l.clone(),
-            z_u: r.z_u.clone(),
-            z_cone: r.z_cone.clone(),
-        }
+        let mut mult = Mult::zeros(0, 0, 0);
+        mult.set_from_qp(r);
+        mult
+    }
+
+    /// [`Mult::from_qp`] into these vectors (no allocation once they have the sizes).
+    pub fn set_from_qp(&mut self, r: &QpResult) {
+        self.lambda.clear();
+        self.lambda
+            .extend(r.lambda.iter().zip(&r.z_w).map(|(l, w)| l + w));
+        self.z_l.clone_from(&r.z_l);
+        self.z_u.clone_from(&r.z_u);
+        self.z_cone.clone_from(&r.z_cone);
     }
 }
 
@@ -60,6 +66,15 @@ pub(super) struct Iterate {
     /// Whether `mult` are multipliers (a warm start's or a QP's) rather than the zeros
     /// of a cold start.
     pub have_mult: bool,
+}
+
+/// A trial point x + αd clamped to the bounds, evaluated (scaled).
+#[derive(Default)]
+pub(super) struct TrialPoint {
+    pub x: Vec<f64>,
+    pub f: f64,
+    pub g: Vec<f64>,
+    pub cone: Vec<f64>,
 }
 
 /// KKT errors of a (scaled) iterate.

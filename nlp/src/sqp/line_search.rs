@@ -9,16 +9,17 @@ use std::time::Instant;
 use clarabel::solver::SolverStatus;
 
 use super::bfgs::quad;
+use super::iterate::TrialPoint;
 use super::qp::QpResult;
 use super::state::{eval_g, SqpState};
+use super::workspace::ModelBuffers;
+use crate::frontend::scaled::refill;
 
-/// An accepted trial point, evaluated (scaled), with the QP result that led to it.
+/// An accepted trial point with the QP result that led to it when that is the
+/// second-order correction's (`None`: the step's own QP result).
 pub(super) struct Trial {
-    pub x: Vec<f64>,
-    pub f: f64,
-    pub g: Vec<f64>,
-    pub cone: Vec<f64>,
-    pub res: QpResult,
+    pub point: TrialPoint,
+    pub soc: Option<QpResult>,
 }
 
 /// Outcome of the line search.
@@ -38,13 +39,11 @@ pub(super) struct LineSearch {
     pub pred: f64,
 }
 
-/// The merit at the iterate and the QP model's linearisation of the step.
+/// The merit at the iterate and the QP model's decrease for the step (J d and J_cone d
+/// are left in the model buffers).
 struct Model {
     phi0: f64,
     pred: f64,
-    /// J d and J_cone d.
-    jd: Vec<f64>,
-    cd: Vec<f64>,
 }
 
 impl SqpState<'_> {
@@ -56,10 +55,11 @@ impl SqpState<'_> {
     /// step out. `first`: no multiplier history yet, start from the classical weights ρ.
     pub fn update_merit_weights(&mut self, res: &QpResult, first: bool) {
         let (o, rho) = (self.o, self.rho);
+        let merit_w = &mut self.steps.merit_w;
         if first {
-            self.merit_w.iter_mut().for_each(|w| *w = rho);
+            merit_w.iter_mut().for_each(|w| *w = rho);
         }
-        for (w, l) in self.merit_w.iter_mut().zip(&res.lambda) {
+        for (w, l) in merit_w.iter_mut().zip(&res.lambda) {
             *w = if o.individual_penalties {
                 let l = l.abs();
                 l.max(0.5 * (*w + l))
@@ -73,17 +73,24 @@ impl SqpState<'_> {
 
     /// The merit φ(x_k) and pred = m(0) − m(d) for the step `d` of the QP with shift
     /// `delta`.
-    fn model(&self, d: &[f64], delta: f64) -> Model {
+    fn model(&mut self, d: &[f64], delta: f64) -> Model {
         let (s, it, geo, curv) = (&self.shape, &self.it, &self.geo, &self.curv);
-        let (n, m, w, rho) = (s.n, s.m, &self.merit_w, self.rho);
+        let (n, m, w, rho) = (s.n, s.m, &self.steps.merit_w, self.rho);
+        let ModelBuffers {
+            jd,
+            cd,
+            lin_g,
+            lin_c,
+            ..
+        } = &mut self.steps.model;
         let phi0 = it.f + geo.penalty(&it.g, &it.cone, w, rho);
-        let mut jd = vec![0.0; m];
+        refill(jd, m, 0.0);
         for c in 0..n {
             for p in s.jp.col_range(c) {
                 jd[s.jp.row_idx()[p]] += it.jv[p] * d[c];
             }
         }
-        let mut cd = vec![0.0; s.n_cone];
+        refill(cd, s.n_cone, 0.0);
         if let Some(cp) = s.cp.as_ref() {
             for c in 0..n {
                 for p in cp.col_range(c) {
@@ -91,8 +98,10 @@ impl SqpState<'_> {
                 }
             }
         }
-        let lin_g: Vec<f64> = (0..m).map(|i| it.g[i] + jd[i]).collect();
-        let lin_c: Vec<f64> = (0..s.n_cone).map(|k| it.cone[k] + cd[k]).collect();
+        lin_g.clear();
+        lin_g.extend((0..m).map(|i| it.g[i] + jd[i]));
+        lin_c.clear();
+        lin_c.extend((0..s.n_cone).map(|k| it.cone[k] + cd[k]));
         let mut dbd = quad(&s.hp, &curv.hv, delta, s.dense.then_some(&curv.bfgs[..]), d);
         if !s.dense {
             dbd += (0..m)
@@ -104,21 +113,24 @@ impl SqpState<'_> {
         }
         let gd: f64 = it.grad.iter().zip(d).map(|(a, b)| a * b).sum();
         let pred = -(gd + 0.5 * dbd) + geo.penalty(&it.g, &it.cone, w, rho)
-            - geo.penalty(&lin_g, &lin_c, w, rho);
-        Model { phi0, pred, jd, cd }
+            - geo.penalty(lin_g, lin_c, w, rho);
+        Model { phi0, pred }
     }
 
-    /// The point x + step clamped to the bounds, evaluated; `None` when not finite.
-    fn evaluate(&mut self, step: &[f64], alpha: f64) -> (Vec<f64>, f64, Vec<f64>, Vec<f64>) {
+    /// A trial point not in use (its vectors are overwritten by [`SqpState::evaluate`]).
+    fn take_point(&mut self) -> TrialPoint {
+        self.steps.points.pop().unwrap_or_default()
+    }
+
+    /// The point x + α·step clamped to the bounds, evaluated into `pt`.
+    fn evaluate(&mut self, step: &[f64], alpha: f64, pt: &mut TrialPoint) {
         let (s, geo, x) = (&self.shape, &self.geo, &self.it.x);
-        let xt: Vec<f64> = (0..s.n)
-            .map(|j| (x[j] + alpha * step[j]).clamp(geo.x_l[j], geo.x_u[j]))
-            .collect();
-        let mut gt = vec![0.0; s.m];
-        let mut ct = vec![0.0; s.n_cone];
-        let ft = self.sc.f(&xt);
-        eval_g(&mut self.sc, &xt, &mut gt, &mut ct);
-        (xt, ft, gt, ct)
+        pt.x.clear();
+        pt.x.extend((0..s.n).map(|j| (x[j] + alpha * step[j]).clamp(geo.x_l[j], geo.x_u[j])));
+        refill(&mut pt.g, s.m, 0.0);
+        refill(&mut pt.cone, s.n_cone, 0.0);
+        pt.f = self.sc.f(&pt.x);
+        eval_g(&mut self.sc, &pt.x, &mut pt.g, &mut pt.cone);
     }
 
     /// The second-order correction after a rejected full step with constraint values
@@ -126,43 +138,61 @@ impl SqpState<'_> {
     /// Armijo's test with `bound`.
     fn second_order_correction(
         &mut self,
-        model: &Model,
-        gt: &[f64],
-        ct: &[f64],
+        full: &TrialPoint,
         bound: f64,
         delta: f64,
     ) -> Option<Trial> {
         let (m, n_cone) = (self.shape.m, self.shape.n_cone);
-        let gh: Vec<f64> = (0..m).map(|i| gt[i] - model.jd[i]).collect();
-        let chat: Vec<f64> = (0..n_cone).map(|k| ct[k] - model.cd[k]).collect();
-        let start = self.working_set.clone();
-        let r2 = match self.active_set_qp(Some(&gh), delta, start, false) {
-            Some(r) => r,
+        let mut mb = std::mem::take(&mut self.steps.model);
+        mb.gh.clear();
+        mb.gh.extend((0..m).map(|i| full.g[i] - mb.jd[i]));
+        mb.chat.clear();
+        mb.chat.extend((0..n_cone).map(|k| full.cone[k] - mb.cd[k]));
+        let r2 = self.correction_qp(&mb.gh, &mb.chat, delta);
+        self.steps.model = mb;
+        let r2 = r2?;
+        let mut pt = self.take_point();
+        self.evaluate(&r2.d, 1.0, &mut pt);
+        let phis = pt.f
+            + self
+                .geo
+                .penalty(&pt.g, &pt.cone, &self.steps.merit_w, self.rho);
+        if phis.is_finite() && phis <= bound {
+            Some(Trial {
+                point: pt,
+                soc: Some(r2),
+            })
+        } else {
+            self.steps.points.push(pt);
+            self.steps.results.push(r2);
+            None
+        }
+    }
+
+    /// The QP of the second-order correction (constraint constants `gh`, cone constants
+    /// `chat`): the active-set method from the step's working set, clarabel otherwise.
+    fn correction_qp(&mut self, gh: &[f64], chat: &[f64], delta: f64) -> Option<QpResult> {
+        let mut start = self.steps.spare_working_set.take();
+        if let (Some(w), Some(s)) = (self.steps.working_set.as_ref(), start.as_mut()) {
+            s.clone_from(w);
+        } else {
+            start = self.steps.working_set.clone();
+        }
+        match self.active_set_qp(Some(gh), delta, start, false) {
+            Some(r) => Some(r),
             None => {
                 let (geo, x) = (&self.geo, &self.it.x);
                 let t_qp = Instant::now();
                 let r2 = self
                     .qp
-                    .resolve_with_g(x, &geo.x_l, &geo.x_u, &gh, &geo.g_l, &geo.g_u, &chat);
+                    .resolve_with_g(x, &geo.x_l, &geo.x_u, gh, &geo.g_l, &geo.g_u, chat);
                 self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
                 self.work.n_qp += 1;
                 let r2 = r2.ok()?;
                 self.work.qp_iterations += r2.iterations as u64;
-                if !matches!(r2.status, SolverStatus::Solved | SolverStatus::AlmostSolved) {
-                    return None;
-                }
-                r2
+                matches!(r2.status, SolverStatus::Solved | SolverStatus::AlmostSolved).then_some(r2)
             }
-        };
-        let (xs, fs, gs, cs) = self.evaluate(&r2.d, 1.0);
-        let phis = fs + self.geo.penalty(&gs, &cs, &self.merit_w, self.rho);
-        (phis.is_finite() && phis <= bound).then_some(Trial {
-            x: xs,
-            f: fs,
-            g: gs,
-            cone: cs,
-            res: r2,
-        })
+        }
     }
 
     /// Backtracking line search on the merit along the QP step of `res` (shift `delta`).
@@ -170,7 +200,7 @@ impl SqpState<'_> {
         let o = self.o;
         let d = &res.d;
         let model = self.model(d, delta);
-        let (phi0, pred) = (model.phi0, model.pred);
+        let Model { phi0, pred } = model;
         let d_norm = d.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         // Rounding allowance of the merit: of f, and of every weighted row value (a row
         // at its bound shows violations at the rounding level of g_i, which the weights
@@ -178,7 +208,7 @@ impl SqpState<'_> {
         // benches/reference/results/performance-notebook.md, "SQP on the flagship").
         let g_noise: f64 = (0..self.shape.m)
             .filter(|&i| !self.geo.cone_row[i])
-            .map(|i| self.merit_w[i] * self.it.g[i].abs().max(1.0))
+            .map(|i| self.steps.merit_w[i] * self.it.g[i].abs().max(1.0))
             .sum();
         let slack = 10.0 * f64::EPSILON * (phi0.abs().max(1.0) + g_noise);
         let x_max = self.it.x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -193,28 +223,30 @@ impl SqpState<'_> {
             d_norm,
             pred,
         };
+        let mut pt = self.take_point();
         loop {
             out.ls += 1;
             let alpha = out.alpha;
-            let (xt, ft, gt, ct) = self.evaluate(d, alpha);
-            let finite = ft.is_finite()
-                && gt.iter().all(|v| v.is_finite())
-                && ct.iter().all(|v| v.is_finite());
+            self.evaluate(d, alpha, &mut pt);
+            let finite = pt.f.is_finite()
+                && pt.g.iter().all(|v| v.is_finite())
+                && pt.cone.iter().all(|v| v.is_finite());
             if finite {
-                let phi = ft + self.geo.penalty(&gt, &ct, &self.merit_w, self.rho);
+                let phi = pt.f
+                    + self
+                        .geo
+                        .penalty(&pt.g, &pt.cone, &self.steps.merit_w, self.rho);
                 if tiny || phi <= phi0 - o.armijo * alpha * pred.max(0.0) + slack {
                     out.trial = Some(Trial {
-                        x: xt,
-                        f: ft,
-                        g: gt,
-                        cone: ct,
-                        res: res.clone(),
+                        point: pt,
+                        soc: None,
                     });
                     return out;
                 }
                 if alpha == 1.0 && o.second_order_correction && pred > 0.0 {
                     let bound = phi0 - o.armijo * pred + slack;
-                    if let Some(t) = self.second_order_correction(&model, &gt, &ct, bound, delta) {
+                    if let Some(t) = self.second_order_correction(&pt, bound, delta) {
+                        self.steps.points.push(pt);
                         out.trial = Some(t);
                         out.soc_used = true;
                         return out;
@@ -223,6 +255,7 @@ impl SqpState<'_> {
             }
             out.alpha *= o.backtrack;
             if out.alpha < o.min_step {
+                self.steps.points.push(pt);
                 return out;
             }
         }

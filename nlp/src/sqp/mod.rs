@@ -70,7 +70,7 @@ use crate::callback::{IterationCallback, Observer};
 use crate::error::SolveError;
 use crate::frontend::solver::{impl_solver_options, solver_entry_points};
 use crate::frontend::user_solution::conclude;
-use crate::frontend::validate::validate;
+use crate::frontend::validate::validate_into;
 use crate::frontend::{Solver, Termination};
 use crate::numeric::NumericNlp;
 use crate::solution::{BackendColumns, IterationRecord, Solution};
@@ -103,7 +103,18 @@ impl Solver for Sqp {
         warm: Option<&Solution>,
         callback: Option<&mut IterationCallback<'_>>,
     ) -> Result<Solution, SolveError> {
-        self.run(nlp, warm, callback)
+        let mut sol = Solution::empty();
+        self.run_into(nlp, warm, callback, &mut sol)?;
+        Ok(sol)
+    }
+
+    fn solve_warm_into(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        previous: &Solution,
+        out: &mut Solution,
+    ) -> Result<(), SolveError> {
+        self.run_into(nlp, Some(previous), None, out)
     }
 }
 
@@ -114,6 +125,44 @@ impl Sqp {
             options,
             workspace: Workspace::default(),
         }
+    }
+
+    /// [`Sqp::solve_warm`] with the result written into `out` (for example the previous
+    /// step's solution in an MPC loop), reusing its vectors. A re-solve of a problem with
+    /// the same structure as this solver's previous solve (same patterns and bounds
+    /// structure, exact Hessian, no cones, no callback, `print_level` < 3) whose QPs the
+    /// active-set method solves allocates nothing once the kept vectors have grown to
+    /// the most iterations, active-set changes and QPs seen; a QP handed to clarabel
+    /// still allocates. The iterates are those of a fresh solver's `solve_warm`.
+    /// On error `out` is left unspecified.
+    /// ```
+    /// use nlp::{Problem, Relation, Sqp};
+    ///
+    /// let mut pb = Problem::new();
+    /// let x = pb.variable("x", 2).unwrap();
+    /// let p = pb.parameter("p", 1).unwrap();
+    /// pb.set_value(&p, &[0.0]).unwrap();
+    /// pb.minimize((x[0] - p[0]).sq() + (x[1] - 2.0).sq());
+    /// pb.subject_to((x[0] - x[1]).le(10.0)).unwrap();
+    /// let mut nlp = pb.compile().unwrap();
+    /// let sqp = Sqp::default();
+    /// let mut sol = sqp.solve(&mut nlp).unwrap();
+    /// let mut next = sol.clone();
+    /// for step in 0..3 {
+    ///     nlp.set_value("p", &[step as f64]).unwrap();
+    ///     sqp.solve_warm_into(&mut nlp, &sol, &mut next).unwrap();
+    ///     assert!(next.status.is_success());
+    ///     assert!((next.x[0] - step as f64).abs() < 1e-6);
+    ///     std::mem::swap(&mut sol, &mut next);
+    /// }
+    /// ```
+    pub fn solve_warm_into(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        previous: &Solution,
+        out: &mut Solution,
+    ) -> Result<(), SolveError> {
+        self.run_into(nlp, Some(previous), None, out)
     }
 }
 
@@ -126,19 +175,26 @@ solver_entry_points!(
 impl_solver_options!(SqpOptions => Sqp);
 
 impl Sqp {
-    fn run(
+    /// One solve in the kept workspace, written into `sol`.
+    fn run_into(
         &self,
         nlp: &mut dyn NumericNlp,
         warm: Option<&Solution>,
         callback: Option<&mut IterationCallback<'_>>,
-    ) -> Result<Solution, SolveError> {
+        sol: &mut Solution,
+    ) -> Result<(), SolveError> {
         let start = Instant::now();
         let o = &self.options;
         o.validate()?;
-        let v = validate(nlp, warm)?;
+        let mut kept = self.workspace.take();
+        if let Err(e) = validate_into(nlp, warm, &mut kept.bufs.validated) {
+            self.workspace.put(kept);
+            return Err(e);
+        }
         let (n, m) = (nlp.n(), nlp.m());
         let mut observer = callback.map(|cb| Observer::new(cb, n, m, None));
-        let mut s = SqpState::new(o, nlp, v, warm, &self.workspace);
+        let records = std::mem::take(&mut sol.stats.records);
+        let mut s = SqpState::new(o, nlp, warm, kept, records);
         let mut iter = 0usize;
         let stop = match s.setup_kkt() {
             Err(e) => Stop::from(e),
@@ -151,9 +207,9 @@ impl Sqp {
         s.stats.n_qp_solves = w.n_qp;
         s.stats.qp_iterations = w.qp_iterations as usize;
         s.stats.qp_seconds = w.qp_seconds;
-        let mut sol = s.user_solution(stop);
+        s.write_solution(stop, sol);
         conclude(
-            &mut sol,
+            sol,
             std::mem::take(&mut s.stats),
             &s.sc,
             start,
@@ -172,7 +228,7 @@ impl Sqp {
             );
         }
         s.keep_parts(&self.workspace);
-        Ok(sol)
+        Ok(())
     }
 }
 
@@ -223,12 +279,16 @@ fn iterate(
         };
         s.stats.max_regularization = s.stats.max_regularization.max(delta);
         let Some(trial) = ls.trial.take() else {
-            if let Some(stop) = s.reject(&ls, &res, delta) {
-                return stop;
+            let stop = s.reject(&ls, &res, delta);
+            s.steps.results.push(res);
+            match stop {
+                Some(stop) => return stop,
+                None => continue,
             }
-            continue;
         };
-        if let Err(e) = s.accept(trial, &ls) {
+        let accepted = s.accept(trial, &ls, &res);
+        s.steps.results.push(res);
+        if let Err(e) = accepted {
             return e.into();
         }
     }

@@ -23,6 +23,7 @@
 use faer::sparse::SymbolicSparseColMat;
 
 use super::qp::{QpData, QpResult};
+use crate::frontend::scaled::refill;
 use crate::kkt::Kkt;
 
 /// Side of a row or bound in the working set.
@@ -97,13 +98,34 @@ impl WorkingSet {
 
 /// J·v for the Jacobian values of `p`.
 pub(super) fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64]) -> Vec<f64> {
-    let mut jd = vec![0.0; p.g.len()];
+    let mut jd = Vec::new();
+    jac_times_into(p, jp, v, &mut jd);
+    jd
+}
+
+/// [`jac_times`] into `jd` (resized; no allocation once it has grown to m).
+pub(super) fn jac_times_into(
+    p: &QpData,
+    jp: &SymbolicSparseColMat<usize>,
+    v: &[f64],
+    jd: &mut Vec<f64>,
+) {
+    refill(jd, p.g.len(), 0.0);
     for c in 0..p.x.len() {
         for q in jp.col_range(c) {
             jd[jp.row_idx()[q]] += p.jac[q] * v[c];
         }
     }
-    jd
+}
+
+/// The work vectors of [`equality_qp_step`] (kept between QPs: no allocation once they
+/// have grown to the sizes): the KKT diagonals, the right-hand side and the shift.
+#[derive(Default)]
+pub(super) struct EqScratch {
+    dx: Vec<f64>,
+    dc: Vec<f64>,
+    rhs: Vec<f64>,
+    shift: Vec<f64>,
 }
 
 /// The equality QP on W: `[B, J_Wᵀ; J_W, 0]·(d, λ) = (−∇f, r_W)`, the bounds of W fixed by
@@ -113,7 +135,7 @@ pub(super) fn jac_times(p: &QpData, jp: &SymbolicSparseColMat<usize>, v: &[f64])
 /// w_i·J_i d, the term's gradient), a bound weight is added to the diagonal of B (rows
 /// and bounds of W need neither: the term is constant on W). `None` unless the inertia is
 /// (n, m) and the solve accurate. The two halves, [`factor_working_set`] and
-/// [`solve_working_set`], may run apart (the real-time iteration factorises before the
+/// [`solve_working_set_into`], may run apart (the real-time iteration factorises before the
 /// new initial state is known).
 pub(super) fn equality_qp_step(
     kkt: &mut Kkt,
@@ -121,10 +143,23 @@ pub(super) fn equality_qp_step(
     w: &WorkingSet,
     n_fact: &mut usize,
 ) -> Option<(Vec<f64>, Vec<f64>)> {
-    if !factor_working_set(kkt, p, w, n_fact) {
-        return None;
-    }
-    solve_working_set(kkt, p, w)
+    let (mut scratch, mut d, mut lambda) = (EqScratch::default(), Vec::new(), Vec::new());
+    equality_qp_step_into(kkt, p, w, n_fact, &mut scratch, (&mut d, &mut lambda))
+        .then_some((d, lambda))
+}
+
+/// [`equality_qp_step`] in `scratch`'s vectors, the step and multipliers written into
+/// `d` and `lambda` (resized); `false` where it gives `None`.
+pub(super) fn equality_qp_step_into(
+    kkt: &mut Kkt,
+    p: &QpData,
+    w: &WorkingSet,
+    n_fact: &mut usize,
+    scratch: &mut EqScratch,
+    out: (&mut Vec<f64>, &mut Vec<f64>),
+) -> bool {
+    factor_working_set_in(kkt, p, w, n_fact, scratch)
+        && solve_working_set_into(kkt, p, w, scratch, out)
 }
 
 /// Regularisation of the zero block of W's rows, removed again by iterative refinement.
@@ -144,41 +179,55 @@ pub(super) fn factor_working_set(
     w: &WorkingSet,
     n_fact: &mut usize,
 ) -> bool {
+    factor_working_set_in(kkt, p, w, n_fact, &mut EqScratch::default())
+}
+
+/// [`factor_working_set`] with the diagonals in `scratch`'s vectors.
+pub(super) fn factor_working_set_in(
+    kkt: &mut Kkt,
+    p: &QpData,
+    w: &WorkingSet,
+    n_fact: &mut usize,
+    scratch: &mut EqScratch,
+) -> bool {
     let (n, m) = (p.x.len(), p.g.len());
     let big = fixing_weight(p);
-    let dx: Vec<f64> = (0..n)
-        .map(|j| {
-            p.shift
-                + if w.vars[j] == Side::Free {
-                    p.bound_weight[j]
-                } else {
-                    big
-                }
-        })
-        .collect();
-    let dc: Vec<f64> = (0..m)
-        .map(|i| match (w.rows[i], p.row_weight[i]) {
-            (Side::Free, r) if r > 0.0 => 1.0 / r,
-            (Side::Free, _) => 1e20,
-            _ => ZERO_BLOCK_REG,
-        })
-        .collect();
+    let EqScratch { dx, dc, .. } = scratch;
+    dx.clear();
+    dx.extend((0..n).map(|j| {
+        p.shift
+            + if w.vars[j] == Side::Free {
+                p.bound_weight[j]
+            } else {
+                big
+            }
+    }));
+    dc.clear();
+    dc.extend((0..m).map(|i| match (w.rows[i], p.row_weight[i]) {
+        (Side::Free, r) if r > 0.0 => 1.0 / r,
+        (Side::Free, _) => 1e20,
+        _ => ZERO_BLOCK_REG,
+    }));
     *n_fact += 1;
-    matches!(kkt.factorize(p.hess, &dx, p.jac, &dc),
+    matches!(kkt.factorize(p.hess, dx, p.jac, dc),
         Ok(inertia) if inertia.positive == n && inertia.negative == m)
 }
 
 /// Solves W's equality QP with the factorisation [`factor_working_set`] left in `kkt`
-/// for the same B, J, weights and W (the point and the constraint values may differ).
-/// `None` when the solve is inaccurate.
-pub(super) fn solve_working_set(
+/// for the same B, J, weights and W (the point and the constraint values may differ),
+/// in `scratch`'s vectors; the step and multipliers are written into `d` and `lambda`
+/// (resized). `false` when the solve is inaccurate.
+pub(super) fn solve_working_set_into(
     kkt: &mut Kkt,
     p: &QpData,
     w: &WorkingSet,
-) -> Option<(Vec<f64>, Vec<f64>)> {
+    scratch: &mut EqScratch,
+    (d, lambda): (&mut Vec<f64>, &mut Vec<f64>),
+) -> bool {
     let (n, m) = (p.x.len(), p.g.len());
     let big = fixing_weight(p);
-    let mut rhs = vec![0.0; n + m];
+    let EqScratch { rhs, shift, .. } = scratch;
+    refill(rhs, n + m, 0.0);
     for j in 0..n {
         rhs[j] = -p.grad[j]
             + if w.vars[j] == Side::Free {
@@ -195,21 +244,22 @@ pub(super) fn solve_working_set(
         };
     }
     // Remove the regularisation of the W rows (solve with the exact zero block).
-    let shift: Vec<f64> = (0..n + m)
-        .map(|k| {
-            if k >= n && w.rows[k - n] != Side::Free {
-                ZERO_BLOCK_REG
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let ratio = kkt.solve_shifted(&mut rhs, Some(&shift)).ok()?;
-    if ratio > 1e-8 {
-        return None;
+    shift.clear();
+    shift.extend((0..n + m).map(|k| {
+        if k >= n && w.rows[k - n] != Side::Free {
+            ZERO_BLOCK_REG
+        } else {
+            0.0
+        }
+    }));
+    match kkt.solve_shifted(rhs, Some(shift)) {
+        Ok(ratio) if ratio <= 1e-8 => {}
+        _ => return false,
     }
-    let mut d = rhs[..n].to_vec();
-    let mut lambda = rhs[n..].to_vec();
+    d.clear();
+    d.extend_from_slice(&rhs[..n]);
+    lambda.clear();
+    lambda.extend_from_slice(&rhs[n..]);
     for j in 0..n {
         if w.vars[j] != Side::Free {
             d[j] = w.target(p, j);
@@ -220,19 +270,33 @@ pub(super) fn solve_working_set(
             lambda[i] = 0.0;
         }
     }
-    Some((d, lambda))
+    true
 }
 
 /// The QP's stationarity residual without bound multipliers, B d + ∇f + Jᵀλ (with the
 /// bound weights of B; `lambda` the rows' total multipliers, augmented term included).
 pub(super) fn stationarity(
     p: &QpData,
-    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    pats: (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
     d: &[f64],
     lambda: &[f64],
 ) -> Vec<f64> {
+    let mut s = Vec::new();
+    stationarity_into(p, pats, d, lambda, &mut s);
+    s
+}
+
+/// [`stationarity`] into `s` (resized; no allocation once it has grown to n).
+pub(super) fn stationarity_into(
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    d: &[f64],
+    lambda: &[f64],
+    s: &mut Vec<f64>,
+) {
     let n = p.x.len();
-    let mut s = p.grad.to_vec();
+    s.clear();
+    s.extend_from_slice(p.grad);
     for c in 0..n {
         s[c] += (p.shift + p.bound_weight[c]) * d[c];
         for q in hp.col_range(c) {
@@ -246,7 +310,6 @@ pub(super) fn stationarity(
             s[c] += p.jac[q] * lambda[jp.row_idx()[q]];
         }
     }
-    s
 }
 
 /// Bound multipliers from the QP's stationarity, z_l − z_u = B d + ∇f + Jᵀλ (with the

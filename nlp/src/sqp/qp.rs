@@ -114,6 +114,23 @@ pub(crate) struct QpResult {
     pub iterations: u32,
 }
 
+impl QpResult {
+    /// A result with empty vectors (to be written into, e.g. by the active-set method).
+    pub fn empty() -> QpResult {
+        QpResult {
+            d: Vec::new(),
+            e: Vec::new(),
+            lambda: Vec::new(),
+            z_l: Vec::new(),
+            z_u: Vec::new(),
+            z_cone: Vec::new(),
+            z_w: Vec::new(),
+            status: SolverStatus::Unsolved,
+            iterations: 0,
+        }
+    }
+}
+
 /// The QP of one problem structure, with its clarabel solver (set up on the first solve).
 pub(crate) struct Qp {
     n: usize,

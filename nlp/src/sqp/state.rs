@@ -8,40 +8,25 @@
 
 use std::time::Instant;
 
-use super::convexify::{active_sets, Convexify};
+pub(super) use super::convexify::Curvature;
+use super::convexify::{active_sets_into, Convexify};
 use super::geometry::Geometry;
 use super::iterate::{Iterate, Mult};
 use super::options::{HessianApproximation, SqpOptions};
-use super::polish::WorkingSet;
 use super::qp::{Qp, QpStructure};
 use super::shape::Shape;
 use super::stop::{StepError, Stop};
-use super::workspace::{Structure, Workspace};
+use super::workspace::{Kept, StepBuffers, Structure, Workspace};
 use crate::callback::Observer;
-use crate::frontend::scaled::ScaledNlp;
-use crate::frontend::user_solution::{user_solution, ConeDuals, UserPoint};
+use crate::frontend::scaled::{refill, NormScratch, ScaledNlp};
+use crate::frontend::user_solution::{user_solution_into, ConeDuals};
 use crate::frontend::validate::Validated;
 use crate::frontend::{KktResiduals, Termination};
+use crate::ipm::reduced::same_pattern;
 use crate::kkt::Kkt;
 use crate::numeric::NumericNlp;
 use crate::scaling::gradient_scale;
 use crate::solution::{BackendColumns, IterationRecord, Solution, Stats, Status};
-
-/// The Hessian term B of the QP and how it was convexified.
-pub(super) struct Curvature {
-    /// Lower-triangular ∇²L values.
-    pub hv: Vec<f64>,
-    /// Dense B, column-major (BFGS only; empty otherwise).
-    pub bfgs: Vec<f64>,
-    /// ρ_a on the active rows, 0 elsewhere.
-    pub row_weight: Vec<f64>,
-    /// ρ_a on the active bounds, 0 elsewhere.
-    pub bound_weight: Vec<f64>,
-    pub rho_a_last: f64,
-    pub delta_last: f64,
-    /// Proximal shift added after rejected or heavily cut steps.
-    pub extra_shift: f64,
-}
 
 /// Work counters for `Stats`.
 #[derive(Default)]
@@ -78,19 +63,19 @@ pub(super) struct SqpState<'a> {
     pub spare_qp: Option<Qp>,
     /// The structure the kept parts of the workspace were built for (handed back to it).
     pub kept_structure: Option<Structure>,
-    /// The working set of the last QP the active-set method solved (its warm start).
-    pub working_set: Option<WorkingSet>,
     /// ℓ1 penalty ρ.
     pub rho: f64,
-    /// Merit weights w_i.
-    pub merit_w: Vec<f64>,
+    /// The vectors of the steps: merit weights, the working set of the last QP the
+    /// active-set method solved (its warm start), QP results and trial points.
+    pub steps: StepBuffers,
+    /// What the solver keeps between solves (the buffers not in use during the solve).
+    kept: Box<Kept>,
     pub work: Work,
     pub stats: Stats,
     /// The row of the iteration log being filled.
     pub record: IterationRecord,
     /// Consecutive rejected steps.
     pub ls_failures: usize,
-    lgrad: Vec<f64>,
 }
 
 /// Scaled g and the cone entries (when there are cones) at x, counted as one evaluation.
@@ -112,12 +97,18 @@ pub(super) fn eval_jac(sc: &mut ScaledNlp<'_>, x: &[f64], jv: &mut [f64], cv: &m
 /// Gradient-based scaling at the starting point x (IPOPT's rule, option
 /// `gradient_scaling`; rows replaced by cones stay unscaled), and the row bounds of `geo`
 /// scaled with it.
-fn scale(sc: &mut ScaledNlp<'_>, geo: &mut Geometry, x: &[f64], o: &SqpOptions) {
+fn scale(
+    sc: &mut ScaledNlp<'_>,
+    geo: &mut Geometry,
+    x: &[f64],
+    o: &SqpOptions,
+    norms: &mut NormScratch,
+) {
     let (max_gradient, min_value) = (o.nlp_scaling_max_gradient, o.nlp_scaling_min_value);
     if o.gradient_scaling {
-        let (gmax, rmax) = sc.unscaled_gradient_norms(x, None);
+        let gmax = sc.unscaled_gradient_norms_into(x, None, norms);
         sc.scaling.obj = gradient_scale(gmax, max_gradient, min_value);
-        for (i, r) in rmax.into_iter().enumerate() {
+        for (i, &r) in norms.rmax.iter().enumerate() {
             if !geo.cone_row[i] {
                 sc.scaling.rows[i] = gradient_scale(r, max_gradient, min_value);
             }
@@ -145,9 +136,38 @@ pub(super) fn new_qp(shape: &Shape, geo: &Geometry, o: &SqpOptions, aug: bool) -
 }
 
 /// The shape and the geometry (unscaled bounds, cones) of `nlp` with the validated
-/// bounds `v`.
-fn layout(nlp: &dyn NumericNlp, v: &Validated, o: &SqpOptions) -> (Shape, Geometry) {
+/// bounds `v`: in `kept`'s vectors when it has the same sizes and patterns (and neither
+/// has cones), new ones otherwise.
+fn layout(
+    nlp: &dyn NumericNlp,
+    v: &Validated,
+    o: &SqpOptions,
+    kept: Option<(Shape, Geometry)>,
+) -> (Shape, Geometry) {
     let (n, m) = (nlp.n(), nlp.m());
+    let dense = o.hessian_approximation == HessianApproximation::DampedBfgs;
+    let same = |s: &Shape| {
+        s.n == n
+            && s.m == m
+            && s.dense == dense
+            && s.n_cone == 0
+            && nlp.affine_cones().is_empty()
+            && nlp.cone_jac_sparsity().is_none()
+            && same_pattern(&s.jp, nlp.jac_g_sparsity())
+            && same_pattern(&s.hp, nlp.hess_l_sparsity())
+    };
+    if let Some((shape, mut geo)) = kept.filter(|(s, _)| same(s)) {
+        for (to, from) in [
+            (&mut geo.x_l, &v.x_l),
+            (&mut geo.x_u, &v.x_u),
+            (&mut geo.g_l, &v.g_l),
+            (&mut geo.g_u, &v.g_u),
+        ] {
+            to.clone_from(from);
+        }
+        refill(&mut geo.cone_row, m, false);
+        return (shape, geo);
+    }
     let cones = nlp.affine_cones().to_vec();
     let n_cone = cones.iter().map(|c| c.offset + c.dim).max().unwrap_or(0);
     let mut cone_row = vec![false; m];
@@ -162,7 +182,7 @@ fn layout(nlp: &dyn NumericNlp, v: &Validated, o: &SqpOptions) -> (Shape, Geomet
         hp: nlp.hess_l_sparsity().clone(),
         cp: nlp.cone_jac_sparsity().cloned(),
         block: cones.iter().map(|c| (c.offset, c.dim)).collect(),
-        dense: o.hessian_approximation == HessianApproximation::DampedBfgs,
+        dense,
     };
     let geo = Geometry {
         x_l: v.x_l.clone(),
@@ -175,25 +195,53 @@ fn layout(nlp: &dyn NumericNlp, v: &Validated, o: &SqpOptions) -> (Shape, Geomet
     (shape, geo)
 }
 
-/// The first iterate: the scaled problem evaluated at `x`, with the multipliers of
-/// `warm` (scaled) or zeros.
+/// The first iterate in `it` (whose `x` holds the starting point; the other vectors are
+/// resized): the scaled problem evaluated at x, with the multipliers of `warm`
+/// (scaled) or zeros. `unscaled`: ∇f and the Jacobian values the gradient scaling
+/// evaluated at x, scaled here instead of evaluated again (the same numbers).
 fn first_iterate(
     sc: &mut ScaledNlp<'_>,
     shape: &Shape,
-    x: Vec<f64>,
+    it: &mut Iterate,
     warm: Option<&Solution>,
-) -> Iterate {
+    unscaled: Option<&NormScratch>,
+) {
     let (n, m) = (shape.n, shape.m);
-    let mut grad = vec![0.0; n];
-    let mut jv = vec![0.0; shape.jp.row_idx().len()];
-    let mut cv = vec![0.0; shape.cp.as_ref().map_or(0, |p| p.row_idx().len())];
-    let mut g = vec![0.0; m];
-    let mut cone = vec![0.0; shape.n_cone];
-    let f = sc.f(&x);
-    eval_g(sc, &x, &mut g, &mut cone);
-    sc.grad(&x, &mut grad);
-    eval_jac(sc, &x, &mut jv, &mut cv);
-    let mut mult = Mult::zeros(n, m, shape.n_cone);
+    refill(&mut it.grad, n, 0.0);
+    refill(&mut it.jv, shape.jp.row_idx().len(), 0.0);
+    refill(
+        &mut it.cv,
+        shape.cp.as_ref().map_or(0, |p| p.row_idx().len()),
+        0.0,
+    );
+    refill(&mut it.g, m, 0.0);
+    refill(&mut it.cone, shape.n_cone, 0.0);
+    it.f = sc.f(&it.x);
+    eval_g(sc, &it.x, &mut it.g, &mut it.cone);
+    match unscaled.filter(|u| u.jv.len() == it.jv.len()) {
+        Some(u) => {
+            // As `ScaledNlp::grad` and `ScaledNlp::jac` scale them.
+            for (v, &w) in it.grad.iter_mut().zip(&u.grad) {
+                *v = w * sc.scaling.obj;
+            }
+            let rows = shape.jp.row_idx();
+            for ((v, &w), &r) in it.jv.iter_mut().zip(&u.jv).zip(rows) {
+                *v = w * sc.scaling.rows[r];
+            }
+            if !it.cv.is_empty() {
+                sc.cone_jac(&it.x, &mut it.cv);
+            }
+        }
+        None => {
+            sc.grad(&it.x, &mut it.grad);
+            eval_jac(sc, &it.x, &mut it.jv, &mut it.cv);
+        }
+    }
+    let mult = &mut it.mult;
+    refill(&mut mult.lambda, m, 0.0);
+    refill(&mut mult.z_l, n, 0.0);
+    refill(&mut mult.z_u, n, 0.0);
+    refill(&mut mult.z_cone, shape.n_cone, 0.0);
     if let Some(p) = warm {
         for i in 0..m {
             mult.lambda[i] = sc.scaling.lambda_from_user(i, p.lambda[i]);
@@ -203,89 +251,91 @@ fn first_iterate(
             mult.z_u[j] = sc.scaling.z_from_user(p.z_u[j]);
         }
     }
-    Iterate {
-        x,
-        f,
-        g,
-        cone,
-        grad,
-        jv,
-        cv,
-        mult,
-        have_mult: warm.is_some(),
-    }
+    it.have_mult = warm.is_some();
 }
 
-impl Curvature {
-    /// No curvature yet: B = I for BFGS, no weights, no shifts.
-    pub(super) fn new(shape: &Shape) -> Curvature {
-        let n = shape.n;
-        Curvature {
-            hv: vec![0.0; shape.hp.row_idx().len()],
-            bfgs: if shape.dense {
-                (0..n * n)
-                    .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
-                    .collect()
-            } else {
-                vec![]
-            },
-            row_weight: vec![0.0; shape.m],
-            bound_weight: vec![0.0; n],
-            rho_a_last: 0.0,
-            delta_last: 0.0,
-            extra_shift: 0.0,
-        }
+/// An iterate with empty vectors (to be filled by [`first_iterate`]).
+fn empty_iterate() -> Iterate {
+    Iterate {
+        x: Vec::new(),
+        f: 0.0,
+        g: Vec::new(),
+        cone: Vec::new(),
+        grad: Vec::new(),
+        jv: Vec::new(),
+        cv: Vec::new(),
+        mult: Mult::zeros(0, 0, 0),
+        have_mult: false,
     }
 }
 
 impl<'a> SqpState<'a> {
-    /// Lays out the solve (with the KKT matrix and QPs the workspace `ws` kept for this
+    /// Lays out the solve of `nlp` with the validated bounds and starting point in
+    /// `kept.bufs.validated` (with the KKT matrix, QPs and vectors `kept` has for this
     /// structure), scales the problem at the (clamped) starting point and evaluates it
-    /// there; `warm` supplies the first multipliers.
+    /// there; `warm` supplies the first multipliers, `records` the vector of the
+    /// iteration log (cleared).
     pub fn new(
         o: &'a SqpOptions,
         nlp: &'a mut dyn NumericNlp,
-        v: Validated,
         warm: Option<&Solution>,
-        ws: &Workspace,
+        mut kept: Box<Kept>,
+        mut records: Vec<IterationRecord>,
     ) -> Self {
-        let (shape, mut geo) = layout(nlp, &v, o);
-        let x: Vec<f64> = (0..shape.n)
-            .map(|j| v.x0[j].clamp(geo.x_l[j], geo.x_u[j]))
-            .collect();
-        let mut sc = ScaledNlp::new(nlp);
-        scale(&mut sc, &mut geo, &x, o);
+        let b = &mut kept.bufs;
+        let v = std::mem::take(&mut b.validated);
+        let (shape, mut geo) = layout(nlp, &v, o, b.layout.take());
+        let mut it = b.it.take().unwrap_or_else(empty_iterate);
+        it.x.clear();
+        it.x.extend((0..shape.n).map(|j| v.x0[j].clamp(geo.x_l[j], geo.x_u[j])));
+        let mut sc = ScaledNlp::with_buffers(nlp, std::mem::take(&mut b.scaled));
+        scale(&mut sc, &mut geo, &it.x, o, &mut b.norms);
+        records.clear();
         let stats = Stats {
             obj_scaling: sc.scaling.obj,
+            records,
             ..Stats::default()
         };
-        let it = first_iterate(&mut sc, &shape, x, warm);
+        let unscaled = o.gradient_scaling.then_some(&b.norms);
+        first_iterate(&mut sc, &shape, &mut it, warm, unscaled);
         let record = IterationRecord::starting_point(
             sc.scaling.objective_to_user(it.f),
             BackendColumns::Sqp {
                 augmented_weight: 0.0,
             },
         );
-        let kept = ws.take(&shape, &geo, (o.qp_tol, o.qp_max_iter));
-        let qp = kept.plain.unwrap_or_else(|| new_qp(&shape, &geo, o, false));
+        let mut curv = match b.curv.take() {
+            Some(c) => c,
+            None => Curvature::new(&shape),
+        };
+        curv.reset(&shape);
+        let mut steps = std::mem::take(&mut b.steps);
+        refill(&mut steps.merit_w, shape.m, 0.0);
+        refill(&mut steps.lgrad, shape.n, 0.0);
+        if let Some(w) = steps.working_set.take() {
+            steps.spare_working_set = Some(w);
+        }
+        let reused = kept.reuse(&shape, &geo, (o.qp_tol, o.qp_max_iter));
+        let qp = reused
+            .plain
+            .unwrap_or_else(|| new_qp(&shape, &geo, o, false));
         SqpState {
             o,
             sc,
             user: v,
             it,
-            curv: Curvature::new(&shape),
-            kkt: kept.kkt,
+            curv,
+            kkt: reused.kkt,
             qp,
-            spare_qp: kept.aug,
-            kept_structure: kept.structure,
-            working_set: None,
+            spare_qp: reused.aug,
+            kept_structure: reused.structure,
             rho: o.penalty_init,
-            merit_w: vec![0.0; shape.m],
+            steps,
+            kept,
             work: Work::default(),
             stats,
             record,
             ls_failures: 0,
-            lgrad: vec![0.0; shape.n],
             shape,
             geo,
         }
@@ -313,7 +363,7 @@ impl<'a> SqpState<'a> {
         let o = self.o;
         let err = self
             .it
-            .kkt_errors(o.s_max, &self.geo, &self.shape, &mut self.lgrad);
+            .kkt_errors(o.s_max, &self.geo, &self.shape, &mut self.steps.lgrad);
         let (it, sc) = (&self.it, &self.sc);
         self.record.iter = iter;
         self.record.objective = sc.scaling.objective_to_user(it.f);
@@ -369,20 +419,22 @@ impl<'a> SqpState<'a> {
             return Ok(0.0);
         }
         let (it, geo, curv) = (&self.it, &self.geo, &mut self.curv);
-        let lam: Vec<f64> = (0..self.shape.m)
-            .map(|i| {
-                if geo.cone_row[i] {
-                    0.0
-                } else {
-                    it.mult.lambda[i]
-                }
-            })
-            .collect();
-        self.sc.hess(&it.x, 1.0, &lam, &mut curv.hv);
+        let steps = &mut self.steps;
+        let lam = &mut steps.hess_lambda;
+        lam.clear();
+        lam.extend((0..self.shape.m).map(|i| {
+            if geo.cone_row[i] {
+                0.0
+            } else {
+                it.mult.lambda[i]
+            }
+        }));
+        self.sc.hess(&it.x, 1.0, lam, &mut curv.hv);
         if curv.hv.iter().any(|v| !v.is_finite()) {
             return Err(StepError::NonFiniteHessian);
         }
-        let (active_r, active_b) = active_sets(geo, &it.x, &it.g, &it.mult);
+        active_sets_into(geo, &it.x, &it.g, &it.mult, &mut steps.active);
+        let (active_r, active_b) = (&steps.active.0, &steps.active.1);
         let conv = Convexify {
             kkt: self
                 .kkt
@@ -390,16 +442,12 @@ impl<'a> SqpState<'a> {
                 .expect("the KKT matrix is set up before iterating"),
             hv: &curv.hv,
             jv: &it.jv,
-            active_r: &active_r,
-            active_b: &active_b,
+            active_r,
+            active_b,
         };
+        let last = (curv.delta_last, curv.rho_a_last);
         let (delta_inertia, rho_a) = conv
-            .run(
-                self.o,
-                curv.delta_last,
-                curv.rho_a_last,
-                &mut self.work.n_fact,
-            )
+            .run_in(self.o, last, &mut self.work.n_fact, &mut steps.convexify)
             .ok_or(StepError::NoConvexification)?;
         // The proximal shift of the step control on top of the inertia's (B stays
         // positive definite: adding δI to a positive definite B keeps it so). Only the
@@ -409,10 +457,10 @@ impl<'a> SqpState<'a> {
         // step control had released it, and the cart-pole swing-up of issue 19 crawled
         // through 324 iterations instead of 60.
         curv.rho_a_last = rho_a;
-        for (w, &a) in curv.row_weight.iter_mut().zip(&active_r) {
+        for (w, &a) in curv.row_weight.iter_mut().zip(active_r) {
             *w = if a { rho_a } else { 0.0 };
         }
-        for (w, &a) in curv.bound_weight.iter_mut().zip(&active_b) {
+        for (w, &a) in curv.bound_weight.iter_mut().zip(active_b) {
             *w = if a { rho_a } else { 0.0 };
         }
         if rho_a > 0.0 && !self.qp.has_aug() {
@@ -428,56 +476,59 @@ impl<'a> SqpState<'a> {
         Ok(delta_inertia.max(curv.extra_shift))
     }
 
-    /// Hands the KKT matrix and the QPs to the workspace for the next solve.
+    /// Hands the KKT matrix, the QPs and the vectors to the workspace for the next solve.
     pub fn keep_parts(self, ws: &Workspace) {
-        let (shape, geo) = (&self.shape, &self.geo);
-        ws.keep(
-            (shape, geo),
-            self.kept_structure,
-            self.kkt,
-            [Some(self.qp), self.spare_qp],
-        );
+        let SqpState {
+            sc,
+            user,
+            shape,
+            geo,
+            it,
+            curv,
+            kkt,
+            qp,
+            spare_qp,
+            kept_structure,
+            steps,
+            mut kept,
+            ..
+        } = self;
+        kept.keep((&shape, &geo), kept_structure, kkt, [Some(qp), spare_qp]);
+        let b = &mut kept.bufs;
+        b.validated = user;
+        b.scaled = sc.into_buffers();
+        b.layout = Some((shape, geo));
+        b.it = Some(it);
+        b.curv = Some(curv);
+        b.steps = steps;
+        ws.put(kept);
     }
 
-    /// The solution in the user's units at the iterate, ending with `stop`.
-    pub fn user_solution(&mut self, stop: Stop) -> Solution {
+    /// The solution in the user's units at the iterate, ending with `stop`, written into
+    /// `sol` (its vectors reused; the stats are left to the caller).
+    pub fn write_solution(&mut self, stop: Stop, sol: &mut Solution) {
         let (sc, it) = (&self.sc, &self.it);
-        let mut lambda = vec![0.0; self.shape.m];
-        sc.scaling.lambdas_to_user(&it.mult.lambda, &mut lambda);
-        let point = UserPoint {
-            x: it.x.clone(),
-            lambda,
-            z_l: it
-                .mult
-                .z_l
-                .iter()
-                .map(|&z| sc.scaling.z_to_user(z))
-                .collect(),
-            z_u: it
-                .mult
-                .z_u
-                .iter()
-                .map(|&z| sc.scaling.z_to_user(z))
-                .collect(),
-        };
-        let z_cone: Vec<f64> = it
-            .mult
-            .z_cone
-            .iter()
-            .map(|&z| sc.scaling.z_to_user(z))
-            .collect();
+        sol.x.clone_from(&it.x);
+        refill(&mut sol.lambda, self.shape.m, 0.0);
+        sc.scaling.lambdas_to_user(&it.mult.lambda, &mut sol.lambda);
+        sol.z_l.clear();
+        sol.z_l
+            .extend(it.mult.z_l.iter().map(|&z| sc.scaling.z_to_user(z)));
+        sol.z_u.clear();
+        sol.z_u
+            .extend(it.mult.z_u.iter().map(|&z| sc.scaling.z_to_user(z)));
+        let z_cone = &mut self.steps.z_cone_user;
+        z_cone.clear();
+        z_cone.extend(it.mult.z_cone.iter().map(|&z| sc.scaling.z_to_user(z)));
         let cones = ConeDuals {
             cones: &self.geo.cones,
             cone_row: &self.geo.cone_row,
-            z_cone: &z_cone,
+            z_cone,
         };
-        user_solution(
-            &mut self.sc,
-            &self.user,
-            point,
-            Some(cones),
-            stop.status,
-            stop.message,
-        )
+        sol.status = stop.status;
+        sol.message.clear();
+        sol.message.push_str(&stop.message);
+        let last = &mut self.kept.bufs.last;
+        user_solution_into(&mut self.sc, &self.user, sol, Some(cones), last);
     }
 }

@@ -42,6 +42,7 @@ impl SqpState<'_> {
     ) -> Option<QpResult> {
         let o = self.o;
         if !o.qp_active_set || self.shape.dense || self.shape.n_cone > 0 {
+            self.steps.spare_working_set = start.or(self.steps.spare_working_set.take());
             return None;
         }
         let mut data = qp_data(&self.it, &self.geo, &self.curv, false, delta, self.rho);
@@ -50,24 +51,39 @@ impl SqpState<'_> {
         }
         let data = &data;
         let kkt = self.kkt.as_mut()?;
-        let start = start
-            .filter(|w| active_set::fits(w, data))
-            .unwrap_or_else(|| active_set::guess(data, &self.it.mult));
+        let steps = &mut self.steps;
+        let mut w = match start.filter(|w| active_set::fits(w, data)) {
+            Some(w) => w,
+            None => {
+                let mut w = steps
+                    .spare_working_set
+                    .take()
+                    .unwrap_or_else(|| WorkingSet {
+                        rows: Vec::new(),
+                        vars: Vec::new(),
+                    });
+                active_set::guess_into(data, &self.it.mult, &mut w);
+                w
+            }
+        };
+        let mut res = steps.results.pop().unwrap_or_else(QpResult::empty);
         let t_qp = Instant::now();
-        let solved = active_set::solve(
+        let solved = active_set::solve_in(
             kkt,
             data,
             (&self.shape.jp, &self.shape.hp),
-            start,
+            (&mut w, &mut res),
             (o.qp_active_set_max_iter as usize, self.qp.n_elastic()),
-            &mut self.work.n_fact,
-            false,
+            (&mut self.work.n_fact, false),
+            &mut steps.active_set,
         );
         self.work.qp_seconds += t_qp.elapsed().as_secs_f64();
         let solved = match solved {
             Ok(s) => s,
             Err(f) => {
                 self.work.active_set_failures[f as usize] += 1;
+                steps.spare_working_set = Some(w);
+                steps.results.push(res);
                 return None;
             }
         };
@@ -81,6 +97,8 @@ impl SqpState<'_> {
         let limits = (o.penalty_increase, increases, o.penalty_max);
         let Some(rho) = active_set::penalty_for(solved.max_multiplier, self.rho, limits) else {
             self.work.active_set_failures[4] += 1;
+            steps.spare_working_set = Some(w);
+            steps.results.push(res);
             return None;
         };
         self.rho = rho;
@@ -88,8 +106,10 @@ impl SqpState<'_> {
         self.work.n_active_set += 1;
         self.work.qp_iterations += solved.iterations as u64;
         self.qp.load(data);
-        self.working_set = Some(solved.working_set);
-        Some(solved.res)
+        if let Some(old) = steps.working_set.replace(w) {
+            steps.spare_working_set = Some(old);
+        }
+        Some(res)
     }
 }
 
@@ -129,7 +149,7 @@ impl SqpState<'_> {
     pub fn subproblem(&mut self, delta: f64) -> Result<(QpResult, f64), StepError> {
         let o = self.o;
         let t_qp_loop = Instant::now();
-        let start = self.working_set.take();
+        let start = self.steps.working_set.take();
         if let Some(res) = self.active_set_qp(None, delta, start, true) {
             self.work.factor_seconds += t_qp_loop.elapsed().as_secs_f64();
             return Ok((res, delta));

@@ -1,8 +1,10 @@
 //! What an [`Sqp`](crate::Sqp) keeps between solves, as the IPM's workspace does: the KKT
 //! matrix of the active-set method and the convexity test (its pattern, AMD ordering and
 //! symbolic factorisation) and the layouts of the QP (with and without the augmented
-//! term), for the structure they were built for. A warm re-solve of a problem with the
-//! same structure then skips the symbolic analysis and the QP layout.
+//! term), for the structure they were built for, and the vectors every solve works in
+//! ([`Buffers`]). A warm re-solve of a problem with the same structure then skips the
+//! symbolic analysis and the QP layout, and allocates nothing (see
+//! [`Sqp::solve_warm_into`](crate::Sqp::solve_warm_into)).
 //!
 //! The [`Solver`](crate::Solver) trait takes `&self`, so the parts sit behind a mutex: a
 //! solve takes them and puts them back at the end; a solve that finds them taken (another
@@ -16,9 +18,16 @@ use std::sync::Mutex;
 
 use faer::sparse::SymbolicSparseColMat;
 
+use super::active_set::Scratch as ActiveSetScratch;
+use super::convexify::{ConvexifyScratch, Curvature};
 use super::geometry::Geometry;
-use super::qp::Qp;
+use super::iterate::{Iterate, TrialPoint};
+use super::polish::WorkingSet;
+use super::qp::{Qp, QpResult};
 use super::shape::Shape;
+use crate::frontend::scaled::{NormScratch, ScaledBuffers};
+use crate::frontend::user_solution::FinalScratch;
+use crate::frontend::validate::Validated;
 use crate::ipm::reduced::same_pattern;
 use crate::kkt::Kkt;
 
@@ -77,6 +86,67 @@ pub(super) struct Parts {
     aug: Option<Qp>,
 }
 
+/// Everything a solver keeps: the parts of one structure (if any) and the vectors every
+/// solve works in, whatever its structure (resized by the next solve; no allocation once
+/// they have grown to its sizes).
+#[derive(Default)]
+pub(super) struct Kept {
+    parts: Option<Parts>,
+    pub bufs: Buffers,
+}
+
+/// The vectors an SQP solve works in, kept between solves. Every value is written again
+/// before it is read, so a re-solve in them is bit-identical to a fresh solver's.
+#[derive(Default)]
+pub(super) struct Buffers {
+    pub validated: Validated,
+    pub scaled: ScaledBuffers,
+    pub norms: NormScratch,
+    pub last: FinalScratch,
+    /// The shape and geometry of the last solve (reused when the patterns are the same).
+    pub layout: Option<(Shape, Geometry)>,
+    pub it: Option<Iterate>,
+    pub curv: Option<Curvature>,
+    pub steps: StepBuffers,
+}
+
+/// The vectors of the steps of an iteration (see `SqpState`'s uses).
+#[derive(Default)]
+pub(super) struct StepBuffers {
+    /// Merit weights w_i.
+    pub merit_w: Vec<f64>,
+    /// ∇L scratch of the KKT error.
+    pub lgrad: Vec<f64>,
+    /// The multipliers ∇²L is evaluated with (cone rows zeroed).
+    pub hess_lambda: Vec<f64>,
+    /// The active rows and bounds of the convexification.
+    pub active: (Vec<bool>, Vec<bool>),
+    pub convexify: ConvexifyScratch,
+    pub active_set: ActiveSetScratch,
+    /// QP results not in use (their vectors are written into by the next QPs).
+    pub results: Vec<QpResult>,
+    /// The working set of the last QP, and one not in use.
+    pub working_set: Option<WorkingSet>,
+    pub spare_working_set: Option<WorkingSet>,
+    /// Trial points not in use.
+    pub points: Vec<TrialPoint>,
+    pub model: ModelBuffers,
+    /// The cone multipliers in the user's units.
+    pub z_cone_user: Vec<f64>,
+}
+
+/// The vectors of the line search's model and second-order correction, kept between
+/// iterations.
+#[derive(Default)]
+pub(super) struct ModelBuffers {
+    pub jd: Vec<f64>,
+    pub cd: Vec<f64>,
+    pub lin_g: Vec<f64>,
+    pub lin_c: Vec<f64>,
+    pub gh: Vec<f64>,
+    pub chat: Vec<f64>,
+}
+
 /// What a solve starts from: the kept KKT matrix and QPs of its structure, if any, and
 /// that structure (handed back to [`Workspace::keep`]).
 #[derive(Default)]
@@ -95,22 +165,37 @@ pub(super) fn keepable(shape: &Shape) -> bool {
 
 /// The kept parts of one solver (empty when cloned).
 #[derive(Default)]
-pub(crate) struct Workspace(Mutex<Option<Box<Parts>>>);
+pub(crate) struct Workspace(Mutex<Option<Box<Kept>>>);
 
 impl Workspace {
+    /// What this solver kept (new, empty buffers when nothing was kept or another thread
+    /// is solving with it).
+    pub(super) fn take(&self) -> Box<Kept> {
+        let kept = self.0.try_lock().ok().and_then(|mut g| g.take());
+        kept.unwrap_or_default()
+    }
+
+    /// Keeps `kept` for the next solve.
+    pub(super) fn put(&self, kept: Box<Kept>) {
+        if let Ok(mut guard) = self.0.try_lock() {
+            *guard = Some(kept);
+        }
+    }
+}
+
+impl Kept {
     /// The kept parts if they were built for the structure of `shape` and `geo` (reset
     /// to the state of new ones), nothing otherwise.
     /// `qp_limits`: the QP tolerance and iteration limit of this solve's options.
-    pub(super) fn take(&self, shape: &Shape, geo: &Geometry, qp_limits: (f64, u32)) -> Reused {
-        let parts = self.0.try_lock().ok().and_then(|mut g| g.take());
-        match parts {
+    pub(super) fn reuse(&mut self, shape: &Shape, geo: &Geometry, qp_limits: (f64, u32)) -> Reused {
+        match self.parts.take() {
             Some(p) if keepable(shape) && p.structure.is(shape, geo) => {
                 let Parts {
                     structure,
                     mut kkt,
                     mut plain,
                     mut aug,
-                } = *p;
+                } = p;
                 kkt.reset();
                 for qp in plain.iter_mut().chain(aug.iter_mut()) {
                     qp.reset(qp_limits.0, qp_limits.1);
@@ -128,9 +213,9 @@ impl Workspace {
 
     /// Keeps the KKT matrix and the QPs of a solve of `shape` and `geo` for the next
     /// solve (not for problems that cannot use them, [`keepable`]); `structure`: the one
-    /// [`Workspace::take`] returned, if any.
+    /// [`Kept::reuse`] returned, if any.
     pub(super) fn keep(
-        &self,
+        &mut self,
         (shape, geo): (&Shape, &Geometry),
         structure: Option<Structure>,
         kkt: Option<Kkt>,
@@ -149,14 +234,12 @@ impl Workspace {
                 plain = Some(qp);
             }
         }
-        if let Ok(mut guard) = self.0.try_lock() {
-            *guard = Some(Box::new(Parts {
-                structure,
-                kkt,
-                plain,
-                aug,
-            }));
-        }
+        self.parts = Some(Parts {
+            structure,
+            kkt,
+            plain,
+            aug,
+        });
     }
 }
 
