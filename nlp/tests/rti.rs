@@ -8,6 +8,10 @@ use nlp::mpc::{Mpc, MpcError};
 use nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Simulator, Transcription};
 use nlp::{Ipm, Relation, Rti, RtiError, Solution, SqpOptions, Status};
 use symx::Matrix;
+use testkit::alloc::ThreadCounting;
+
+#[global_allocator]
+static GLOBAL: ThreadCounting = ThreadCounting;
 
 const N: usize = 10;
 
@@ -306,3 +310,46 @@ fn feedback_inserts_a_parameter_that_enters_g_nonlinearly() {
         .unwrap()[0];
     assert!((rti.plan().x[x0] - 3.0).abs() < 1e-12);
 }
+
+/// Allocations of the two phases in the steady state of a pendulum loop (shift, prepare,
+/// feedback; counted on this thread). Not zero yet: the active-set QP's working set and
+/// result and the QP's multipliers (`Mult::from_qp`) are built per call in
+/// `sqp/active_set.rs`, `sqp/polish.rs` and `sqp/iterate.rs`, and the convexification's
+/// active sets in `sqp/convexify.rs` (the SQP's own allocation-free work will remove
+/// them); what `Rti` itself allocated (the model's J d) is gone. The bounds are the counts
+/// measured when this test was written: a change that allocates more fails here.
+#[test]
+fn steady_state_allocations_of_prepare_and_feedback() {
+    let (_, tr) = pendulum();
+    let mut rti = Rti::from_transcription(&tr, SqpOptions::default()).unwrap();
+    rti.initialize(&converged(&tr, &[1.0, 0.0])).unwrap();
+    let shift = tr.shift_plan().unwrap();
+    let u0 = tr
+        .problem()
+        .variable_indices(&tr.controls().column(0).unwrap())
+        .unwrap()[0];
+    let mut x: Vec<f64> = vec![1.0, 0.0];
+    let mut counts = Vec::new();
+    for _ in 0..12 {
+        let u = rti.plan().x[u0];
+        x = vec![x[0] + 0.15 * x[1], x[1] + 0.15 * (u - x[0].sin())];
+        rti.shift(&shift).unwrap();
+        let (prepared, n_prepare) = ThreadCounting::during(|| rti.prepare());
+        prepared.unwrap();
+        let (fb, n_feedback) = ThreadCounting::during(|| rti.feedback(&x));
+        assert_eq!(fb.unwrap().status, Status::RealTimeIterationTaken);
+        counts.push((n_prepare, n_feedback));
+    }
+    println!("allocations (prepare, feedback) per step: {counts:?}");
+    let steady = &counts[2..];
+    assert!(
+        steady
+            .iter()
+            .all(|&(p, f)| p <= PREPARE_ALLOCATIONS && f <= FEEDBACK_ALLOCATIONS),
+        "{counts:?}"
+    );
+}
+
+/// The most allocations of a steady-state preparation and feedback (see the test).
+const PREPARE_ALLOCATIONS: usize = 12;
+const FEEDBACK_ALLOCATIONS: usize = 14;

@@ -6,8 +6,10 @@
 //!   lower triangle, cone rows, bounds, starting point);
 //! - `scaled`: the user's problem scaled (`ScaledNlp`: s_f, s_g, evaluation counters
 //!   and timing, multipliers to and from the user's units);
-//! - `user_solution`: the returned `Solution`, evaluated in the user's units with its
-//!   KKT measures;
+//! - `point_values`: f, g, ∇f and J at the last point evaluated, so that no value is
+//!   evaluated twice at one point (the end of a solve reuses the final iterate's);
+//! - `user_solution`: the returned `Solution` in the user's units with its KKT
+//!   measures;
 //! - `termination`: the KKT error of an iterate (`KktResiduals`) and one
 //!   convergence test (`tol` and the `acceptable_*` options);
 //! - [`solver`]: the [`Solver`] trait both implement, through which drivers
@@ -15,6 +17,7 @@
 //!   the same for their options (set by name, common part, solver).
 
 pub mod common_options;
+pub(crate) mod point_values;
 pub(crate) mod scaled;
 pub mod solver;
 pub(crate) mod termination;

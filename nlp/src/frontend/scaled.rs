@@ -3,12 +3,16 @@
 //! counted and timed, and the conversions of multipliers between the scaled problem and
 //! the user's units.
 //!
-//! The factors are chosen by each back end from [`ScaledNlp::unscaled_gradient_norms`]
+//! f, g, ∇f and J are evaluated once per point ([`PointValues`]): asked for again at the
+//! same point, they are not evaluated (nor counted) again.
+//!
+//! The factors are chosen by each back end from [`ScaledNlp::unscaled_gradient_norms_into`]
 //! with the rules of `scaling.rs`; the IPM layers its removal of fixed variables and
 //! unbounded rows on top (`ipm/reduced.rs`).
 
 use std::time::Instant;
 
+use super::point_values::{PointValues, Value};
 use crate::numeric::NumericNlp;
 use crate::solution::Stats;
 
@@ -115,15 +119,12 @@ pub(crate) fn refill<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
 pub(crate) struct ScaledBuffers {
     rows: Vec<f64>,
     lam: Vec<f64>,
+    values: PointValues,
 }
 
-/// Scratch of [`ScaledNlp::unscaled_gradient_norms_into`]; `rmax` holds its result.
+/// The result of [`ScaledNlp::unscaled_gradient_norms_into`], kept between solves.
 #[derive(Default)]
 pub(crate) struct NormScratch {
-    /// The unscaled ∇f at the point (the SQP's first iterate reuses it).
-    pub grad: Vec<f64>,
-    /// The unscaled Jacobian values at the point (empty without rows).
-    pub jv: Vec<f64>,
     /// The unscaled max-norm of each row of the Jacobian over the kept columns.
     pub rmax: Vec<f64>,
 }
@@ -148,27 +149,35 @@ pub(crate) struct ScaledNlp<'a> {
     pub counters: EvalCounters,
     /// Scratch: the user's multipliers for the Hessian.
     lam: Vec<f64>,
+    /// The unscaled values at the last point evaluated.
+    values: PointValues,
 }
 
 impl<'a> ScaledNlp<'a> {
     /// The unscaled problem (all factors 1).
-    #[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
+    #[cfg(test)] // the back ends use the `_into` forms
     pub fn new(user: &'a mut dyn NumericNlp) -> Self {
         Self::with_buffers(user, ScaledBuffers::default())
     }
 
-    /// [`ScaledNlp::new`] in the vectors of `buffers` (kept from an earlier solve with
+    /// The unscaled problem (all factors 1) in the vectors of `buffers` (kept from an earlier solve with
     /// [`ScaledNlp::into_buffers`]; no allocation once they have grown to the sizes).
     pub fn with_buffers(user: &'a mut dyn NumericNlp, buffers: ScaledBuffers) -> Self {
-        let m = user.m();
-        let ScaledBuffers { mut rows, mut lam } = buffers;
+        let (n, m) = (user.n(), user.m());
+        let ScaledBuffers {
+            mut rows,
+            mut lam,
+            mut values,
+        } = buffers;
         refill(&mut rows, m, 1.0);
         refill(&mut lam, m, 0.0);
+        values.reset(n, m, user.jac_g_sparsity().row_idx().len());
         ScaledNlp {
             user,
             scaling: Scaling { obj: 1.0, rows },
             counters: EvalCounters::default(),
             lam,
+            values,
         }
     }
 
@@ -177,6 +186,7 @@ impl<'a> ScaledNlp<'a> {
         ScaledBuffers {
             rows: self.scaling.rows,
             lam: self.lam,
+            values: self.values,
         }
     }
 
@@ -191,45 +201,71 @@ impl<'a> ScaledNlp<'a> {
         self.user
     }
 
+    /// Makes `value` known at `x` ([`ScaledNlp::values`]): evaluated (unscaled, counted
+    /// and timed) unless it was evaluated at this point (same bits) already.
+    pub fn evaluate(&mut self, value: Value, x: &[f64]) {
+        if self.values.has(value, x) {
+            return;
+        }
+        let t = Instant::now();
+        let (u, c) = (&mut *self.user, &mut self.counters);
+        match value {
+            Value::F => {
+                let f = u.eval_f(x);
+                self.values.store_f(x, f);
+                c.f += 1;
+            }
+            Value::G => {
+                u.eval_g(x, self.values.store(value, x));
+                c.g += 1;
+            }
+            Value::Grad => {
+                u.eval_grad_f(x, self.values.store(value, x));
+                c.grad_f += 1;
+            }
+            Value::Jac => {
+                u.eval_jac_g(x, self.values.store(value, x));
+                c.jac_g += 1;
+            }
+        }
+        c.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// The unscaled values at the last point evaluated (those [`ScaledNlp::evaluate`]
+    /// made known at a point are there until another point is evaluated).
+    pub fn values(&self) -> &PointValues {
+        &self.values
+    }
+
     /// Scaled objective s_f·f(x).
     pub fn f(&mut self, x: &[f64]) -> f64 {
-        let t = Instant::now();
-        let v = self.user.eval_f(x) * self.scaling.obj;
-        self.counters.f += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
-        v
+        self.evaluate(Value::F, x);
+        self.values.f() * self.scaling.obj
     }
 
     /// Scaled gradient s_f·∇f(x).
     pub fn grad(&mut self, x: &[f64], out: &mut [f64]) {
-        let t = Instant::now();
-        self.user.eval_grad_f(x, out);
-        out.iter_mut().for_each(|v| *v *= self.scaling.obj);
-        self.counters.grad_f += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
+        self.evaluate(Value::Grad, x);
+        for (v, &u) in out.iter_mut().zip(self.values.grad()) {
+            *v = u * self.scaling.obj;
+        }
     }
 
     /// Scaled rows s_g,i·g_i(x).
     pub fn g(&mut self, x: &[f64], out: &mut [f64]) {
-        let t = Instant::now();
-        self.user.eval_g(x, out);
-        for (v, s) in out.iter_mut().zip(&self.scaling.rows) {
-            *v *= s;
+        self.evaluate(Value::G, x);
+        for ((v, &u), s) in out.iter_mut().zip(self.values.g()).zip(&self.scaling.rows) {
+            *v = u * s;
         }
-        self.counters.g += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
     }
 
     /// Scaled Jacobian values (row i times s_g,i), in the user's pattern order.
     pub fn jac(&mut self, x: &[f64], out: &mut [f64]) {
-        let t = Instant::now();
-        self.user.eval_jac_g(x, out);
+        self.evaluate(Value::Jac, x);
         let rows = self.user.jac_g_sparsity().row_idx();
-        for (v, &r) in out.iter_mut().zip(rows) {
-            *v *= self.scaling.rows[r];
+        for ((v, &u), &r) in out.iter_mut().zip(self.values.jac()).zip(rows) {
+            *v = u * self.scaling.rows[r];
         }
-        self.counters.jac_g += 1;
-        self.counters.seconds += t.elapsed().as_secs_f64();
     }
 
     /// Hessian of the scaled Lagrangian σ·f̃ + λ̃ᵀg̃ for multipliers λ̃ of the scaled rows
@@ -263,14 +299,14 @@ impl<'a> ScaledNlp<'a> {
     /// columns in `cols` (all when `None`) and of each row of the Jacobian over the same
     /// columns (the Jacobian is not evaluated when there are no rows). A row with a
     /// non-finite entry reports NaN (the gradient-based rule then leaves it unscaled).
-    #[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
+    #[cfg(test)] // the back ends use the `_into` forms
     pub fn unscaled_gradient_norms(&mut self, x: &[f64], cols: Option<&[bool]>) -> (f64, Vec<f64>) {
         let mut scratch = NormScratch::default();
         let gmax = self.unscaled_gradient_norms_into(x, cols, &mut scratch);
         (gmax, scratch.rmax)
     }
 
-    /// [`ScaledNlp::unscaled_gradient_norms`] in the vectors of `scratch` (no allocation
+    /// The norms the gradient-based scaling needs, in the vectors of `scratch` (no allocation
     /// once they have grown to the problem's sizes): returns max |∇f|, the row norms are
     /// left in `scratch.rmax`.
     pub fn unscaled_gradient_norms_into(
@@ -281,17 +317,12 @@ impl<'a> ScaledNlp<'a> {
     ) -> f64 {
         let (n, m) = (self.user.n(), self.user.m());
         let keep = |j: usize| cols.is_none_or(|c| c[j]);
-        let t = Instant::now();
-        let NormScratch { grad, jv, rmax } = scratch;
-        refill(grad, n, 0.0);
-        self.user.eval_grad_f(x, grad);
-        self.counters.grad_f += 1;
-        refill(jv, self.user.jac_g_sparsity().row_idx().len(), 0.0);
+        self.evaluate(Value::Grad, x);
         if m > 0 {
-            self.user.eval_jac_g(x, jv);
-            self.counters.jac_g += 1;
+            self.evaluate(Value::Jac, x);
         }
-        self.counters.seconds += t.elapsed().as_secs_f64();
+        let NormScratch { rmax } = scratch;
+        let (grad, jv) = (self.values.grad(), self.values.jac());
         let gmax = (0..n)
             .filter(|&j| keep(j))
             .map(|j| grad[j].abs())
@@ -390,8 +421,19 @@ mod tests {
         let mut hv = vec![0.0; sc.user().hess_l_sparsity().row_idx().len()];
         sc.hess(&x, 2.0, &[3.0, 7.0], &mut hv);
         assert_eq!(dense(sc.user(), &hv), [[6.0, 0.0], [6.0, 0.0]]);
+        // Everything at one point: ∇f and J evaluated once for the two norms and the
+        // scaled values (the Hessian is not cached).
         let c = &sc.counters;
-        assert_eq!((c.f, c.grad_f, c.g, c.jac_g, c.hess_l), (1, 3, 1, 3, 1));
+        assert_eq!((c.f, c.grad_f, c.g, c.jac_g, c.hess_l), (1, 1, 1, 1, 1));
+        sc.f(&[2.0, 4.0]);
+        sc.g(&x, &mut v);
+        assert_eq!(v, [12.0, 203.0 * 0.01]);
+        let c = &sc.counters;
+        assert_eq!(
+            (c.f, c.grad_f, c.g, c.jac_g),
+            (2, 1, 2, 1),
+            "another point between"
+        );
         // λ_user = λ̃·s_g/s_f and back; z_user = z/s_f and back.
         assert_eq!(sc.scaling.lambda_to_user(0, 3.0), 12.0);
         assert_eq!(sc.scaling.lambda_from_user(0, 12.0), 3.0);
@@ -410,7 +452,7 @@ mod tests {
         );
         let mut stats = Stats::default();
         sc.write_stats(&mut stats);
-        assert_eq!((stats.n_eval_jac_g, stats.obj_scaling), (3, 0.5));
+        assert_eq!((stats.n_eval_jac_g, stats.obj_scaling), (1, 0.5));
     }
 
     #[test]

@@ -1,18 +1,22 @@
-//! The [`Solution`] both back ends return: the final point evaluated once more in the
-//! user's units, with the multipliers already unscaled, and the KKT measures reported
-//! there (dual infeasibility, constraint violation, complementarity).
+//! The [`Solution`] both back ends return: the final point in the user's units, with the
+//! multipliers already unscaled, its f and g, and the KKT measures reported there (dual
+//! infeasibility, constraint violation, complementarity). f, g, ∇f and J are those the
+//! back end evaluated at that point (the [`ScaledNlp`]'s unscaled values); only what it
+//! did not evaluate there is evaluated (e.g. after the IPM's clamp to the original bounds
+//! moved the point, or when the SQP's last trial point was rejected).
 
 #![allow(clippy::needless_range_loop)]
 
 use std::time::Instant;
 
-use super::scaled::{refill, ScaledNlp};
+use super::point_values::Value;
+use super::scaled::ScaledNlp;
 use super::validate::Validated;
 use crate::numeric::AffineCone;
 use crate::solution::{Solution, Stats, Status};
 
 /// The final point and multipliers in the user's numbering and units.
-#[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
+#[cfg(test)] // the back ends use the `_into` forms
 pub(crate) struct UserPoint {
     pub x: Vec<f64>,
     pub lambda: Vec<f64>,
@@ -28,7 +32,7 @@ pub(crate) struct ConeDuals<'c> {
     pub z_cone: &'c [f64],
 }
 
-/// The end of every solve, after [`user_solution`]: the evaluation counters and times of
+/// The end of every solve, after [`user_solution_into`]: the evaluation counters and times of
 /// `sc` written into `stats` (whose back-end parts are filled), the total and other times
 /// from `start`, `stats` moved into `sol`, and at `print_level` ≥ 3 the summary and the
 /// solution's message printed.
@@ -57,13 +61,14 @@ fn viol(v: f64, lo: f64, hi: f64) -> f64 {
     (lo - v).max(v - hi).max(0.0)
 }
 
-/// Evaluates f, ∇f, g and J at `p.x` (counted in `sc`) and builds the solution:
+/// f, ∇f, g and J at `p.x` (those not evaluated there yet evaluated and counted in `sc`)
+/// and the solution built from them:
 /// dual infeasibility ‖∇f + Jᵀλ − J_coneᵀz_cone − z_L + z_U‖∞, the violation of bounds,
 /// rows and cones, and complementarity of the inequality rows and non-fixed bounds, all
 /// in the user's units. A fixed variable's bound multipliers absorb its gradient of the
 /// Lagrangian (only z_L − z_U is determined there). A cone's smooth row reports the
 /// cone's multiplier z_t. `stats` are left at their defaults.
-#[allow(dead_code)] // unused since the SQP writes into kept vectors (s14-sqp)
+#[cfg(test)] // the back ends use the `_into` forms
 pub(crate) fn user_solution(
     sc: &mut ScaledNlp<'_>,
     b: &Validated,
@@ -97,16 +102,14 @@ pub(crate) fn user_solution(
     sol
 }
 
-/// The vectors [`user_solution_into`] works in, kept between solves.
+/// The vector [`user_solution_into`] works in, kept between solves.
 #[derive(Default)]
 pub(crate) struct FinalScratch {
     /// The gradient of the Lagrangian.
     r: Vec<f64>,
-    /// The Jacobian's values.
-    jv: Vec<f64>,
 }
 
-/// [`user_solution`] in place: `sol.x`, `sol.lambda`, `sol.z_l` and `sol.z_u` hold the
+/// The solution at the final point, in place: `sol.x`, `sol.lambda`, `sol.z_l` and `sol.z_u` hold the
 /// point (user numbering and units); its values, measures and parameters are written
 /// into `sol` (status, message and stats are left as they are). Allocates nothing once
 /// `sol`'s and `scratch`'s vectors have the problem's sizes and without cones.
@@ -118,19 +121,21 @@ pub(crate) fn user_solution_into(
     scratch: &mut FinalScratch,
 ) {
     let (n, m) = (sol.x.len(), sol.lambda.len());
-    let FinalScratch { r, jv } = scratch;
+    let FinalScratch { r } = scratch;
     sol.parameters.clear();
     sol.parameters
         .extend_from_slice(sc.user().parameter_values());
-    let t = Instant::now();
-    let u = sc.user_mut();
-    sol.objective = u.eval_f(&sol.x);
-    refill(r, n, 0.0);
-    refill(&mut sol.g, m, 0.0);
-    refill(jv, u.jac_g_sparsity().row_idx().len(), 0.0);
-    u.eval_grad_f(&sol.x, r);
-    u.eval_g(&sol.x, &mut sol.g);
-    u.eval_jac_g(&sol.x, jv);
+    for value in [Value::F, Value::G, Value::Grad, Value::Jac] {
+        sc.evaluate(value, &sol.x);
+    }
+    let at = sc.values();
+    sol.objective = at.f();
+    sol.g.clear();
+    sol.g.extend_from_slice(at.g());
+    r.clear();
+    r.extend_from_slice(at.grad());
+    let jv = at.jac();
+    debug_assert_eq!((r.len(), sol.g.len()), (n, m));
     let is_cone_row = |i: usize| cones.as_ref().is_some_and(|c| c.cone_row[i]);
     // r = ∇f + Jᵀλ − J_coneᵀ z_cone
     let jp = sc.user().jac_g_sparsity();
@@ -146,11 +151,6 @@ pub(crate) fn user_solution_into(
     if let Some(cd) = &cones {
         constr_viol = cone_terms(sc, cd, &sol.x, r, &mut sol.lambda);
     }
-    sc.counters.f += 1;
-    sc.counters.grad_f += 1;
-    sc.counters.g += 1;
-    sc.counters.jac_g += 1;
-    sc.counters.seconds += t.elapsed().as_secs_f64();
     let mut dual_inf: f64 = 0.0;
     let mut compl: f64 = 0.0;
     let (x, z_l, z_u) = (&sol.x, &mut sol.z_l, &mut sol.z_u);
@@ -227,7 +227,8 @@ fn cone_terms(
 
 #[cfg(test)]
 mod tests {
-    use super::{user_solution, ScaledNlp, UserPoint};
+    use super::{user_solution, UserPoint};
+    use crate::frontend::scaled::ScaledNlp;
     use crate::frontend::validate::validate;
     use crate::solution::Status;
     use crate::{Problem, Relation};

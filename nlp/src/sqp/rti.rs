@@ -190,6 +190,8 @@ pub struct Rti {
     plan: Solution,
     residual: RtiResidual,
     lgrad: Vec<f64>,
+    /// Scratch: J d, for the QP model's prediction.
+    jd: Vec<f64>,
 }
 
 impl Rti {
@@ -269,6 +271,7 @@ impl Rti {
             plan,
             residual: RtiResidual::default(),
             lgrad: vec![0.0; n],
+            jd: vec![0.0; m],
         })
     }
 
@@ -560,12 +563,20 @@ impl Rti {
                 plan.g[shape.jp.row_idx()[p]] += it.jv[p] * res.d[c];
             }
         }
-        plan.objective = it.f + model_change(it, &self.curv, self.delta, shape, &res.d);
+        let change = model_change(it, &self.curv, self.delta, shape, &res.d, &mut self.jd);
+        plan.objective = it.f + change;
     }
 }
 
-/// ∇fᵀd + ½dᵀBd with B = H + δI + ρ_a·(J_AᵀJ_A + I_b).
-fn model_change(it: &Iterate, curv: &Curvature, delta: f64, shape: &Shape, d: &[f64]) -> f64 {
+/// ∇fᵀd + ½dᵀBd with B = H + δI + ρ_a·(J_AᵀJ_A + I_b); `jd` (m entries) is scratch.
+fn model_change(
+    it: &Iterate,
+    curv: &Curvature,
+    delta: f64,
+    shape: &Shape,
+    d: &[f64],
+    jd: &mut [f64],
+) -> f64 {
     let mut lin = 0.0;
     let mut quad = 0.0;
     for c in 0..shape.n {
@@ -577,13 +588,13 @@ fn model_change(it: &Iterate, curv: &Curvature, delta: f64, shape: &Shape, d: &[
             quad += if r == c { v } else { 2.0 * v };
         }
     }
-    let mut jd = vec![0.0; shape.m];
+    jd.iter_mut().for_each(|v| *v = 0.0);
     for c in 0..shape.n {
         for p in shape.jp.col_range(c) {
             jd[shape.jp.row_idx()[p]] += it.jv[p] * d[c];
         }
     }
-    for (w, v) in curv.row_weight.iter().zip(&jd) {
+    for (w, v) in curv.row_weight.iter().zip(jd.iter()) {
         quad += w * v * v;
     }
     lin + 0.5 * quad

@@ -197,14 +197,13 @@ fn layout(
 
 /// The first iterate in `it` (whose `x` holds the starting point; the other vectors are
 /// resized): the scaled problem evaluated at x, with the multipliers of `warm`
-/// (scaled) or zeros. `unscaled`: ∇f and the Jacobian values the gradient scaling
-/// evaluated at x, scaled here instead of evaluated again (the same numbers).
+/// (scaled) or zeros. ∇f and J at x come from the front end's cache when the gradient
+/// scaling evaluated them there (the same numbers, not evaluated again).
 fn first_iterate(
     sc: &mut ScaledNlp<'_>,
     shape: &Shape,
     it: &mut Iterate,
     warm: Option<&Solution>,
-    unscaled: Option<&NormScratch>,
 ) {
     let (n, m) = (shape.n, shape.m);
     refill(&mut it.grad, n, 0.0);
@@ -218,25 +217,8 @@ fn first_iterate(
     refill(&mut it.cone, shape.n_cone, 0.0);
     it.f = sc.f(&it.x);
     eval_g(sc, &it.x, &mut it.g, &mut it.cone);
-    match unscaled.filter(|u| u.jv.len() == it.jv.len()) {
-        Some(u) => {
-            // As `ScaledNlp::grad` and `ScaledNlp::jac` scale them.
-            for (v, &w) in it.grad.iter_mut().zip(&u.grad) {
-                *v = w * sc.scaling.obj;
-            }
-            let rows = shape.jp.row_idx();
-            for ((v, &w), &r) in it.jv.iter_mut().zip(&u.jv).zip(rows) {
-                *v = w * sc.scaling.rows[r];
-            }
-            if !it.cv.is_empty() {
-                sc.cone_jac(&it.x, &mut it.cv);
-            }
-        }
-        None => {
-            sc.grad(&it.x, &mut it.grad);
-            eval_jac(sc, &it.x, &mut it.jv, &mut it.cv);
-        }
-    }
+    sc.grad(&it.x, &mut it.grad);
+    eval_jac(sc, &it.x, &mut it.jv, &mut it.cv);
     let mult = &mut it.mult;
     refill(&mut mult.lambda, m, 0.0);
     refill(&mut mult.z_l, n, 0.0);
@@ -296,8 +278,7 @@ impl<'a> SqpState<'a> {
             records,
             ..Stats::default()
         };
-        let unscaled = o.gradient_scaling.then_some(&b.norms);
-        first_iterate(&mut sc, &shape, &mut it, warm, unscaled);
+        first_iterate(&mut sc, &shape, &mut it, warm);
         let record = IterationRecord::starting_point(
             sc.scaling.objective_to_user(it.f),
             BackendColumns::Sqp {
