@@ -285,8 +285,8 @@ impl Band {
     }
 
     /// The cheapest path from the start to the final counts with the values known now
-    /// (bounds for unsolved points): the point index at each stance.
-    fn shortest_path(&self) -> Option<Vec<usize>> {
+    /// (bounds for unsolved points): the point index at each stance, and the path's cost.
+    fn shortest_path(&self) -> Option<(Vec<usize>, f64)> {
         let n = self.points.len();
         let mut best: Vec<Vec<(f64, usize)>> = Vec::with_capacity(n);
         best.push(vec![(self.values[0][0].cost(), 0)]);
@@ -304,14 +304,15 @@ impl Band {
             best.push(layer);
         }
         // The path's own point is first: at the last stance it is the final counts.
-        if !best[n - 1][0].0.is_finite() {
+        let cost = best[n - 1][0].0;
+        if !cost.is_finite() {
             return None;
         }
         let mut at = vec![0; n];
         for k in (1..n).rev() {
             at[k - 1] = best[k][at[k]].1;
         }
-        Some(at)
+        Some((at, cost))
     }
 }
 
@@ -394,8 +395,17 @@ pub fn propose(
         .collect();
     let mut band = Band::new(s, plan, &path, &holds, &known);
     let mut evaluated = 0;
+    let cost = plan.cost(s);
+    // The least cost a proposal must beat to be returned.
+    let worth = cost - MIN_RELATIVE_GAIN * cost;
     let at = loop {
-        let at = band.shortest_path()?;
+        let (at, bound) = band.shortest_path()?;
+        // `bound` is a lower bound of the band's best path, and it only grows as points
+        // are solved (a solved point costs at least its bound): once it reaches `worth`,
+        // no path of the band can be returned and the round stops here.
+        if bound >= worth {
+            return None;
+        }
         let mut open = 0;
         for (k, &p) in at.iter().enumerate() {
             if let Value::Bound(_) = band.values[k][p] {
@@ -439,7 +449,6 @@ pub fn propose(
     if !within_com_travel(s, &new_plan) {
         return None;
     }
-    let cost = plan.cost(s);
     let gain = cost - new_plan.cost(s);
     if gain <= MIN_RELATIVE_GAIN * cost {
         return None;

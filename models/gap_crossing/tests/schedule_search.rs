@@ -266,3 +266,122 @@ fn stance_solves_take_the_users_back_end_and_options() {
     let mut capped = StanceSolver::with_settings(&s, &t, &none).unwrap();
     assert!(capped.solve(&s, &feet, &start).is_none());
 }
+
+/// A round that proposes nothing misses nothing: a round stops early when the lazy
+/// programme's lower bound shows that no path of the band can gain more than
+/// `MIN_RELATIVE_GAIN`, so after the rounds from the solved crawl gait (n_step 40, each
+/// proposal re-solved as the search does) the round that proposes nothing is compared
+/// with its band evaluated exhaustively here (every point off the path solved, an
+/// independent dynamic programme). Tolerance: the stance solves stop at the solver's
+/// tolerance, and a point solved from another start may differ by that (1e-6 of the
+/// plan's cost).
+#[test]
+fn a_round_without_proposal_misses_no_gain_of_its_band() {
+    let s = Scenario {
+        n_step: 40,
+        gait: Gait::Crawl,
+        ..Scenario::default()
+    };
+    let t = GapTerrain { gap: s.gap };
+    let settings = Settings::default();
+    let mut plan = solve::plan(&s, &settings).unwrap().file.plan();
+    let mut schedule = gait::crawl_schedule(s.n_step);
+    let mut solver = StanceSolver::new(&s, &t).unwrap();
+    let mut rounds = 0;
+    while let Some(p) = schedule_search::propose(&s, &mut solver, &plan, &schedule) {
+        rounds += 1;
+        assert!(rounds < 6, "the search goes on");
+        let warm = solve::plan_warm(&s, &t, &p.schedule, &p.plan, &settings, false).unwrap();
+        assert!(warm.phases[warm.chosen].status.is_success());
+        plan = warm.file.plan();
+        schedule = p.schedule;
+    }
+    assert!(
+        rounds >= 1,
+        "at least one improving round before the fruitless one"
+    );
+    let cost = plan.cost(&s);
+    let exhaustive = exhaustive_band_gain(&s, &mut solver, &plan, &schedule);
+    assert!(
+        exhaustive <= schedule_search::MIN_RELATIVE_GAIN * cost + 1e-6 * cost,
+        "no proposal after {rounds} rounds, but the band gains {exhaustive}"
+    );
+}
+
+/// The largest decrease of the plan's cost over the band of `schedule` (counts c(k) + δ,
+/// δ ∈ {−1, 0, 1}⁴, Σ δ = 0, points within `NULL_MOVE` of the path's own feet left out),
+/// every point solved.
+fn exhaustive_band_gain(
+    s: &Scenario,
+    solver: &mut StanceSolver,
+    plan: &Plan,
+    schedule: &[gap_crossing::scenario::Foot],
+) -> f64 {
+    let holds = schedule_search::footholds(plan, schedule);
+    let path = schedule_search::path_counts(schedule);
+    let feet_at = |c: &[usize; 4]| {
+        gap_crossing::scenario::Feet::from_array(std::array::from_fn(|i| holds[i][c[i]]))
+    };
+    let null2 = schedule_search::NULL_MOVE * schedule_search::NULL_MOVE;
+    let mut layers: Vec<Vec<([usize; 4], f64)>> =
+        vec![vec![(path[0], stance_cost(s, &plan.stances[0]))]];
+    for (k, base) in path.iter().enumerate().skip(1) {
+        let own = feet_at(base);
+        let mut layer = vec![(*base, stance_cost(s, &plan.stances[k]))];
+        for code in 0..81_i64 {
+            let d = [
+                code % 3 - 1,
+                code / 3 % 3 - 1,
+                code / 9 % 3 - 1,
+                code / 27 % 3 - 1,
+            ];
+            if d.iter().sum::<i64>() != 0 || d == [0; 4] {
+                continue;
+            }
+            let c: Vec<i64> = (0..4).map(|i| base[i] as i64 + d[i]).collect();
+            if (0..4).any(|i| c[i] < 0 || c[i] >= holds[i].len() as i64) {
+                continue;
+            }
+            let c: [usize; 4] = std::array::from_fn(|i| c[i] as usize);
+            let feet = feet_at(&c);
+            let same = gap_crossing::scenario::Foot::ALL
+                .iter()
+                .all(|&i| gap_crossing::scenario::dist2(feet.get(i), own.get(i)) < null2);
+            if same {
+                continue;
+            }
+            let value = if schedule_search::feet_distances_ok(s, &feet) {
+                solver
+                    .solve(s, &feet, &plan.stances[k])
+                    .map_or(f64::INFINITY, |(_, v)| v)
+            } else {
+                f64::INFINITY
+            };
+            layer.push((c, value));
+        }
+        layers.push(layer);
+    }
+    // Dynamic programme: best[p] = least cost of a path to point p.
+    let mut best: Vec<f64> = vec![layers[0][0].1];
+    for k in 1..layers.len() {
+        let next: Vec<f64> = layers[k]
+            .iter()
+            .map(|(c, v)| {
+                let from = layers[k - 1]
+                    .iter()
+                    .zip(&best)
+                    .filter(|((p, _), _)| {
+                        (0..4)
+                            .map(|i| c[i] as i64 - p[i] as i64)
+                            .all(|x| x == 0 || x == 1)
+                            && (0..4).filter(|&i| c[i] != p[i]).count() == 1
+                    })
+                    .map(|(_, b)| *b)
+                    .fold(f64::INFINITY, f64::min);
+                from + v
+            })
+            .collect();
+        best = next;
+    }
+    plan.cost(s) - best[0]
+}

@@ -13,7 +13,7 @@ use super::point_values::Value;
 use super::scaled::ScaledNlp;
 use super::validate::Validated;
 use crate::numeric::AffineCone;
-use crate::solution::{Solution, Stats, Status};
+use crate::solution::{Solution, Stats};
 
 /// The final point and multipliers in the user's numbering and units.
 #[cfg(test)] // the back ends use the `_into` forms
@@ -74,7 +74,7 @@ pub(crate) fn user_solution(
     b: &Validated,
     p: UserPoint,
     cones: Option<ConeDuals<'_>>,
-    status: Status,
+    status: crate::solution::Status,
     message: String,
 ) -> Solution {
     let UserPoint {
