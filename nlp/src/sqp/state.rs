@@ -199,12 +199,7 @@ fn layout(
 /// resized): the scaled problem evaluated at x, with the multipliers of `warm`
 /// (scaled) or zeros. ∇f and J at x come from the front end's cache when the gradient
 /// scaling evaluated them there (the same numbers, not evaluated again).
-fn first_iterate(
-    sc: &mut ScaledNlp<'_>,
-    shape: &Shape,
-    it: &mut Iterate,
-    warm: Option<&Solution>,
-) {
+fn first_iterate(sc: &mut ScaledNlp<'_>, shape: &Shape, it: &mut Iterate, warm: Option<&Solution>) {
     let (n, m) = (shape.n, shape.m);
     refill(&mut it.grad, n, 0.0);
     refill(&mut it.jv, shape.jp.row_idx().len(), 0.0);
