@@ -15,7 +15,7 @@ use symnlp_examples::mpc_cart_pole;
 use symnlp::nlp::mpc::Mpc;
 use symnlp::nlp::ocp::Transcription;
 use symnlp::nlp::{Compiled, Ipm, Solution};
-use testkit::alloc::Counting;
+use testkit::alloc::{check_warm_re_solves, Counting, ReSolveCount};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -70,7 +70,11 @@ fn main() {
             assert_identical(&sol, &a, step);
             let grown = sol.stats.iterations > most_iterations;
             most_iterations = most_iterations.max(sol.stats.iterations);
-            counts.push((n_kept, n_fresh, grown));
+            counts.push(ReSolveCount {
+                kept: n_kept,
+                fresh: n_fresh,
+                grew: grown,
+            });
         }
         assert!(sol.status.is_success(), "step {step}: {}", sol.status);
         let u: Vec<f64> = first_control(&tr, &sol);
@@ -80,32 +84,7 @@ fn main() {
     // earlier one allocates nothing; one that takes more may only grow the vectors
     // whose length follows the iteration count (iteration records, filter), and still
     // allocates less than a fresh solver.
-    let mut zero_steps = 0;
-    for (k, &(n_kept, n_fresh, grown)) in counts.iter().enumerate() {
-        let step = k + 1;
-        assert!(
-            n_kept < n_fresh,
-            "step {step}: {n_kept} allocations with the kept workspace, {n_fresh} without"
-        );
-        if step >= 2 && !grown {
-            assert_eq!(n_kept, 0, "step {step}: allocations in a warm re-solve");
-            zero_steps += 1;
-        }
-    }
-    assert!(
-        zero_steps >= STEPS / 2,
-        "only {zero_steps} steady-state re-solves"
-    );
-    let median = |mut v: Vec<usize>| {
-        v.sort_unstable();
-        v[v.len() / 2]
-    };
-    println!(
-        "ipm_warm_alloc: {STEPS} closed-loop steps bit-identical to a fresh solver's; \
-         allocations per warm re-solve (median): {} kept ({zero_steps} re-solves with 0), {} fresh",
-        median(counts.iter().map(|c| c.0).collect()),
-        median(counts.iter().map(|c| c.1).collect()),
-    );
+    check_warm_re_solves("ipm_warm_alloc", &counts);
     mpc_steps();
 }
 

@@ -9,7 +9,7 @@ use symnlp_examples::mpc_cart_pole;
 
 use symnlp::nlp::ocp::Transcription;
 use symnlp::nlp::{Compiled, Solution, Sqp};
-use testkit::alloc::Counting;
+use testkit::alloc::{check_warm_re_solves, Counting, ReSolveCount};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -75,38 +75,17 @@ fn main() {
             }
             // A QP handed to clarabel (counted in QP solves, not in active-set ones)
             // builds clarabel's solver: allowed to allocate.
-            counts.push((n_kept, n_fresh, grown));
+            counts.push(ReSolveCount {
+                kept: n_kept,
+                fresh: n_fresh,
+                grew: grown,
+            });
         }
         assert!(sol.status.is_success(), "step {step}: {}", sol.status);
         let u = first_control(&tr, &sol);
         x = plant.step(&x, &u, example.dt).expect("plant");
     }
-    let mut zero_steps = 0;
-    for (k, &(n_kept, n_fresh, grown)) in counts.iter().enumerate() {
-        let step = k + 1;
-        assert!(
-            n_kept < n_fresh,
-            "step {step}: {n_kept} allocations with the kept workspace, {n_fresh} without"
-        );
-        if step >= 2 && !grown {
-            assert_eq!(n_kept, 0, "step {step}: allocations in a warm re-solve");
-            zero_steps += 1;
-        }
-    }
-    assert!(
-        zero_steps >= STEPS / 2,
-        "only {zero_steps} steady-state re-solves: {counts:?}"
-    );
-    let median = |mut v: Vec<usize>| {
-        v.sort_unstable();
-        v[v.len() / 2]
-    };
-    println!(
-        "sqp_warm_alloc: {STEPS} closed-loop steps bit-identical to a fresh solver's; \
-         allocations per warm re-solve (median): {} kept ({zero_steps} re-solves with 0), {} fresh",
-        median(counts.iter().map(|c| c.0).collect()),
-        median(counts.iter().map(|c| c.1).collect()),
-    );
+    check_warm_re_solves("sqp_warm_alloc", &counts);
 }
 
 /// A warm re-solve by a new solver (a function of its own for callgrind's per-function

@@ -128,3 +128,56 @@ impl ThreadCounting {
         (out.expect("the span ran"), count)
     }
 }
+
+/// Allocations of one warm re-solve of a closed loop: with the solver's kept workspace,
+/// by a fresh solver doing the same re-solve, and whether the kept one did more work than
+/// any re-solve before it (so its vectors may grow).
+#[derive(Clone, Copy, Debug)]
+pub struct ReSolveCount {
+    /// Allocations with the kept workspace.
+    pub kept: usize,
+    /// Allocations of a fresh solver doing the same re-solve.
+    pub fresh: usize,
+    /// The kept solver did more work than in any earlier re-solve.
+    pub grew: bool,
+}
+
+/// Checks the allocation counts of a closed loop's warm re-solves (`counts[k]` is step
+/// k + 1): every re-solve allocates less with the kept workspace than a fresh solver;
+/// from the second re-solve on, one that did no more work than an earlier one allocates
+/// nothing; at least half of them are such steady-state re-solves (else the test would
+/// prove little). Prints a one-line summary under `label`; panics naming the step otherwise.
+pub fn check_warm_re_solves(label: &str, counts: &[ReSolveCount]) {
+    let mut zero_steps = 0;
+    for (k, c) in counts.iter().enumerate() {
+        let step = k + 1;
+        assert!(
+            c.kept < c.fresh,
+            "{label} step {step}: {} allocations with the kept workspace, {} without",
+            c.kept,
+            c.fresh
+        );
+        if step >= 2 && !c.grew {
+            assert_eq!(
+                c.kept, 0,
+                "{label} step {step}: allocations in a warm re-solve"
+            );
+            zero_steps += 1;
+        }
+    }
+    assert!(
+        zero_steps >= counts.len().div_ceil(2),
+        "{label}: only {zero_steps} steady-state re-solves: {counts:?}"
+    );
+    let median = |mut v: Vec<usize>| {
+        v.sort_unstable();
+        v[v.len() / 2]
+    };
+    println!(
+        "{label}: {} closed-loop steps bit-identical to a fresh solver's; allocations per \
+         warm re-solve (median): {} kept ({zero_steps} re-solves with 0), {} fresh",
+        counts.len(),
+        median(counts.iter().map(|c| c.kept).collect()),
+        median(counts.iter().map(|c| c.fresh).collect()),
+    );
+}
