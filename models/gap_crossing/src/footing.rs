@@ -331,15 +331,14 @@ pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
             .fold([p[0], p[0]], |a, k| {
                 [a[0].min(cells[k].box_.x[0]), a[1].max(cells[k].box_.x[1])]
             });
-        return Some(Uncrossable {
-            foot: i,
-            reach,
-            need_within: rho,
+        return Some(Uncrossable::for_foot(
+            s,
+            i,
             nearest,
             reachable_x,
-            shortest_exit: shortest_exit(&comps, cells, &standable, &reached),
-            unstandable: Some(cert),
-        });
+            shortest_exit(&comps, cells, &standable, &reached),
+            Some(cert),
+        ));
     }
     None
 }

@@ -84,6 +84,29 @@ pub struct Uncrossable {
     pub unstandable: Option<Unstandable>,
 }
 
+impl Uncrossable {
+    /// The certificate for `foot` of scenario `s`: the step reach and the goal radius are
+    /// `s`'s ([`goal_radius`]), the rest as found by the caller.
+    pub fn for_foot(
+        s: &Scenario,
+        foot: Foot,
+        nearest: f64,
+        reachable_x: [f64; 2],
+        shortest_exit: Option<f64>,
+        unstandable: Option<Unstandable>,
+    ) -> Uncrossable {
+        Uncrossable {
+            foot,
+            reach: s.step_radius_sq.sqrt(),
+            need_within: goal_radius(s),
+            nearest,
+            reachable_x,
+            shortest_exit,
+            unstandable,
+        }
+    }
+}
+
 impl fmt::Display for Uncrossable {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if let Some(u) = &self.unstandable {
@@ -279,15 +302,14 @@ pub fn uncrossable(s: &Scenario) -> Option<Uncrossable> {
             })
             .map(|(a, b)| step_distance(terrain, &regions[a], &regions[b]))
             .min_by(f64::total_cmp);
-        return Some(Uncrossable {
-            foot: i,
-            reach,
-            need_within: rho,
+        return Some(Uncrossable::for_foot(
+            s,
+            i,
             nearest,
             reachable_x,
             shortest_exit,
-            unstandable: None,
-        });
+            None,
+        ));
     }
     crate::footing::uncrossable(s)
 }
