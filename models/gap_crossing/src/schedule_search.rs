@@ -371,10 +371,11 @@ pub fn cost_lower_bound(s: &Scenario, feet: &Feet) -> f64 {
 /// by more than [`MIN_RELATIVE_GAIN`] of it.
 ///
 /// Solved lazily, exactly: the shortest path is computed with lower bounds for the
-/// points not solved yet ([`cost_lower_bound`]); the unsolved points on it are solved,
-/// and this repeats until the shortest path runs through solved points only. Its cost is
-/// then at most that of any other path (their unsolved points cost at least their
-/// bounds), so it is the best path of the band, found without solving most of it.
+/// points not solved yet ([`cost_lower_bound`]); the first unsolved point on it is
+/// solved (one stance problem per shortest path: the solve often moves the path off the
+/// others), and this repeats until the shortest path runs through solved points only.
+/// Its cost is then at most that of any other path (their unsolved points cost at least
+/// their bounds), so it is the best path of the band, found without solving most of it.
 pub fn propose(
     s: &Scenario,
     solver: &mut StanceSolver,
@@ -406,17 +407,21 @@ pub fn propose(
         if bound >= worth {
             return None;
         }
+        // The unsolved points on the path are solved in order, but at most one stance
+        // problem per shortest path (points whose feet are known cost nothing): each
+        // solve can move the path off the others (a lazy shortest path that evaluates
+        // one point at a time; same result, fewer solves).
         let mut open = 0;
         for (k, &p) in at.iter().enumerate() {
             if let Value::Bound(_) = band.values[k][p] {
                 open += 1;
                 let feet = feet_at(&holds, &band.points[k][p]);
                 let key = feet_key(&feet);
-                let solved = match known.get(&key) {
-                    Some(&(st, c)) => Some((st, c)),
+                let (solved, fresh) = match known.get(&key) {
+                    Some(&(st, c)) => (Some((st, c)), false),
                     None => {
                         evaluated += 1;
-                        solver.solve(s, &feet, &plan.stances[k])
+                        (solver.solve(s, &feet, &plan.stances[k]), true)
                     }
                 };
                 band.values[k][p] = match solved {
@@ -426,6 +431,9 @@ pub fn propose(
                     }
                     None => Value::Infeasible,
                 };
+                if fresh {
+                    break;
+                }
             }
         }
         if open == 0 {

@@ -308,6 +308,34 @@ fn a_round_without_proposal_misses_no_gain_of_its_band() {
     );
 }
 
+/// A proposal is the best path of its band: from the solved crawl gait (n_step 40), the
+/// first round's gain equals the band's best gain with every point solved (an
+/// independent dynamic programme), although the lazy programme solves one stance
+/// problem per shortest path and most points never. Tolerance: a point solved from
+/// another start may differ by the stance solves' tolerance (1e-6 of the plan's cost).
+#[test]
+fn a_proposal_is_the_best_path_of_its_band() {
+    let s = Scenario {
+        n_step: 40,
+        gait: Gait::Crawl,
+        ..Scenario::default()
+    };
+    let t = GapTerrain { gap: s.gap };
+    let plan = solve::plan(&s, &Settings::default()).unwrap().file.plan();
+    let schedule = gait::crawl_schedule(s.n_step);
+    let mut solver = StanceSolver::new(&s, &t).unwrap();
+    let p = schedule_search::propose(&s, &mut solver, &plan, &schedule)
+        .expect("the crawl schedule can be improved");
+    let cost = plan.cost(&s);
+    let exhaustive = exhaustive_band_gain(&s, &mut solver, &plan, &schedule);
+    assert!(
+        (p.gain - exhaustive).abs() <= 1e-6 * cost,
+        "proposal gains {} ({} stance solves), the exhaustive band {exhaustive}",
+        p.gain,
+        p.evaluated
+    );
+}
+
 /// The largest decrease of the plan's cost over the band of `schedule` (counts c(k) + δ,
 /// δ ∈ {−1, 0, 1}⁴, Σ δ = 0, points within `NULL_MOVE` of the path's own feet left out),
 /// every point solved.
