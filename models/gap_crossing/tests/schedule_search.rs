@@ -6,7 +6,7 @@
 use gap_crossing::check;
 use gap_crossing::gait;
 use gap_crossing::plan::{Plan, SolutionFile, SolverInfo};
-use gap_crossing::scenario::{Gait, Scenario};
+use gap_crossing::scenario::{Foot, Gait, Scenario};
 use gap_crossing::schedule_search::{self, stance_cost, StanceSolver};
 use gap_crossing::solve::{self, Settings};
 use gap_crossing::terrain::GapTerrain;
@@ -267,6 +267,21 @@ fn stance_solves_take_the_users_back_end_and_options() {
     assert!(capped.solve(&s, &feet, &start).is_none());
 }
 
+/// The crawl gait solved at n_step 40 on the default gap: the scenario, its terrain, the
+/// plan, its schedule and a stance solver.
+fn solved_crawl_40() -> (Scenario, GapTerrain, Plan, Vec<Foot>, StanceSolver) {
+    let s = Scenario {
+        n_step: 40,
+        gait: Gait::Crawl,
+        ..Scenario::default()
+    };
+    let t = GapTerrain { gap: s.gap };
+    let plan = solve::plan(&s, &Settings::default()).unwrap().file.plan();
+    let schedule = gait::crawl_schedule(s.n_step);
+    let solver = StanceSolver::new(&s, &t).unwrap();
+    (s, t, plan, schedule, solver)
+}
+
 /// A round that proposes nothing misses nothing: a round stops early when the lazy
 /// programme's lower bound shows that no path of the band can gain more than
 /// `MIN_RELATIVE_GAIN`, so after the rounds from the solved crawl gait (n_step 40, each
@@ -277,16 +292,8 @@ fn stance_solves_take_the_users_back_end_and_options() {
 /// plan's cost).
 #[test]
 fn a_round_without_proposal_misses_no_gain_of_its_band() {
-    let s = Scenario {
-        n_step: 40,
-        gait: Gait::Crawl,
-        ..Scenario::default()
-    };
-    let t = GapTerrain { gap: s.gap };
+    let (s, t, mut plan, mut schedule, mut solver) = solved_crawl_40();
     let settings = Settings::default();
-    let mut plan = solve::plan(&s, &settings).unwrap().file.plan();
-    let mut schedule = gait::crawl_schedule(s.n_step);
-    let mut solver = StanceSolver::new(&s, &t).unwrap();
     let mut rounds = 0;
     while let Some(p) = schedule_search::propose(&s, &mut solver, &plan, &schedule) {
         rounds += 1;
@@ -315,15 +322,7 @@ fn a_round_without_proposal_misses_no_gain_of_its_band() {
 /// another start may differ by the stance solves' tolerance (1e-6 of the plan's cost).
 #[test]
 fn a_proposal_is_the_best_path_of_its_band() {
-    let s = Scenario {
-        n_step: 40,
-        gait: Gait::Crawl,
-        ..Scenario::default()
-    };
-    let t = GapTerrain { gap: s.gap };
-    let plan = solve::plan(&s, &Settings::default()).unwrap().file.plan();
-    let schedule = gait::crawl_schedule(s.n_step);
-    let mut solver = StanceSolver::new(&s, &t).unwrap();
+    let (s, _, plan, schedule, mut solver) = solved_crawl_40();
     let p = schedule_search::propose(&s, &mut solver, &plan, &schedule)
         .expect("the crawl schedule can be improved");
     let cost = plan.cost(&s);
