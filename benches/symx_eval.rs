@@ -1004,7 +1004,12 @@ fn memory_run(mode: &str) {
 /// inside [`hot_loop`] and exits: run under `valgrind --tool=callgrind
 /// --collect-atstart=no --toggle-collect='*hot_loop*'`, the instructions counted divided by
 /// `calls` are the instructions per call (benches/reference/native_side_by_side.sh). It
-/// then prints the per-call median wall time of [`per_call`].
+/// then prints the per-call median wall time of [`per_call`]. With `SYMX_NATIVE_SAVE=DIR`
+/// it first saves the function's tape to `DIR/{problem}_{function}.json`
+/// (`Function::save`); with `SYMX_NATIVE_PAUSE=S` it prints `ready` and sleeps `S`
+/// seconds before the loop, so that a long JIT compilation can run under `valgrind
+/// --instr-atstart=no` and instrumentation be switched on (`callgrind_control -i on`)
+/// only then.
 fn profile_run(spec: &str) {
     let parts: Vec<&str> = spec.split(':').collect();
     let [problem, function, evaluator, calls] = parts[..] else {
@@ -1057,7 +1062,10 @@ fn profile_run(spec: &str) {
     let f = match evaluator {
         "tape" => f,
         "jit" => {
+            let t = Instant::now();
             native = f.jit().unwrap();
+            let (n, ms) = (f.instruction_count(), t.elapsed().as_secs_f64() * 1e3);
+            eprintln!("{problem} {function}: {n} instructions, jit compile {ms:.1} ms");
             &native
         }
         other => {
@@ -1065,9 +1073,19 @@ fn profile_run(spec: &str) {
             std::process::exit(2);
         }
     };
+    if let Ok(dir) = std::env::var("SYMX_NATIVE_SAVE") {
+        let path = std::path::Path::new(&dir).join(format!("{problem}_{function}.json"));
+        f.save(&path).unwrap();
+        eprintln!("saved {}", path.display());
+    }
     let calls: usize = calls.parse().unwrap_or(100);
     let mut out = vec![0.0; f.output_sizes()[0]];
     let mut work = vec![0.0; f.work_size()];
+    if let Ok(seconds) = std::env::var("SYMX_NATIVE_PAUSE") {
+        // For valgrind --instr-atstart=no: time to run `callgrind_control -i on`.
+        eprintln!("ready");
+        std::thread::sleep(Duration::from_secs(seconds.parse().unwrap_or(10)));
+    }
     hot_loop(f, args, &mut out, &mut work, calls);
     let sum: f64 = out.iter().sum();
     let (median, _) = per_call(f, args);

@@ -3,6 +3,7 @@
 //! Every new node goes through [`Graph::unary`], [`Graph::binary`] or [`Graph::if_else`],
 //! which fold constant operands, apply identities such as `x + 0 = x`, `x·1 = x`,
 //! `x·0 = 0`, `−(−x) = x`, `x − x = 0`, move negations out of products and quotients,
+//! fold `c·(2ᵏ·y)` into one product where that gives the same bits (`|c| ≥ 1`),
 //! put commutative operands in a canonical order and
 //! finally hash-cons the node. The rules are local: none looks deeper than the operands'
 //! own operation.
@@ -107,6 +108,9 @@ impl Graph {
                 if let Some(r) = self.pull_negation(Op::Mul, a, b) {
                     return r;
                 }
+                if let Some(r) = self.fold_scale(va, b).or_else(|| self.fold_scale(vb, a)) {
+                    return r;
+                }
             }
             Op::StrongMul => {
                 if is(va, 0.0) || is(vb, 0.0) {
@@ -192,6 +196,38 @@ impl Graph {
                 Some(self.unary(Op::Neg, p))
             }
         }
+    }
+
+    /// `c·(s·y) = (c·s)·y` for constants with `|c| ≥ 1` and `s = ±2ᵏ`, `k ≥ 0`, when `c·s`
+    /// is finite (so `c·s` is exact): the same bits for every `y`, NaN and ±0 included.
+    ///
+    /// Proof: `s·y` is exact unless it overflows (scaling by `2ᵏ`, `k ≥ 0`, drops no bit,
+    /// subnormals included), and then both sides round the same real number `c·s·y` once.
+    /// If `s·y` overflows, `|s·y|` is at least the overflow threshold, so is `|c·s·y|`
+    /// since `|c| ≥ 1`: both sides are the same signed infinity. A NaN `y` comes out of
+    /// both as `y`'s NaN, quieted (a product returns its one NaN operand's sign and
+    /// payload). Derivatives make this shape: `w·(x − t)²` gives `w·(2·(x − t))`. (With
+    /// `|c| < 1` it is not exact: `0.001·(2·y)` is infinite for `|y| > MAX/2`, `0.002·y`
+    /// is not; a constant `s` other than `±2ᵏ` rounds `s·y` first.)
+    fn fold_scale(&mut self, c: Option<f64>, m: u32) -> Option<u32> {
+        let c = c.filter(|c| c.abs() >= 1.0 && c.is_finite())?;
+        let n = self.node(m);
+        if n.op != Op::Mul {
+            return None;
+        }
+        let [p, q, _] = n.args;
+        let (s, y) = match (self.value(p), self.value(q)) {
+            (Some(s), None) => (s, q),
+            (None, Some(s)) => (s, p),
+            _ => return None,
+        };
+        let scale_up = s.abs() >= 1.0 && s.is_finite() && s.to_bits() << 12 == 0;
+        let product = c * s;
+        if !scale_up || !product.is_finite() {
+            return None;
+        }
+        let k = self.constant(product);
+        Some(self.binary(Op::Mul, k, y))
     }
 
     /// Creates `if_else(c, a, b)`, simplified.

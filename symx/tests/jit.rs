@@ -346,3 +346,34 @@ fn constants_first_match_the_tape_on_special_values() {
         same_bits(&f, &[&xs]);
     }
 }
+
+/// A NaN constant (the graph keeps one, `f64::NAN`) made before the variables is the first
+/// operand of `c + x` and `c · x` on the tape (commutative operands are ordered by node),
+/// and x86 returns the first operand's NaN when both are NaN: the JIT must not move such a
+/// constant second (as it does other constants), or `x`'s payload would come out instead
+/// of `c`'s. Lone and paired (lanes) instructions both.
+#[test]
+fn a_nan_constant_first_keeps_its_place() {
+    with_fresh_arena(|| {
+        let cs = [Expr::from(f64::NAN)];
+        let n = 4;
+        let x = Matrix::sym_vec("x", n);
+        let mut outs = Vec::new();
+        for &c in &cs {
+            outs.extend((0..n).map(|i| c * x[i]));
+            outs.extend((0..n).map(|i| c + x[i]));
+            outs.push(-(c * x[0]) + -(c + x[n - 1]));
+        }
+        let f = Function::new(&[&x], &[&outs]).unwrap();
+        let xs = [
+            f64::from_bits(0x7ff8_0000_0000_0001),
+            f64::from_bits(0xfff8_0000_0000_0002),
+            f64::NAN,
+            1.5,
+        ];
+        let out = same_bits(&f, &[&xs]);
+        // The tape itself returns the constant's NaN, not x₀'s (the test's premise).
+        assert_eq!(out[0][0].to_bits(), f64::NAN.to_bits());
+        assert_ne!(xs[0].to_bits(), f64::NAN.to_bits());
+    });
+}

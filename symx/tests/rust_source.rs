@@ -6,8 +6,10 @@ use std::process::Command;
 use symx::{gradient, hessian, if_else, lt, Function, Matrix, SymxError};
 use testkit::special::same_or_both_nan;
 
-/// Compiles `f.to_rust()` with a `main` evaluating it at `point` and returns the outputs.
-fn run_generated(f: &Function, point: &[f64], tag: &str) -> Vec<f64> {
+/// Compiles `f.to_rust()` with a `main` evaluating it at `point` with a work vector of
+/// exactly `WORK_SIZE` entries, checking that the generated code writes every one of them
+/// and none after; returns `WORK_SIZE` and the outputs.
+fn run_generated(f: &Function, point: &[f64], tag: &str) -> (usize, Vec<f64>) {
     let dir = std::env::temp_dir().join(format!("symx_rust_source_{}_{tag}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let module = f.to_rust().unwrap();
@@ -22,10 +24,16 @@ fn main() {{
     let x = [{}];
     let mut outs: Vec<Vec<f64>> = f::OUTPUT_SIZES.iter().map(|&n| vec![0.0; n]).collect();
     let mut refs: Vec<&mut [f64]> = outs.iter_mut().map(|v| v.as_mut_slice()).collect();
-    let mut work = vec![0.0; f::WORK_SIZE];
-    f::eval(&[&x], &mut refs, &mut work).unwrap();
+    // A signalling NaN no operation produces marks every slot, and 16 more after the end.
+    let mark = f64::from_bits(0x7ff0_dead_beef_0001);
+    let mut work = vec![mark; f::WORK_SIZE + 16];
+    f::eval(&[&x], &mut refs, &mut work[..f::WORK_SIZE]).unwrap();
+    let written = |v: &f64| v.to_bits() != mark.to_bits();
+    assert!(work[..f::WORK_SIZE].iter().all(written), "an unused slot in WORK_SIZE");
+    assert!(!work[f::WORK_SIZE..].iter().any(written), "a write past WORK_SIZE");
     assert_eq!(f::eval(&[], &mut refs, &mut work), Err("wrong number of inputs"));
     assert_eq!(f::INPUT_SIZES.len(), 1);
+    println!("{{}}", f::WORK_SIZE);
     for v in outs.concat() {{ println!("{{:x}}", v.to_bits()); }}
 }}"#,
         bits.join(", ")
@@ -47,11 +55,13 @@ fn main() {{
         String::from_utf8_lossy(&out.stderr)
     );
     let _ = std::fs::remove_dir_all(&dir);
-    String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    let work_size = lines.next().unwrap().parse().unwrap();
+    let outputs = lines
         .map(|l| f64::from_bits(u64::from_str_radix(l, 16).unwrap()))
-        .collect()
+        .collect();
+    (work_size, outputs)
 }
 
 /// Values, gradient and Hessian of a function with transcendental functions, powers,
@@ -88,7 +98,13 @@ fn generated_rust_matches_the_tape() {
     .enumerate()
     {
         let want = fun.call(&[p]).unwrap().concat();
-        let got = run_generated(&fun, p, &k.to_string());
+        let (work_size, got) = run_generated(&fun, p, &k.to_string());
+        // Only temporaries: not the tape's inputs, constants and output slots.
+        let kept_elsewhere = 3 + want.len();
+        assert!(
+            work_size + kept_elsewhere <= fun.work_size(),
+            "WORK_SIZE {work_size}"
+        );
         assert_eq!(want.len(), got.len());
         for (i, (a, b)) in want.iter().zip(&got).enumerate() {
             // A NaN's sign and payload are not kept: rustc may swap the operands of a

@@ -51,6 +51,80 @@ fn identities_simplify_locally() {
     assert!(if_else(gt(x, 0.0), y, y).is(y));
 }
 
+/// `c·(2ᵏ·y)` becomes `(c·2ᵏ)·y` only where that is exact (`|c| ≥ 1`, `k ≥ 0`: see
+/// `Graph::fold_scale`), and the folded function gives the bits of the unfolded product on
+/// special values, at the overflow threshold and among subnormals.
+#[test]
+fn a_constant_times_a_doubling_folds_only_where_exact() {
+    let x = Expr::sym("x");
+    let y = x - 3.0;
+    for (c, s) in [(1000.0, 2.0), (-3.0, 4.0), (1.5, -2.0), (1e300, 8.0)] {
+        let folded = c * (s * y);
+        assert!(folded.is((c * s) * y), "{c}·({s}·y) is {folded}");
+        assert!(((s * y) * c).is((c * s) * y));
+    }
+    // |c| < 1, s not a power of two, s < 1, or c·s overflowing: kept as written.
+    for (c, s) in [(0.001, 2.0), (1000.0, 3.0), (1000.0, 0.5), (1e308, 4.0)] {
+        assert!(!(c * (s * y)).is((c * s) * y), "{c}·({s}·y) folded");
+    }
+    let mut ys = testkit::special::SPECIAL.to_vec();
+    let max = f64::MAX;
+    ys.extend([
+        max,
+        -max,
+        max / 2.0,
+        max / 1000.0,
+        5e-324,
+        -1.5e-323,
+        2.2e-308,
+    ]);
+    ys.extend([
+        f64::from_bits(0x7ff8_0000_0000_0007),
+        f64::from_bits(0xfff8_0000_0000_0009),
+    ]);
+    for (c, s) in [
+        (1000.0, 2.0),
+        (-3.0, 4.0),
+        (1.5, -2.0),
+        (1.0 + f64::EPSILON, 1024.0),
+    ] {
+        let f = Function::new(&[&[x]], &[&[c * (s * x)]]).unwrap();
+        assert_eq!(f.instruction_count(), 1);
+        for &v in &ys {
+            let got = f.call(&[&[v]]).unwrap()[0][0];
+            let want = c * (s * std::hint::black_box(v));
+            assert_eq!(got.to_bits(), want.to_bits(), "{c}·({s}·{v:e})");
+        }
+    }
+    // Why |c| ≥ 1: 0.001·(2·y) overflows where 0.002·y does not.
+    let y = std::hint::black_box(max);
+    assert!((0.001 * (2.0 * y)).is_infinite() && (0.002 * y).is_finite());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 20_000, max_global_rejects: 100_000, ..ProptestConfig::default() })]
+    /// The rule of `Graph::fold_scale` on arbitrary bit patterns: `c·(s·y)` and `(c·s)·y`
+    /// agree bit for bit for every `y` (NaN payloads, infinities, subnormals included),
+    /// every `|c| ≥ 1` and `s = ±2ᵏ`, `k ≥ 0`, with `c·s` finite.
+    #[test]
+    fn a_constant_times_a_doubling_is_exact_for_every_operand(
+        y in any::<u64>(),
+        c_mantissa in 0u64..1 << 52,
+        c_exponent in 1023u64..2047,
+        c_negative in any::<bool>(),
+        k in 0i32..1100,
+        negative in any::<bool>(),
+    ) {
+        let y = f64::from_bits(y);
+        // |c| ≥ 1, finite: any sign and mantissa, a biased exponent of at least 1023.
+        let c = f64::from_bits((c_negative as u64) << 63 | c_exponent << 52 | c_mantissa);
+        let s = if negative { -(2f64.powi(k)) } else { 2f64.powi(k) };
+        prop_assume!(c.abs() >= 1.0 && s.is_finite() && (c * s).is_finite());
+        let (c, s, y) = std::hint::black_box((c, s, y));
+        prop_assert_eq!((c * (s * y)).to_bits(), ((c * s) * y).to_bits());
+    }
+}
+
 #[test]
 fn constants_fold() {
     let x = Expr::sym("x");

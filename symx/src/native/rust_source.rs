@@ -5,7 +5,9 @@
 //! Nothing is copied per call: each generated function `exec(w, x, y)` reads its inputs
 //! where the caller keeps them (`x[k]`), writes its outputs where the caller wants them
 //! (`y[k]`), and has its constants as literals; the work vector `w` holds only the
-//! temporaries (and the arguments gathered for a call of another function).
+//! temporaries (and the arguments gathered for a call of another function), so
+//! `WORK_SIZE` counts only those: the tape's registers from its first temporary on
+//! (`first_temporary`), already reused by liveness when the tape was compiled.
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
 use crate::function::{Function, Instr};
@@ -29,10 +31,37 @@ enum Place {
     Work(usize),
 }
 
+/// The first register of `f`'s temporaries: the tape's registers before it are its inputs,
+/// constants and output slots (`[inputs | constants | outputs | temporaries | call
+/// scratch]`), which the generated code keeps elsewhere; register `r` from here on is
+/// `w[r - first_temporary(f)]`.
+fn first_temporary(f: &Function) -> usize {
+    f.template_start + f.template.len()
+}
+
+/// The length of the work vector of `f`'s generated code: its temporaries, then, when it
+/// calls other functions, the largest callee's gathered arguments and work vector.
+fn work_need(f: &Function) -> usize {
+    let callees = f
+        .calls
+        .iter()
+        .map(|c| callee_base(&c.function) + work_need(&c.function));
+    f.call_scratch - first_temporary(f) + callees.max().unwrap_or(0)
+}
+
+/// Where a callee's own work vector starts in its scratch block: after its arguments,
+/// gathered there in the layout of its inputs.
+fn callee_base(g: &Function) -> usize {
+    g.template_start
+}
+
 /// The place of every register of `f`. Inputs and constants are never written (compilation
 /// gives temporaries only registers after the output slots).
 fn places(f: &Function) -> Vec<Place> {
-    let mut p: Vec<Place> = (0..f.work_size).map(Place::Work).collect();
+    let t = first_temporary(f);
+    let mut p: Vec<Place> = (0..f.work_size)
+        .map(|r| Place::Work(r.saturating_sub(t)))
+        .collect();
     for (k, &v) in f.template.iter().enumerate() {
         p[f.template_start + k] = Place::Constant(v);
     }
@@ -131,7 +160,7 @@ impl Body<'_> {
     fn call(&mut self, f: &Function, ins: &Instr, callee: &str) {
         let call = &f.calls[ins.d as usize];
         let g = &call.function;
-        let s = f.call_scratch;
+        let s = f.call_scratch - first_temporary(f);
         let mut p = 0;
         for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
             for i in 0..n {
@@ -145,7 +174,7 @@ impl Body<'_> {
             .iter()
             .map(|at| format!("w.add({}) as *const f64", s + at))
             .collect();
-        let mut q = call.out as usize;
+        let mut q = call.out as usize - first_temporary(f);
         let ys: Vec<String> = g
             .output_sizes
             .iter()
@@ -156,9 +185,10 @@ impl Body<'_> {
             .collect();
         writeln!(
             self.out,
-            "    {{ let x = [{}]; let y = [{}]; {callee}(w.add({s}), x.as_ptr(), y.as_ptr()); }}",
+            "    {{ let x = [{}]; let y = [{}]; {callee}(w.add({}), x.as_ptr(), y.as_ptr()); }}",
             xs.join(", "),
-            ys.join(", ")
+            ys.join(", "),
+            s + callee_base(g)
         )
         .unwrap();
     }
@@ -364,8 +394,8 @@ impl Function {
         .unwrap();
         writeln!(
             o,
-            "/// Length of the work vector.\npub const WORK_SIZE: usize = {};",
-            self.work_size
+            "/// Length of the work vector (the temporaries only).\npub const WORK_SIZE: usize = {};",
+            work_need(self)
         )
         .unwrap();
         writeln!(
