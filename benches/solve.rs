@@ -6,6 +6,17 @@
 //! cargo bench --bench solve                 # criterion (10², 10³, 10⁴; 10⁵ timed once)
 //! cargo bench --bench solve -- --json       # one JSON line per problem and size
 //! ```
+//! cargo bench --bench solve -- --small     # the small problems' per-iteration cost
+//! ```
+//! `--small` solves, 20 times each, the problems whose IPM cost is fixed costs rather
+//! than linear algebra: the gap-crossing planner's single-stance problem (18 variables,
+//! `gap_crossing::model::build_stance`, solved cold for each stance of the crawl guess,
+//! as the schedule search does) and HS116/HS118 (13/15 variables). It prints the
+//! iterations and the wall time per iteration; under
+//! `valgrind --tool=callgrind --toggle-collect='*small_solve*'` it gives the
+//! instructions per iteration (the numbers in docs/performance.md).
+//!
+//! ```text
 //! `SOLVE_MAX_LOG_N=4` limits the JSON mode to sizes up to 10⁴ variables and
 //! `SOLVE_PROBLEM=ocp` (or `hanging_chain`) to one problem (the 10⁵ chain runs into its
 //! 120 s cap).
@@ -134,10 +145,129 @@ fn criterion_mode() {
     c.final_summary();
 }
 
+/// One small problem of `--small`: a compiled problem and the starting points and
+/// parameter values of its solves.
+struct Small {
+    name: &'static str,
+    compiled: Compiled,
+    /// (parameter values of `STANCE_FEET` or none, starting point) of each solve.
+    starts: Vec<(Option<Vec<f64>>, Vec<f64>)>,
+}
+
+/// The gap-crossing planner's stance problem, solved for the feet of each stance of
+/// the default scenario's crawl guess from the previous stance's CoMs and forces.
+fn stance_problem() -> Small {
+    use gap_crossing::model::{build_stance, STANCE_FEET};
+    use gap_crossing::scenario::Scenario;
+    use gap_crossing::terrain::GapTerrain;
+    let s = Scenario::default();
+    let problem = build_stance(&s, &GapTerrain { gap: s.gap }).expect("stance problem");
+    let plan = gap_crossing::gait::crawl_plan(&s);
+    let starts = plan
+        .stances
+        .windows(2)
+        .map(|w| {
+            let feet: Vec<f64> = w[1].feet.to_array().iter().flatten().copied().collect();
+            let mut x0: Vec<f64> = w[0].com.b.iter().chain(&w[0].com.f).copied().collect();
+            x0.extend(w[0].forces.to_array().iter().flatten());
+            (Some(feet), x0)
+        })
+        .collect();
+    assert_eq!(STANCE_FEET, "stance feet");
+    Small {
+        name: "gap_stance",
+        compiled: problem.compile().expect("compiles"),
+        starts,
+    }
+}
+
+/// An HS problem solved from its published start.
+fn hs_problem(name: &'static str, build: fn() -> testkit::hs::problems::Built) -> Small {
+    let compiled = build()
+        .expect("HS problem")
+        .problem
+        .compile()
+        .expect("compiles");
+    let x0 = case_x0(&compiled);
+    Small {
+        name,
+        compiled,
+        starts: vec![(None, x0)],
+    }
+}
+
+/// Solves every start of `pb` with `ipm` (the solver keeps its workspace across
+/// solves, as the planner's stance solver does); returns the total iterations.
+#[inline(never)]
+fn small_solve(ipm: &Ipm, pb: &mut Small) -> usize {
+    let mut iterations = 0;
+    for (feet, x0) in &pb.starts {
+        if let Some(p) = feet {
+            pb.compiled.set_value("stance feet", p).expect("feet");
+        }
+        pb.compiled.set_initial_point(x0).expect("start");
+        let sol = ipm.solve(&mut pb.compiled).expect("valid problem");
+        iterations += sol.stats.iterations;
+    }
+    iterations
+}
+
+/// `--small`: iterations and wall time per iteration of the small problems (20 rounds,
+/// median round).
+fn small_mode() {
+    // The planner's stance-solver settings (`StanceSolver::with_settings`).
+    let ipm = Ipm::new(IpmOptions {
+        common: CommonOptions {
+            max_iter: 100,
+            print_level: 0,
+            ..CommonOptions::default()
+        },
+        ..IpmOptions::default()
+    });
+    let rounds: usize = std::env::var("SMALL_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20);
+    let problems = [
+        stance_problem(),
+        hs_problem("hs116", testkit::hs::problems::hs116),
+        hs_problem("hs118", testkit::hs::problems::hs118),
+    ];
+    for mut pb in problems {
+        let mut times = Vec::new();
+        let mut iterations = 0;
+        for _ in 0..rounds {
+            let t = Instant::now();
+            iterations = small_solve(&ipm, &mut pb);
+            times.push(t.elapsed().as_secs_f64());
+        }
+        times.sort_by(f64::total_cmp);
+        let median = times[times.len() / 2];
+        println!(
+            "{}: {} solves, {iterations} iterations per round, median round {:.3} ms, \
+             {:.2} µs per iteration",
+            pb.name,
+            pb.starts.len(),
+            median * 1e3,
+            median * 1e6 / iterations as f64
+        );
+    }
+}
+
 fn main() {
-    if std::env::args().any(|a| a == "--json") {
+    if std::env::args().any(|a| a == "--small") {
+        small_mode();
+    } else if std::env::args().any(|a| a == "--json") {
         json_mode();
     } else {
         criterion_mode();
     }
+}
+
+/// The starting point stored in a compiled problem.
+fn case_x0(compiled: &Compiled) -> Vec<f64> {
+    use nlp::NumericNlp;
+    let mut x0 = vec![0.0; compiled.n()];
+    compiled.initial_point(&mut x0);
+    x0
 }

@@ -245,6 +245,7 @@ impl Simplicial {
     /// x ← (L D Lᵀ)⁻¹ x in the permuted space.
     pub(super) fn solve_in_place(&self, l: &[f64], x: &mut [f64]) {
         let dim = self.d_inv.len();
+        let x = &mut x[..dim];
         let lcp = &self.l_col_ptr;
         let lri = &self.l_row_idx;
         for j in 0..dim {
@@ -252,7 +253,9 @@ impl Simplicial {
             if xj != 0.0 {
                 let (a, b) = (lcp[j] + 1, lcp[j + 1]);
                 for (&i, &lij) in lri[a..b].iter().zip(&l[a..b]) {
-                    x[i] -= lij * xj;
+                    // SAFETY: every row index of L is below `dim` = x.len() (checked
+                    // in `Simplicial::new`, the only place L's pattern is set).
+                    unsafe { *x.get_unchecked_mut(i) -= lij * xj };
                 }
             }
         }
@@ -263,7 +266,8 @@ impl Simplicial {
             let (a, b) = (lcp[j] + 1, lcp[j + 1]);
             let mut acc = x[j];
             for (&i, &lij) in lri[a..b].iter().zip(&l[a..b]) {
-                acc -= lij * x[i];
+                // SAFETY: as above, i < dim = x.len().
+                acc -= lij * unsafe { *x.get_unchecked(i) };
             }
             x[j] = acc;
         }

@@ -30,12 +30,14 @@ impl Core<'_> {
     /// out = Aᵀ y with A = [J, −E].
     pub(super) fn at_times(&self, jac: &[f64], y: &[f64], out: &mut [f64]) {
         let pat = self.nlp.jac_g_sparsity();
-        for j in 0..self.lay.n {
+        let rows = pat.row_idx();
+        for (j, o) in out[..self.lay.n].iter_mut().enumerate() {
+            let range = pat.col_range(j);
             let mut s = 0.0;
-            for p in pat.col_range(j) {
-                s += jac[p] * y[pat.row_idx()[p]];
+            for (&v, &i) in jac[range.clone()].iter().zip(&rows[range]) {
+                s += v * y[i];
             }
-            out[j] = s;
+            *o = s;
         }
         for k in 0..self.lay.ni {
             out[self.lay.n + k] = -y[self.lay.row_of_slack[k]];

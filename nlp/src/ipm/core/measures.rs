@@ -66,16 +66,21 @@ impl Core<'_> {
     /// and the unscaled parts.
     pub(super) fn nlp_error(&mut self, mu_t: f64, damping: bool) -> (f64, [f64; 3]) {
         let (e, eu) = self.errors(mu_t, damping);
+        (self.scaled_error(e), eu)
+    }
+
+    /// IPOPT's scaled optimality error of the measures `e` of [`Core::errors`] at the
+    /// current iterate.
+    pub(super) fn scaled_error(&self, e: [f64; 3]) -> f64 {
         let it = &self.it;
         let lay = &self.lay;
-        let e0 = scaled_error(
+        scaled_error(
             e,
             &it.y,
             (&it.zl, &lay.has_l),
             (&it.zu, &lay.has_u),
             self.opts.s_max,
-        );
-        (e0, eu)
+        )
     }
 
     pub(super) fn avg_compl(&self, w: &[f64], zl: &[f64], zu: &[f64]) -> (f64, f64) {

@@ -176,6 +176,12 @@ pub(crate) struct Core<'p> {
     /// The outer iteration's failed line search (alpha_pr, ls) that starts a restoration
     /// phase; shown in the restoration's first log row as IPOPT does ("12r … 4.8e-7R 22").
     resto_start: Option<(f64, usize)>,
+    /// The error measures (`Core::errors` with μ = 0, no damping) of the current
+    /// iterate, computed for its log row and taken by the next stop test, which needs
+    /// the same numbers (one evaluation of them instead of two per iteration). Set only
+    /// where the stop test follows the log row with the iterate unchanged; cleared
+    /// when a restoration phase starts.
+    errors_here: Option<([f64; 3], [f64; 3])>,
 }
 
 impl<'p> Core<'p> {
@@ -240,6 +246,7 @@ impl<'p> Core<'p> {
                     .unwrap_or(opts.hessian_approximation == crate::IpmHessian::LimitedMemory),
             scaling,
             resto_start: setup.failed_search,
+            errors_here: None,
         })
     }
 
@@ -324,6 +331,14 @@ impl<'p> Core<'p> {
         }
     }
 
+    /// The unscaled error measures of the current iterate for its log row, kept for
+    /// the next stop test (`errors_here`).
+    fn errors_for_record(&mut self) -> [f64; 3] {
+        let errors = self.errors(0.0, false);
+        self.errors_here = Some(errors);
+        errors.1
+    }
+
     pub(crate) fn outcome(
         &self,
         status: Status,
@@ -353,7 +368,10 @@ impl<'p> Core<'p> {
                 false,
             ));
         }
-        let (e0, eu) = self.nlp_error(0.0, false);
+        let (e0, eu) = match self.errors_here.take() {
+            Some((e, eu)) => (self.scaled_error(e), eu),
+            None => self.nlp_error(0.0, false),
+        };
         let e = KktResiduals {
             overall: e0,
             dual: eu[0],
@@ -383,7 +401,7 @@ impl<'p> Core<'p> {
         if let Err(e) = self.initialize(start) {
             return self.outcome(Status::InvalidNumberDetected, e.to_string(), false);
         }
-        let (_, eu) = self.errors(0.0, false);
+        let eu = self.errors_for_record();
         match self.resto_start.take() {
             Some((a_pr, ls)) => self.record(shared, 0.0, 0.0, a_pr, 'R', ls, eu[0]),
             None => self.record(shared, 0.0, 0.0, 0.0, ' ', 0, eu[0]),
@@ -466,7 +484,7 @@ impl<'p> Core<'p> {
         }
         self.end_soft_resto();
         self.count.tiny_count += 1;
-        let (_, eu) = self.errors(0.0, false);
+        let eu = self.errors_for_record();
         self.record(shared, d_norm, 1.0, 1.0, 't', 1, eu[0]);
         if self.count.tiny_count >= 2 && self.mu_update.at_floor() {
             return Some(Iteration::Finished(self.outcome(
@@ -489,7 +507,7 @@ impl<'p> Core<'p> {
                 kind,
                 trials,
             } => {
-                let (_, eu) = self.errors(0.0, false);
+                let eu = self.errors_for_record();
                 let ch = kind.log_char();
                 self.record(shared, d_norm, alpha_du, alpha_pr, ch, trials, eu[0]);
                 if self.setup_in_resto && self.nlp.restoration_accepts(&self.it.w) {
@@ -531,6 +549,8 @@ impl<'p> Core<'p> {
         filter_augmented: bool,
         restore: Restorer,
     ) -> Option<Outcome> {
+        // The restoration phase moves the iterate: the kept error measures are stale.
+        self.errors_here = None;
         let last_acceptable = self.termination.last_was_acceptable();
         if let Some((status, message)) =
             refusal(self.setup_in_resto, self.lay.m, last_acceptable, why)
