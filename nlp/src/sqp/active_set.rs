@@ -350,7 +350,43 @@ mod tests {
     //! bounds and fixed variables, feasible by construction; and on degenerate ones
     //! (duplicated rows, a bound duplicating a row), where the method may give up but
     //! must not return a wrong answer.
-    use super::{guess, penalty_for, solve};
+    use super::{guess_into, penalty_for, solve_in, Failure, Scratch};
+
+    /// A solved QP: its result, working set and iterations (the test's view of `solve_in`).
+    struct Solved {
+        res: QpResult,
+        working_set: WorkingSet,
+    }
+
+    /// The working set guessed from `mult` (`guess_into` into a new one).
+    fn guess(p: &QpData, mult: &Mult) -> WorkingSet {
+        let mut w = WorkingSet {
+            rows: Vec::new(),
+            vars: Vec::new(),
+        };
+        guess_into(p, mult, &mut w);
+        w
+    }
+
+    /// `solve_in` from `start` with new vectors.
+    fn solve(
+        kkt: &mut Kkt,
+        p: &QpData,
+        pats: (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+        mut w: WorkingSet,
+        limits: (usize, usize),
+        n_fact: &mut usize,
+        factored: bool,
+    ) -> Result<Solved, Failure> {
+        let mut res = QpResult::empty();
+        let mut scratch = Scratch::default();
+        let ws = (&mut w, &mut res);
+        solve_in(kkt, p, pats, ws, limits, (n_fact, factored), &mut scratch)?;
+        Ok(Solved {
+            res,
+            working_set: w,
+        })
+    }
     use crate::kkt::Kkt;
     use crate::sqp::iterate::Mult;
     use crate::sqp::polish::WorkingSet;
