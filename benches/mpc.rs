@@ -7,6 +7,8 @@
 //! `mpc_cart_pole_sqp_warm_resolve`: the same re-solve by the SQP.
 //! `mpc_cart_pole_rti_prepare` / `mpc_cart_pole_rti_feedback`: the two phases of one
 //! real-time iteration (`nlp::Rti`) at the same state, from the same plan.
+//! The `_jit` variants: the IPM re-solve and the two RTI phases on native evaluators
+//! (`Evaluator::Jit`, the same iterates).
 //!
 //! ```text
 //! cargo bench --bench mpc
@@ -18,7 +20,9 @@ use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 use nlp::mpc::Mpc;
-use nlp::{Ipm, Rti, Sqp, SqpOptions};
+use nlp::ocp::Transcription;
+use nlp::{Ipm, Rti, Solution, Sqp, SqpOptions};
+use symx::Evaluator;
 
 /// Closed-loop steps taken before the benchmarked re-solve (mid swing-up stabilisation,
 /// where a warm step takes 2–3 iterations as most of the loop's steps do).
@@ -61,25 +65,41 @@ fn warm_resolve(c: &mut Criterion) {
     c.bench_function("mpc_cart_pole_sqp_warm_resolve", |b| {
         b.iter(|| black_box(sqp.solve_warm(compiled, &shifted).expect("warm solve")))
     });
-    // RTI: the plan of step STEPS_BEFORE − 1 shifted is the linearisation point, x the
-    // measured state; prepare and feedback from the same plan each time.
-    let mut rti = Rti::from_transcription(&tr, SqpOptions::default()).expect("RTI");
-    rti.initialize(&shifted).expect("plan");
-    c.bench_function("mpc_cart_pole_rti_prepare", |b| {
+    let mut native = compiled
+        .clone()
+        .with_evaluator(Evaluator::Jit)
+        .expect("jit");
+    c.bench_function("mpc_cart_pole_ipm_warm_resolve_jit", |b| {
+        b.iter(|| black_box(ipm.solve_warm(&mut native, &shifted).expect("warm solve")))
+    });
+    rti_phases(c, &tr, &shifted, &x, Evaluator::Tape);
+    rti_phases(c, &tr, &shifted, &x, Evaluator::Jit);
+}
+
+/// RTI: the plan of step STEPS_BEFORE − 1 shifted is the linearisation point, x the
+/// measured state; prepare and feedback from the same plan each time.
+fn rti_phases(c: &mut Criterion, tr: &Transcription, shifted: &Solution, x: &[f64], e: Evaluator) {
+    let suffix = if e == Evaluator::Jit { "_jit" } else { "" };
+    let mut rti = Rti::from_transcription(tr, SqpOptions::default())
+        .expect("RTI")
+        .with_evaluator(e)
+        .expect("evaluator");
+    rti.initialize(shifted).expect("plan");
+    c.bench_function(&format!("mpc_cart_pole_rti_prepare{suffix}"), |b| {
         b.iter(|| {
-            rti.initialize(&shifted).expect("plan");
+            rti.initialize(shifted).expect("plan");
             rti.prepare().expect("prepare");
         })
     });
     // The feedback alone: each repetition prepares untimed, then times the feedback.
-    c.bench_function("mpc_cart_pole_rti_feedback", |b| {
+    c.bench_function(&format!("mpc_cart_pole_rti_feedback{suffix}"), |b| {
         b.iter_custom(|iters| {
             let mut total = Duration::ZERO;
             for _ in 0..iters {
-                rti.initialize(&shifted).expect("plan");
+                rti.initialize(shifted).expect("plan");
                 rti.prepare().expect("prepare");
                 let t = Instant::now();
-                black_box(rti.feedback(&x).expect("feedback"));
+                black_box(rti.feedback(x).expect("feedback"));
                 total += t.elapsed();
             }
             total

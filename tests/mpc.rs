@@ -10,7 +10,7 @@ use symnlp::nlp::ocp::{
     ButcherTableau, CollocationPoints, Horizon, Method, Ocp, OcpError, Simulator, Transcription,
 };
 use symnlp::nlp::{Compiled, Constraint, Ipm, Relation, Solution, Status};
-use symnlp::symx::Matrix;
+use symnlp::symx::{Evaluator, Matrix};
 
 const N: usize = 5;
 
@@ -359,4 +359,47 @@ fn cart_pole_rti_loop_within_2_percent_of_the_converged_loop() {
 #[test]
 fn car_rti_loop_within_2_percent_of_the_converged_loop() {
     assert_rti_loop_near_converged!(mpc_car::example());
+}
+
+/// The car's loop (first 20 steps) with the tape and with native evaluators
+/// (`Mpc::with_evaluator(Evaluator::Jit)`) for the IPM, the SQP and real-time iterations:
+/// the same states, controls, statuses and iteration counts bit for bit (the JIT performs
+/// the tape's operations in the tape's order, so no tolerance applies).
+#[test]
+fn jit_closed_loops_are_bit_identical_to_the_tape() {
+    let example = mpc_car::example();
+    for solver in ["ipm", "sqp", "rti"] {
+        let runs: Vec<_> = [false, true]
+            .into_iter()
+            .map(|jit| {
+                let (tr, mut plant) = example.setup().unwrap();
+                let (mut mpc, _) = example.controller(&tr, solver, jit).unwrap();
+                let want = if jit { Evaluator::Jit } else { Evaluator::Tape };
+                assert_eq!(mpc.compiled_mut().evaluator(), want);
+                let dt = example.dt;
+                mpc.run(&example.x_init, 20, |x, u, next| {
+                    plant.step_into(x, u, dt, next)
+                })
+                .unwrap()
+            })
+            .collect();
+        let (tape, jit) = (&runs[0], &runs[1]);
+        assert!(tape.all_succeeded(), "{solver}");
+        let bits =
+            |v: &[Vec<f64>]| -> Vec<u64> { v.concat().iter().map(|a| a.to_bits()).collect() };
+        assert_eq!(bits(&tape.states), bits(&jit.states), "{solver}: states");
+        assert_eq!(
+            bits(&tape.controls),
+            bits(&jit.controls),
+            "{solver}: controls"
+        );
+        for (a, b) in tape.steps.iter().zip(&jit.steps) {
+            assert_eq!(
+                (a.status, a.iterations),
+                (b.status, b.iterations),
+                "{solver}"
+            );
+            assert_eq!(a.objective.to_bits(), b.objective.to_bits(), "{solver}");
+        }
+    }
 }

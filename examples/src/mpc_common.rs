@@ -1,10 +1,12 @@
 //! What the MPC examples share: a closed loop of an OCP whose initial state is the
 //! parameter `x0`, on the nominal plant (the transcription's RK4 step), with its cost
-//! `dt Σ_s l(x_s, u_s)` and a command line `[ipm|sqp|rti] [--json]`.
+//! `dt Σ_s l(x_s, u_s)` and a command line `[ipm|sqp|rti] [--jit] [--json]`.
+use std::time::Instant;
+
 use symnlp::nlp::mpc::{ClosedLoop, Mpc, MpcError};
 use symnlp::nlp::ocp::{ButcherTableau, Method, Ocp, Simulator, Transcription};
 use symnlp::nlp::{Ipm, Solver, Sqp, SqpOptions};
-use symnlp::symx::{Expr, Function, Matrix};
+use symnlp::symx::{Evaluator, Expr, Function, Matrix};
 
 /// One MPC example: the OCP (initial state the parameter `x0`), its grid and loop.
 pub struct MpcExample {
@@ -47,9 +49,7 @@ impl MpcExample {
     /// convergence by the interior point, as CasADi's RTI loop in
     /// `benches/reference/mpc_casadi.py` does with its sqpmethod.
     pub fn closed_loop_rti(&self) -> Result<ClosedLoop, Box<dyn std::error::Error>> {
-        self.closed_loop_with(|tr| {
-            Mpc::with_rti(tr, SqpOptions::default(), Box::new(Ipm::default()))
-        })
+        self.closed_loop_with(|tr| Ok(self.controller(tr, "rti", false)?.0))
     }
 
     /// The closed loop with the controller `make` builds for the transcription.
@@ -78,17 +78,51 @@ impl MpcExample {
         Ok(self.dt * total)
     }
 
-    /// `[ipm|sqp|rti] [--json]`: runs the loop; prints the steps as CSV (or one JSON
-    /// summary line with `--json`) on stdout and a summary on stderr.
+    /// The controller `solver` (`"ipm"`, `"sqp"` or `"rti"`, as in [`MpcExample::main`])
+    /// for `tr`, its functions compiled to machine code when `jit`
+    /// ([`Mpc::with_evaluator`]); also returns the wall seconds of that compilation (0
+    /// without `jit`).
+    pub fn controller(
+        &self,
+        tr: &Transcription,
+        solver: &str,
+        jit: bool,
+    ) -> Result<(Mpc, f64), MpcError> {
+        let mpc = match solver {
+            "rti" => Mpc::with_rti(tr, SqpOptions::default(), Box::new(Ipm::default()))?,
+            "sqp" => Mpc::new(tr, Box::new(Sqp::default()))?,
+            _ => Mpc::new(tr, Box::new(Ipm::default()))?,
+        };
+        if !jit {
+            return Ok((mpc, 0.0));
+        }
+        let start = Instant::now();
+        let mpc = mpc.with_evaluator(Evaluator::Jit)?;
+        Ok((mpc, start.elapsed().as_secs_f64()))
+    }
+
+    /// `[ipm|sqp|rti] [--jit] [--json]`: runs the loop (with `--jit` on native
+    /// evaluators, [`Mpc::with_evaluator`]); prints the steps as CSV (or one JSON summary
+    /// line with `--json`, its `jit_compile_ms` the native compilation's wall time, not
+    /// part of any step) on stdout and a summary on stderr.
     pub fn main(&self) -> Result<(), Box<dyn std::error::Error>> {
         let args: Vec<String> = std::env::args().skip(1).collect();
-        let (name, run) = if args.iter().any(|a| a == "rti") {
-            ("rti", self.closed_loop_rti()?)
-        } else if args.iter().any(|a| a == "sqp") {
-            ("sqp", self.closed_loop(Box::new(Sqp::default()))?)
+        let solver = ["rti", "sqp"]
+            .into_iter()
+            .find(|s| args.iter().any(|a| a == s))
+            .unwrap_or("ipm");
+        let jit = args.iter().any(|a| a == "--jit");
+        let name = if jit {
+            format!("{solver}_jit")
         } else {
-            ("ipm", self.closed_loop(Box::new(Ipm::default()))?)
+            solver.to_string()
         };
+        let mut jit_seconds = 0.0;
+        let run = self.closed_loop_with(|tr| {
+            let (mpc, seconds) = self.controller(tr, solver, jit)?;
+            jit_seconds = seconds;
+            Ok(mpc)
+        })?;
         let (median, max) = run.latency();
         // The steps after the first (RTI's first step is a converged solve).
         let later = ClosedLoop {
@@ -112,6 +146,7 @@ impl MpcExample {
                 "feedback_max_ms": 1e3 * feedback_max,
                 "iterations_mean": mean_it, "iterations_max": max_it,
                 "final_state": run.states.last(),
+                "jit_compile_ms": 1e3 * jit_seconds,
             });
             println!("{summary}");
         } else {
@@ -133,12 +168,13 @@ impl MpcExample {
             }
         }
         eprintln!(
-            "{} {name}: all succeeded {}, closed-loop cost {cost:.10}, latency median {:.3} ms max {:.3} ms (feedback median {:.3} ms after the first step), iterations mean {mean_it:.2} max {max_it}",
+            "{} {name}: all succeeded {}, closed-loop cost {cost:.10}, latency median {:.3} ms max {:.3} ms (feedback median {:.3} ms after the first step), iterations mean {mean_it:.2} max {max_it}, jit compile {:.0} ms",
             self.name,
             run.all_succeeded(),
             1e3 * median,
             1e3 * max,
             1e3 * feedback_median,
+            1e3 * jit_seconds,
         );
         Ok(())
     }

@@ -24,6 +24,7 @@ use std::time::Instant;
 #[doc = include_str!("../../docs/mpc.md")]
 pub struct MpcGuide;
 
+use symx::Evaluator;
 use thiserror::Error;
 
 use crate::compiled::Compiled;
@@ -242,6 +243,52 @@ impl Mpc {
             prepared: None,
         };
         Mpc::with_engine(tr, engine)
+    }
+
+    /// This controller with its problem's functions evaluated by `evaluator` (CasADi's
+    /// `jit` option): [`Evaluator::Jit`] compiles them to machine code once here (see
+    /// [`Compiled::with_evaluator`]); the values are the tape's bit for bit, so every
+    /// step takes the same iterates, in less time. Errors: native code cannot be generated
+    /// (e.g. built without the `jit` feature). See `docs/mpc.md` §4 for when it pays.
+    ///
+    /// ```
+    /// # use nlp::mpc::Mpc;
+    /// # use nlp::ocp::{ButcherTableau, Horizon, Method, Ocp};
+    /// # use nlp::Ipm;
+    /// # use symx::Matrix;
+    /// use symx::Evaluator;
+    /// # let mut ocp = Ocp::new(&["x"], &["u"]);
+    /// # ocp.set_dynamics(|x, u, _p| Matrix::from_vec(vec![x[0] + u[0]]));
+    /// # ocp.set_stage_cost(|x, u, _p| x[0].sq() + 0.1 * u[0].sq());
+    /// # ocp.set_horizon(Horizon::Fixed(1.0)).unwrap();
+    /// # ocp.set_initial_state_parameter("x0", &[1.0]).unwrap();
+    /// # let tr = ocp.transcribe(&Method::multiple_shooting(ButcherTableau::rk4(), 1), 10).unwrap();
+    /// let mut mpc = Mpc::new(&tr, Box::new(Ipm::default()))
+    ///     .unwrap()
+    ///     .with_evaluator(Evaluator::Jit)
+    ///     .unwrap();
+    /// assert_eq!(mpc.compiled_mut().evaluator(), Evaluator::Jit);
+    /// assert!(mpc.step(&[1.0]).unwrap().status.is_success());
+    /// ```
+    pub fn with_evaluator(self, evaluator: Evaluator) -> Result<Mpc, MpcError> {
+        let engine = match self.engine {
+            Engine::Solver { solver, compiled } => Engine::Solver {
+                solver,
+                compiled: Box::new(compiled.with_evaluator(evaluator)?),
+            },
+            Engine::Rti {
+                rti,
+                first,
+                started,
+                prepared,
+            } => Engine::Rti {
+                rti: Box::new(rti.with_evaluator(evaluator)?),
+                first,
+                started,
+                prepared,
+            },
+        };
+        Ok(Mpc { engine, ..self })
     }
 
     fn with_engine(tr: &Transcription, engine: Engine) -> Result<Mpc, MpcError> {

@@ -6,7 +6,7 @@ use super::{
     ButcherTableau, Collocation, CollocationPoints, ControlInterpolation, Grid, Horizon, Ocp,
     OcpError, Trajectory,
 };
-use crate::compiled::Compiled;
+use crate::compiled::{CompileOptions, Compiled};
 use crate::constraint::{Constraint, Relation};
 use crate::problem::Problem;
 use crate::solution::Solution;
@@ -842,6 +842,13 @@ impl Transcription {
     /// Compiles the problem (see [`Problem::compile`]).
     pub fn compile(&self) -> Result<Compiled, OcpError> {
         Ok(self.problem.compile()?)
+    }
+
+    /// Compiles the problem with `options` (see [`Problem::compile_with`]), e.g. with
+    /// native evaluators (`Evaluator::Jit`, CasADi's `jit` option) for a problem solved
+    /// many times, as in an MPC loop.
+    pub fn compile_with(&self, options: CompileOptions) -> Result<Compiled, OcpError> {
+        Ok(self.problem.compile_with(options)?)
     }
 
     /// Number of intervals N.

@@ -53,14 +53,6 @@ pub(super) enum Failure {
     IterationLimit,
 }
 
-/// A solved QP: the result (in the convention of [`QpResult`]), its working set and the
-/// number of active-set iterations (= factorisations).
-pub(super) struct Solved {
-    pub res: QpResult,
-    pub working_set: WorkingSet,
-    pub iterations: usize,
-}
-
 /// The ℓ1 penalty for which a QP solution with multipliers up to `max_multiplier` is
 /// also the elastic QP's: `rho` itself when it suffices, otherwise the first of
 /// ρ·f, ρ·f², … (`f` = `increase`, at most `max_increases` times, at most `rho_max`) that
@@ -84,16 +76,7 @@ pub(super) fn penalty_for(
 /// The working set guessed from multipliers at the point of `p` (a warm start without a
 /// previous QP): equality rows and fixed variables always; an inequality side or a
 /// bound when its multiplier has the side's sign and exceeds its slack.
-pub(super) fn guess(p: &QpData, mult: &Mult) -> WorkingSet {
-    let mut w = WorkingSet {
-        rows: Vec::new(),
-        vars: Vec::new(),
-    };
-    guess_into(p, mult, &mut w);
-    w
-}
-
-/// [`guess`] into `w` (resized; no allocation once its vectors have grown to the sizes).
+/// Written into `w` (resized; no allocation once its vectors have grown to the sizes).
 pub(super) fn guess_into(p: &QpData, mult: &Mult, w: &mut WorkingSet) {
     let (n, m) = (p.x.len(), p.g.len());
     w.rows.clear();
@@ -139,40 +122,6 @@ fn hash_of(w: &WorkingSet) -> u64 {
     h.finish()
 }
 
-/// Solves the QP of `p` from the working set `start` (see the module documentation).
-/// `jp`, `hp`: the patterns of `p.jac` and `p.hess`; `n_elastic`: the length of the
-/// (zero) elastic part of the result; every factorisation is counted in `n_fact`.
-/// `factored`: `kkt` already holds the factorisation of `start`'s equality QP for this
-/// B, J and weights (`polish::factor_working_set`, the real-time iteration's
-/// preparation), so the first iteration only solves with it.
-pub(super) fn solve(
-    kkt: &mut Kkt,
-    p: &QpData,
-    pats: (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
-    start: WorkingSet,
-    limits: (usize, usize),
-    n_fact: &mut usize,
-    factored: bool,
-) -> Result<Solved, Failure> {
-    let mut w = start;
-    let mut res = QpResult::empty();
-    let mut scratch = Scratch::default();
-    let found = solve_in(
-        kkt,
-        p,
-        pats,
-        (&mut w, &mut res),
-        limits,
-        (n_fact, factored),
-        &mut scratch,
-    )?;
-    Ok(Solved {
-        res,
-        working_set: w,
-        iterations: found.iterations,
-    })
-}
-
 /// The work vectors of [`solve_in`], kept between QPs (no allocation once they have
 /// grown to the sizes and the most iterations seen).
 #[derive(Default)]
@@ -195,9 +144,14 @@ pub(super) struct Found {
     pub max_multiplier: f64,
 }
 
-/// [`solve`] in place: the working set `w` is the start and ends as the solution's (on
-/// failure: the last one tried), the result is written into `res` (its vectors reused),
-/// the work vectors are `scratch`'s. `(n_fact, factored)` as in [`solve`].
+/// Solves the QP of `p` from the working set `w` (see the module documentation) in
+/// place: `w` ends as the solution's (on failure: the last one tried), the result is
+/// written into `res` (its vectors reused), the work vectors are `scratch`'s. `jp`, `hp`:
+/// the patterns of `p.jac` and `p.hess`; `n_elastic`: the length of the (zero) elastic
+/// part of the result; every factorisation is counted in `n_fact`. `factored`: `kkt`
+/// already holds the factorisation of `w`'s equality QP for this B, J and weights
+/// (`polish::factor_working_set_in`, the real-time iteration's preparation), so the
+/// first iteration only solves with it.
 pub(super) fn solve_in(
     kkt: &mut Kkt,
     p: &QpData,
@@ -451,7 +405,46 @@ mod tests {
     //! bounds and fixed variables, feasible by construction; and on degenerate ones
     //! (duplicated rows, a bound duplicating a row), where the method may give up but
     //! must not return a wrong answer.
-    use super::{guess, keep_largest, penalty_for, solve, ChangeBudget, STALL_ITERATIONS};
+    use super::{
+        guess_into, keep_largest, penalty_for, solve_in, ChangeBudget, Failure, Scratch,
+        STALL_ITERATIONS,
+    };
+
+    /// A solved QP: its result, working set and iterations (the test's view of `solve_in`).
+    struct Solved {
+        res: QpResult,
+        working_set: WorkingSet,
+    }
+
+    /// The working set guessed from `mult` (`guess_into` into a new one).
+    fn guess(p: &QpData, mult: &Mult) -> WorkingSet {
+        let mut w = WorkingSet {
+            rows: Vec::new(),
+            vars: Vec::new(),
+        };
+        guess_into(p, mult, &mut w);
+        w
+    }
+
+    /// `solve_in` from `start` with new vectors.
+    fn solve(
+        kkt: &mut Kkt,
+        p: &QpData,
+        pats: (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+        mut w: WorkingSet,
+        limits: (usize, usize),
+        n_fact: &mut usize,
+        factored: bool,
+    ) -> Result<Solved, Failure> {
+        let mut res = QpResult::empty();
+        let mut scratch = Scratch::default();
+        let ws = (&mut w, &mut res);
+        solve_in(kkt, p, pats, ws, limits, (n_fact, factored), &mut scratch)?;
+        Ok(Solved {
+            res,
+            working_set: w,
+        })
+    }
     use crate::kkt::Kkt;
     use crate::sqp::iterate::Mult;
     use crate::sqp::polish::Side;

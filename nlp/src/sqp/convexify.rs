@@ -66,18 +66,7 @@ impl Curvature {
 /// a constraint the step should leave it acts as a proximal term of weight ρ_a and the
 /// iterates creep (the gap-crossing planner crawled at ‖d‖ ≈ 1e-4 for 3000 iterations
 /// with complementarity error 5e3 when "at the bound" counted as active).
-pub(super) fn active_sets(
-    geo: &Geometry,
-    x: &[f64],
-    g: &[f64],
-    mult: &Mult,
-) -> (Vec<bool>, Vec<bool>) {
-    let mut active = (Vec::new(), Vec::new());
-    active_sets_into(geo, x, g, mult, &mut active);
-    active
-}
-
-/// [`active_sets`] into `(rows, bounds)` (resized; no allocation once grown to m and n).
+/// Written into `(rows, bounds)` (resized; no allocation once grown to m and n).
 pub(super) fn active_sets_into(
     geo: &Geometry,
     x: &[f64],
@@ -189,19 +178,8 @@ impl Convexify<'_> {
     /// more: the step control's proximal shift is the caller's, applied on top (mixing it
     /// into `delta_last` made one cut step damp the next iterations through the δ/3
     /// memory, see `SqpState::convexify`).
-    pub fn run(
-        self,
-        o: &SqpOptions,
-        delta_last: f64,
-        rho_last: f64,
-        n_fact: &mut usize,
-    ) -> Option<(f64, f64)> {
-        let last = (delta_last, rho_last);
-        self.run_in(o, last, n_fact, &mut ConvexifyScratch::default())
-    }
-
-    /// [`Convexify::run`] with the diagonals of the tests in `scratch`'s vectors;
-    /// `(delta_last, rho_last)` as there.
+    /// `(delta_last, rho_last)`: the last iteration's; the diagonals of the tests are in
+    /// `scratch`'s vectors.
     pub fn run_in(
         mut self,
         o: &SqpOptions,

@@ -31,13 +31,7 @@ impl Mult {
 
     /// The QP's multipliers; with the augmented term ½ρ_a‖J_A d‖² the row multiplier is
     /// λ_i + ρ_a·J_i d (the dual of `J_i d − w_i = 0`), which tends to λ_i as d → 0.
-    pub fn from_qp(r: &QpResult) -> Mult {
-        let mut mult = Mult::zeros(0, 0, 0);
-        mult.set_from_qp(r);
-        mult
-    }
-
-    /// [`Mult::from_qp`] into these vectors (no allocation once they have the sizes).
+    /// Written into these vectors (no allocation once they have the sizes).
     pub fn set_from_qp(&mut self, r: &QpResult) {
         self.lambda.clear();
         self.lambda

@@ -3,7 +3,7 @@
 //!
 //! Each iteration at x_k (with multipliers λ_k):
 //! 1. **Hessian.** B = ∇²L(x_k, λ_k) + δI + ρ_a·(J_AᵀJ_A + I_b) over the strongly active
-//!    rows and bounds A (`active_sets`): δ is chosen for positive definiteness on the
+//!    rows and bounds A (`active_sets_into`): δ is chosen for positive definiteness on the
 //!    null space of the active constraints and ρ_a as small as makes B itself positive
 //!    definite (inertia tests with a faer LDLᵀ, `Convexify`): clarabel needs a convex
 //!    QP. Alternatively damped BFGS ([`HessianApproximation`]).

@@ -134,7 +134,7 @@ pub(super) struct EqScratch {
 /// a row i with weight w_i > 0 gets the diagonal −1/w_i (its multiplier is then
 /// w_i·J_i d, the term's gradient), a bound weight is added to the diagonal of B (rows
 /// and bounds of W need neither: the term is constant on W). `None` unless the inertia is
-/// (n, m) and the solve accurate. The two halves, [`factor_working_set`] and
+/// (n, m) and the solve accurate. The two halves, [`factor_working_set_in`] and
 /// [`solve_working_set_into`], may run apart (the real-time iteration factorises before the
 /// new initial state is known).
 pub(super) fn equality_qp_step(
@@ -173,16 +173,7 @@ fn fixing_weight(p: &QpData) -> f64 {
 /// Factorises the KKT matrix of W's equality QP (see [`equality_qp_step`]): it depends on
 /// B, J, the weights and W, not on the constraint values or the point. `false` unless the
 /// inertia is (n, m).
-pub(super) fn factor_working_set(
-    kkt: &mut Kkt,
-    p: &QpData,
-    w: &WorkingSet,
-    n_fact: &mut usize,
-) -> bool {
-    factor_working_set_in(kkt, p, w, n_fact, &mut EqScratch::default())
-}
-
-/// [`factor_working_set`] with the diagonals in `scratch`'s vectors.
+/// The diagonals are in `scratch`'s vectors.
 pub(super) fn factor_working_set_in(
     kkt: &mut Kkt,
     p: &QpData,
@@ -213,7 +204,7 @@ pub(super) fn factor_working_set_in(
         Ok(inertia) if inertia.positive == n && inertia.negative == m)
 }
 
-/// Solves W's equality QP with the factorisation [`factor_working_set`] left in `kkt`
+/// Solves W's equality QP with the factorisation [`factor_working_set_in`] left in `kkt`
 /// for the same B, J, weights and W (the point and the constraint values may differ),
 /// in `scratch`'s vectors; the step and multipliers are written into `d` and `lambda`
 /// (resized). `false` when the solve is inaccurate.

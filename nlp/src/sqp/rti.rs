@@ -29,11 +29,11 @@ use std::time::Instant;
 use thiserror::Error;
 
 use super::active_set;
-use super::convexify::{active_sets, Convexify};
+use super::convexify::{active_sets_into, Convexify, ConvexifyScratch};
 use super::geometry::Geometry;
 use super::iterate::{Errors, Iterate, Mult};
 use super::options::{HessianApproximation, SqpOptions};
-use super::polish::{factor_working_set, WorkingSet};
+use super::polish::{factor_working_set_in, EqScratch, WorkingSet};
 use super::qp::{Qp, QpResult};
 use super::shape::Shape;
 use super::state::{new_qp, Curvature};
@@ -46,6 +46,7 @@ use crate::numeric::NumericNlp;
 use crate::ocp::{OcpError, Shift, Transcription};
 use crate::problem::BuildError;
 use crate::solution::{Solution, Stats, Status};
+use symx::Evaluator;
 
 /// Why a real-time iteration could not be set up or carried out.
 #[derive(Debug, Error)]
@@ -180,8 +181,10 @@ pub struct Rti {
     kkt: Kkt,
     /// clarabel's elastic QP, laid out on the first fallback.
     qp: Option<Qp>,
-    /// The working set prepared (and, after a feedback, the one of its QP).
-    working_set: Option<WorkingSet>,
+    /// The working set prepared (and, after a feedback, the one of its QP), when
+    /// `has_working_set`; otherwise the next preparation guesses one.
+    working_set: WorkingSet,
+    has_working_set: bool,
     /// Whether `kkt` holds the factorisation of `working_set`'s equality QP.
     factored: bool,
     /// The shift δ of the prepared B.
@@ -192,6 +195,36 @@ pub struct Rti {
     lgrad: Vec<f64>,
     /// Scratch: J d, for the QP model's prediction.
     jd: Vec<f64>,
+    work: Work,
+}
+
+/// The work vectors of the two phases, kept between steps: a steady-state preparation
+/// and feedback allocate nothing (`nlp/tests/rti.rs`), except when clarabel's fallback
+/// solves the QP.
+struct Work {
+    /// The convexification's strongly active rows and bounds.
+    active: (Vec<bool>, Vec<bool>),
+    convexify: ConvexifyScratch,
+    /// The diagonals of the preparation's factorisation.
+    eq: EqScratch,
+    /// The active-set method's vectors.
+    qp: active_set::Scratch,
+    /// The QP's result.
+    res: QpResult,
+    /// The QP's multipliers of the problem (`Mult::set_from_qp`).
+    mult: Mult,
+}
+
+/// How the feedback's QP was solved.
+struct QpOutcome {
+    /// Whether a result is in `Work::res`.
+    solved: bool,
+    /// Active-set iterations (0 when clarabel solved it).
+    iterations: usize,
+    /// Factorisations.
+    factorizations: usize,
+    /// Whether clarabel solved it.
+    fallback: bool,
 }
 
 impl Rti {
@@ -264,7 +297,11 @@ impl Rti {
             curv,
             kkt,
             qp: None,
-            working_set: None,
+            working_set: WorkingSet {
+                rows: Vec::with_capacity(m),
+                vars: Vec::with_capacity(n),
+            },
+            has_working_set: false,
             factored: false,
             delta: 0.0,
             prepared: false,
@@ -272,6 +309,14 @@ impl Rti {
             residual: RtiResidual::default(),
             lgrad: vec![0.0; n],
             jd: vec![0.0; m],
+            work: Work {
+                active: (Vec::with_capacity(m), Vec::with_capacity(n)),
+                convexify: ConvexifyScratch::default(),
+                eq: EqScratch::default(),
+                qp: active_set::Scratch::default(),
+                res: QpResult::empty(),
+                mult: Mult::zeros(n, m, 0),
+            },
         })
     }
 
@@ -283,6 +328,15 @@ impl Rti {
             .ok_or(RtiError::NoInitialStateParameter)?
             .to_string();
         Rti::new(tr.compile()?, &name, options)
+    }
+
+    /// This real-time iteration with its problem's functions evaluated by `evaluator`
+    /// ([`Compiled::with_evaluator`]: e.g. `Evaluator::Jit`, native code with the tape's
+    /// values bit for bit, so the same iterates, faster). Errors: native code cannot be
+    /// generated (e.g. built without the `jit` feature).
+    pub fn with_evaluator(self, evaluator: Evaluator) -> Result<Rti, RtiError> {
+        let compiled = self.compiled.with_evaluator(evaluator)?;
+        Ok(Rti { compiled, ..self })
     }
 
     /// Starts from `guess` (x and the multipliers λ, z_L, z_U; e.g. a converged solve of
@@ -299,7 +353,7 @@ impl Rti {
         }
         self.plan.objective = guess.objective;
         self.prepared = false;
-        self.working_set = None;
+        self.has_working_set = false;
         Ok(())
     }
 
@@ -324,14 +378,14 @@ impl Rti {
         self.residual = residual(&err);
         self.delta = self.convexify()?;
         let data = qp_data(&self.it, &self.geo, &self.curv, false, self.delta, 0.0);
-        let start = self
-            .working_set
-            .take()
-            .filter(|w| active_set::fits(w, &data))
-            .unwrap_or_else(|| active_set::guess(&data, &self.it.mult));
+        let w = &mut self.working_set;
+        if !(self.has_working_set && active_set::fits(w, &data)) {
+            active_set::guess_into(&data, &self.it.mult, w);
+        }
+        self.has_working_set = true;
         let mut n_fact = 0;
-        self.factored = factor_working_set(&mut self.kkt, &data, &start, &mut n_fact);
-        self.working_set = Some(start);
+        let eq = &mut self.work.eq;
+        self.factored = factor_working_set_in(&mut self.kkt, &data, w, &mut n_fact, eq);
         self.prepared = true;
         Ok(())
     }
@@ -354,13 +408,12 @@ impl Rti {
         }
         self.insert_initial_state(x0)?;
         self.prepared = false;
-        let (solved, qp_iterations, factorizations, fallback) = self.solve_qp();
-        let status = match solved {
-            Some(res) => {
-                self.take_step(&res);
-                Status::RealTimeIterationTaken
-            }
-            None => Status::ErrorInStepComputation,
+        let qp = self.solve_qp();
+        let status = if qp.solved {
+            self.take_step();
+            Status::RealTimeIterationTaken
+        } else {
+            Status::ErrorInStepComputation
         };
         self.plan.status = status;
         self.plan.parameters.clear();
@@ -375,9 +428,9 @@ impl Rti {
             .fold(0.0f64, |a, (p, x)| a.max((p - x).abs()));
         Ok(Feedback {
             status,
-            qp_iterations,
-            factorizations,
-            fallback,
+            qp_iterations: qp.iterations,
+            factorizations: qp.factorizations,
+            fallback: qp.fallback,
             step_norm,
             seconds: start.elapsed().as_secs_f64(),
         })
@@ -466,37 +519,38 @@ impl Rti {
 
     /// B's convexification at the linearisation point (as the SQP's), returning δ.
     fn convexify(&mut self) -> Result<f64, RtiError> {
-        let (it, curv) = (&self.it, &mut self.curv);
-        let (active_r, active_b) = active_sets(&self.geo, &it.x, &it.g, &it.mult);
+        let (it, curv, work) = (&self.it, &mut self.curv, &mut self.work);
+        active_sets_into(&self.geo, &it.x, &it.g, &it.mult, &mut work.active);
+        let (active_r, active_b) = &work.active;
         let conv = Convexify {
             kkt: &mut self.kkt,
             hv: &curv.hv,
             jv: &it.jv,
-            active_r: &active_r,
-            active_b: &active_b,
+            active_r,
+            active_b,
         };
         let mut n_fact = 0;
+        let last = (curv.delta_last, curv.rho_a_last);
         let (delta, rho_a) = conv
-            .run(&self.options, curv.delta_last, curv.rho_a_last, &mut n_fact)
+            .run_in(&self.options, last, &mut n_fact, &mut work.convexify)
             .ok_or(RtiError::Unsupported(
                 "a Hessian that no shift up to max_hessian_shift convexifies",
             ))?;
         curv.rho_a_last = rho_a;
         curv.delta_last = delta;
-        for (w, &a) in curv.row_weight.iter_mut().zip(&active_r) {
+        for (w, &a) in curv.row_weight.iter_mut().zip(active_r) {
             *w = if a { rho_a } else { 0.0 };
         }
-        for (w, &a) in curv.bound_weight.iter_mut().zip(&active_b) {
+        for (w, &a) in curv.bound_weight.iter_mut().zip(active_b) {
             *w = if a { rho_a } else { 0.0 };
         }
         Ok(delta)
     }
 
-    /// The QP at the prepared linearisation with the current g: the active-set method from
-    /// the prepared working set (and factorisation), else clarabel's elastic QP with
-    /// ρ = `penalty_max`. Returns the result, the active-set iterations, the
-    /// factorisations and whether clarabel solved it.
-    fn solve_qp(&mut self) -> (Option<QpResult>, usize, usize, bool) {
+    /// The QP at the prepared linearisation with the current g, its result into
+    /// `work.res`: the active-set method from the prepared working set (and
+    /// factorisation), else clarabel's elastic QP with ρ = `penalty_max` (which allocates).
+    fn solve_qp(&mut self) -> QpOutcome {
         let o = &self.options;
         let data = qp_data(
             &self.it,
@@ -508,23 +562,29 @@ impl Rti {
         );
         let mut n_fact = 0;
         if o.qp_active_set {
-            let start = self
-                .working_set
-                .take()
-                .unwrap_or_else(|| active_set::guess(&data, &self.it.mult));
-            let solved = active_set::solve(
+            let w = &mut self.working_set;
+            if !self.has_working_set {
+                active_set::guess_into(&data, &self.it.mult, w);
+            }
+            let solved = active_set::solve_in(
                 &mut self.kkt,
                 &data,
                 (&self.shape.jp, &self.shape.hp),
-                start,
+                (w, &mut self.work.res),
                 (o.qp_active_set_max_iter as usize, 0),
-                &mut n_fact,
-                self.factored,
+                (&mut n_fact, self.factored),
+                &mut self.work.qp,
             );
             self.factored = false;
-            if let Ok(s) = solved {
-                self.working_set = Some(s.working_set);
-                return (Some(s.res), s.iterations, n_fact, false);
+            // On failure `w` is the last working set tried: the next preparation guesses.
+            self.has_working_set = solved.is_ok();
+            if let Ok(found) = solved {
+                return QpOutcome {
+                    solved: true,
+                    iterations: found.iterations,
+                    factorizations: n_fact,
+                    fallback: false,
+                };
             }
         }
         let qp = self
@@ -537,20 +597,31 @@ impl Rti {
                     | clarabel::solver::SolverStatus::AlmostSolved
             ) && r.e.iter().all(|e| *e <= o.elastic_tol)
         });
-        (res, 0, n_fact, true)
+        let solved = res.is_some();
+        if let Some(res) = res {
+            self.work.res = res;
+        }
+        QpOutcome {
+            solved,
+            iterations: 0,
+            factorizations: n_fact,
+            fallback: true,
+        }
     }
 
-    /// The plan ← x̄ + d with the QP's multipliers, its predicted g and objective.
-    fn take_step(&mut self, res: &QpResult) {
+    /// The plan ← x̄ + d with the QP's multipliers (of `work.res`), its predicted g and
+    /// objective.
+    fn take_step(&mut self) {
         let (it, plan, shape) = (&self.it, &mut self.plan, &self.shape);
+        let (res, mult) = (&self.work.res, &mut self.work.mult);
         for j in 0..shape.n {
             plan.x[j] = it.x[j] + res.d[j];
         }
-        let mult = Mult::from_qp(res);
+        mult.set_from_qp(res);
         plan.lambda.copy_from_slice(&mult.lambda);
         // The augmented term ρ_a·d_j of an active bound is in the QP's bound multiplier
         // but not in the problem's Lagrangian (as ρ_a·J_i d of a row is in λ, which
-        // `from_qp` removes): without it the multipliers of a long step (a jump of the
+        // `set_from_qp` removes): without it the multipliers of a long step (a jump of the
         // initial state) would be off by ρ_a·d_j. The SQP's steps shrink to 0, RTI's not.
         for j in 0..shape.n {
             let z = mult.z_l[j] - mult.z_u[j] - self.curv.bound_weight[j] * res.d[j];
