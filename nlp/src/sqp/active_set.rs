@@ -19,11 +19,12 @@
 //!
 //! When the total violation of the proposed changes stops falling, the method applies
 //! only the largest half of them, and so on down to one (`ChangeBudget`); when a working
-//! set repeats, one entry per iteration (the largest violation) from then on. It gives up (`Err`, and the caller solves the QP with
-//! clarabel) when a working set repeats again, after `max_iter` iterations, and when the
-//! equality QP of a working set is singular or has the wrong inertia (dependent active
-//! rows, or B not convex on W's null space). A solution whose multipliers exceed the ℓ1
-//! penalty ρ is the elastic QP's only for a larger ρ ([`penalty_for`]).
+//! set repeats, one entry per iteration (the largest violation) from then on. It gives
+//! up (`Err`, and the caller solves the QP with clarabel) when a working set repeats
+//! again, after `max_iter` iterations, and when the equality QP of a working set is
+//! singular or has the wrong inertia (dependent active rows, or B not convex on W's null
+//! space). A solution whose multipliers exceed the ℓ1 penalty ρ is the elastic QP's only
+//! for a larger ρ ([`penalty_for`]).
 
 use std::hash::{DefaultHasher, Hash, Hasher};
 
@@ -410,7 +411,7 @@ mod tests {
         STALL_ITERATIONS,
     };
 
-    /// A solved QP: its result, working set and iterations (the test's view of `solve_in`).
+    /// A solved QP: its result and working set (the test's view of `solve_in`).
     struct Solved {
         res: QpResult,
         working_set: WorkingSet,
