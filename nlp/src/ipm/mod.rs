@@ -291,7 +291,7 @@ impl Solver for Ipm {
         previous: &Solution,
         out: &mut Solution,
     ) -> Result<(), SolveError> {
-        self.run_into(nlp, Some(previous), None, out)
+        Ipm::solve_warm_into(self, nlp, previous, out)
     }
 }
 

@@ -114,7 +114,7 @@ impl Solver for Sqp {
         previous: &Solution,
         out: &mut Solution,
     ) -> Result<(), SolveError> {
-        self.run_into(nlp, Some(previous), None, out)
+        Sqp::solve_warm_into(self, nlp, previous, out)
     }
 }
 
