@@ -377,3 +377,32 @@ fn a_nan_constant_first_keeps_its_place() {
         assert_ne!(xs[0].to_bits(), f64::NAN.to_bits());
     });
 }
+
+/// Paired instructions whose second operand is a pair of different constants, which the
+/// JIT loads from its pool of constant pairs (folded into the SIMD instruction): each lane
+/// must get its own constant, special values and NaN payloads included, for `+ − × ÷` on
+/// every special operand.
+#[test]
+fn constant_pairs_keep_their_lanes() {
+    let mut special = SPECIAL.to_vec();
+    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
+    special.push(f64::from_bits(0xfff8_0000_0000_0002));
+    special.push(-f64::NAN);
+    let n = special.len();
+    let x = Matrix::sym_vec("x", n);
+    let binary: [fn(Expr, Expr) -> Expr; 4] =
+        [|a, b| a + b, |a, b| a - b, |a, b| a * b, |a, b| a / b];
+    for shift in [0, 1, 5] {
+        let mut outs = Vec::new();
+        for op in binary {
+            // Consecutive alike instructions: paired, each pair with two constants.
+            outs.extend((0..n).map(|i| op(x[i], Expr::from(special[(i + shift) % n]))));
+            outs.extend((0..n).map(|i| op(x[i], Expr::from(0.25 + i as f64))));
+        }
+        let f = Function::new(&[&x], &[&outs]).unwrap();
+        for s in 0..n {
+            let xs: Vec<f64> = (0..n).map(|i| special[(i * 3 + s) % n]).collect();
+            same_bits(&f, &[&xs]);
+        }
+    }
+}

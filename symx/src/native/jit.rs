@@ -11,6 +11,7 @@
 //! to be spilled); a backward liveness pass decides. Constants are immediates, and only
 //! the constant outputs of the template are written. A call of another function gathers its arguments into the scratch block and
 //! calls that function's machine code, compiled once in the same module.
+use super::constant_pairs::{ConstantPairs, Pair};
 use super::lanes::{self, Operand, Step};
 use super::{Entry, SymxError};
 use crate::function::{Function, Instr};
@@ -43,11 +44,12 @@ const WINDOW: usize = 48;
 /// ones by a copy.
 const INLINE_TEMPLATE: usize = 16;
 
-/// What the machine code needs alive: the code memory, the templates it copies and the
-/// tables it reads (through raw pointers).
+/// What the machine code needs alive: the code memory, the templates it copies, the pools
+/// of constant pairs it reads and the tables it reads (through raw pointers).
 pub(crate) struct Owner {
     module: Option<JITModule>,
     _templates: Vec<Vec<f64>>,
+    _pools: Vec<Vec<Pair>>,
     _tables: Vec<Arc<Table>>,
 }
 
@@ -106,6 +108,7 @@ pub(crate) fn compile(f: &Function) -> Result<(Entry, Owner, usize, usize), Symx
         fbc: FunctionBuilderContext::new(),
         compiled: FxHashMap::default(),
         templates: Vec::new(),
+        pools: Vec::new(),
         tables: Vec::new(),
         functions: 0,
         instructions: 0,
@@ -118,6 +121,7 @@ pub(crate) fn compile(f: &Function) -> Result<(Entry, Owner, usize, usize), Symx
     let owner = Owner {
         module: Some(jit.module),
         _templates: jit.templates,
+        _pools: jit.pools,
         _tables: jit.tables,
     };
     Ok((entry, owner, jit.functions, jit.instructions))
@@ -130,6 +134,9 @@ struct Jit {
     /// Functions compiled, by identity: their entry points.
     compiled: FxHashMap<u64, FuncId>,
     templates: Vec<Vec<f64>>,
+    /// The constant pairs of each machine-code function's SIMD instructions (see
+    /// [`ConstantPairs`]).
+    pools: Vec<Vec<Pair>>,
     tables: Vec<Arc<Table>>,
     functions: usize,
     instructions: usize,
@@ -247,9 +254,15 @@ impl Jit {
     ) -> Result<(), SymxError> {
         self.ctx.func.signature = self.signature();
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let params = prologue(&mut b, layout);
+        let params = prologue(&mut b, layout, None);
         let entry = params.entry;
-        let mut e = Emitter::new(&mut b, &mut self.module, params, layout);
+        let mut e = Emitter::new(
+            &mut b,
+            &mut self.module,
+            params,
+            layout,
+            ConstantPairs::default(),
+        );
         e.template();
         for &c in chunk_ids {
             let r = e.module.declare_func_in_func(c, e.b.func);
@@ -274,31 +287,36 @@ impl Jit {
         ranges: &[(usize, usize)],
     ) -> Result<(), SymxError> {
         self.ctx.func.signature = self.signature();
+        let regs = lanes::Registers {
+            constant: &layout.constant,
+            input_of: &layout.input_of,
+            output_of: &layout.output_of,
+            store: &layout.store,
+            last_reader: &layout.last_reader,
+        };
+        let steps: Vec<Step> = ranges
+            .iter()
+            .flat_map(|&(start, end)| lanes::steps(layout.f, &regs, start, end))
+            .collect();
+        let (pairs, pool) = ConstantPairs::of(&steps, &layout.constant);
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let params = prologue(&mut b, layout);
-        let mut e = Emitter::new(&mut b, &mut self.module, params, layout);
+        let params = prologue(&mut b, layout, Some(pool.as_ptr() as i64));
+        let mut e = Emitter::new(&mut b, &mut self.module, params, layout, pairs);
         if with_template {
             e.template();
         }
-        for &(start, end) in ranges {
-            let regs = lanes::Registers {
-                constant: &layout.constant,
-                input_of: &layout.input_of,
-                output_of: &layout.output_of,
-                store: &layout.store,
-                last_reader: &layout.last_reader,
-            };
-            for step in lanes::steps(layout.f, &regs, start, end) {
-                match step {
-                    Step::Single(i) => e.instruction(i),
-                    Step::Pair {
-                        start,
-                        len,
-                        operands,
-                    } => e.pair(start, len, &operands),
-                }
+        for step in steps {
+            match step {
+                Step::Single(i) => e.instruction(i),
+                Step::Pair {
+                    start,
+                    len,
+                    operands,
+                } => e.pair(start, len, &operands),
             }
         }
+        // The pool's heap buffer does not move with the `Vec`: the address stays valid.
+        self.pools.push(pool);
         b.ins().return_(&[]);
         b.finalize();
         self.module
@@ -322,11 +340,15 @@ struct Params {
     /// parameter, kept in a register, where Cranelift would materialise a constant again
     /// at every use.
     template: Value,
+    /// The address of this machine-code function's pool of constant pairs (see
+    /// [`ConstantPairs`]), likewise.
+    pool: Value,
 }
 
 /// The entry block of a machine-code function: the address of each input and output (from
-/// `args` and `res`, or in `w` when `args` is null) and of the template, computed once.
-fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
+/// `args` and `res`, or in `w` when `args` is null), of the template and of the pool of
+/// constant pairs (`pool`, if the function has one), computed once.
+fn prologue(b: &mut FunctionBuilder, layout: &Layout, pool: Option<i64>) -> Params {
     let f = layout.f;
     let entry_block = b.create_block();
     b.append_block_params_for_function_params(entry_block);
@@ -340,6 +362,7 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
         inputs: Vec::new(),
         outputs: Vec::new(),
         template: w,
+        pool: w,
     };
     let ptr = types::I64;
     let flags = MemFlags::trusted();
@@ -347,7 +370,9 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
     let direct = b.create_block();
     let in_w = b.create_block();
     let body = b.create_block();
-    for _ in 0..n_in + n_out + 1 {
+    let addresses = [Some(layout.template as i64), pool];
+    let extra = addresses.iter().flatten().count();
+    for _ in 0..n_in + n_out + extra {
         b.append_block_param(body, ptr);
     }
     b.ins().brif(args, direct, &[], in_w, &[]);
@@ -360,7 +385,9 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
     for k in 0..n_out {
         bases.push(b.ins().load(ptr, flags, res, 8 * k as i32).into());
     }
-    bases.push(b.ins().iconst(ptr, layout.template as i64).into());
+    for &a in addresses.iter().flatten() {
+        bases.push(b.ins().iconst(ptr, a).into());
+    }
     b.ins().jump(body, &bases);
     b.switch_to_block(in_w);
     b.seal_block(in_w);
@@ -368,7 +395,9 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
     let mut bases: Vec<_> = offsets
         .map(|&at| b.ins().iadd_imm(w, 8 * at as i64).into())
         .collect();
-    bases.push(b.ins().iconst(ptr, layout.template as i64).into());
+    for &a in addresses.iter().flatten() {
+        bases.push(b.ins().iconst(ptr, a).into());
+    }
     b.ins().jump(body, &bases);
     b.switch_to_block(body);
     b.seal_block(body);
@@ -376,6 +405,9 @@ fn prologue(b: &mut FunctionBuilder, layout: &Layout) -> Params {
     params.inputs = ps[..n_in].to_vec();
     params.outputs = ps[n_in..n_in + n_out].to_vec();
     params.template = ps[n_in + n_out];
+    if pool.is_some() {
+        params.pool = ps[n_in + n_out + 1];
+    }
     params
 }
 
@@ -494,7 +526,7 @@ struct Emitter<'a, 'b> {
     layout: &'a Layout<'a>,
     /// The SSA value of each register read or written in this function so far, and the
     /// instruction of its last access.
-    values: FxHashMap<u32, (Value, usize)>,
+    values: FxHashMap<u32, (Held, usize)>,
     /// The instruction being emitted.
     at: usize,
     flags: MemFlags,
@@ -505,6 +537,20 @@ struct Emitter<'a, 'b> {
     slot: Option<StackSlot>,
     /// The sign mask loaded by [`Emitter::negate`] and the instruction of its last use.
     sign_mask: Option<(Value, usize)>,
+    /// Where the constant pairs of this function's SIMD instructions lie in its pool.
+    pairs: ConstantPairs,
+}
+
+/// How the machine code holds a register's value.
+#[derive(Clone, Copy)]
+enum Held {
+    /// In a scalar SSA value.
+    Scalar(Value),
+    /// In a lane of an `f64x2` value, extracted only when read: an `extractlane` nobody
+    /// reads would still count as a use of the vector for Cranelift, and a vector used more
+    /// than once makes its operands' loads (constant pairs above all) unfit to fold into
+    /// the instruction as memory operands.
+    Lane(Value, u8),
 }
 
 type Unary = extern "C" fn(f64) -> f64;
@@ -516,6 +562,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
         module: &'a mut JITModule,
         params: Params,
         layout: &'a Layout<'a>,
+        pairs: ConstantPairs,
     ) -> Self {
         Emitter {
             b,
@@ -532,6 +579,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
             copy: None,
             slot: None,
             sign_mask: None,
+            pairs,
         }
     }
 
@@ -556,11 +604,18 @@ impl<'a, 'b> Emitter<'a, 'b> {
     /// `fadd`/`fmul`, and x86 returns the first operand's NaN when both are NaN: the swap
     /// would change a NaN's sign or payload.
     fn operand(&mut self, r: u32, first: bool) -> Value {
-        if let Some((v, last)) = self.values.get_mut(&r) {
+        if let Some((held, last)) = self.values.get_mut(&r) {
             // (A paired instruction may read before a later-positioned access of its pair.)
             if self.at.saturating_sub(*last) <= WINDOW {
                 *last = (*last).max(self.at);
-                return *v;
+                return match *held {
+                    Held::Scalar(v) => v,
+                    Held::Lane(v, lane) => {
+                        let x = self.b.ins().extractlane(v, lane);
+                        *held = Held::Scalar(x);
+                        x
+                    }
+                };
             }
         }
         let (base, offset) = match (
@@ -569,7 +624,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
         ) {
             (Some(c), _) if c.is_nan() || c.to_bits() == 0 => {
                 let v = self.constant(c);
-                self.values.insert(r, (v, self.at));
+                self.values.insert(r, (Held::Scalar(v), self.at));
                 return v;
             }
             // Loaded afresh at every use (not kept in a register), so that the load folds
@@ -585,7 +640,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
         } else {
             self.b.ins().load(types::F64, self.flags, base, offset)
         };
-        self.values.insert(r, (v, self.at));
+        self.values.insert(r, (Held::Scalar(v), self.at));
         v
     }
 
@@ -655,6 +710,13 @@ impl<'a, 'b> Emitter<'a, 'b> {
         let ty = types::F64X2;
         let c = &self.layout.constant;
         if let (Some(x), Some(y)) = (c[r1 as usize], c[r2 as usize]) {
+            // From the pool (the load folds into its user as a memory operand), except as
+            // the first operand of a commutative operation (see [`Emitter::operand`]).
+            if let Some(offset) = self.pairs.offset(x, y).filter(|_| !first) {
+                // (Aligned: the pool's pairs are 16-byte aligned.)
+                let flags = MemFlags::trusted().with_readonly();
+                return self.b.ins().load(ty, flags, self.params.pool, offset);
+            }
             let bytes: Vec<u8> = [x, y].iter().flat_map(|v| v.to_le_bytes()).collect();
             let k = self.b.func.dfg.constants.insert(ConstantData::from(bytes));
             return self.b.ins().vconst(ty, k);
@@ -671,8 +733,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
                 };
                 // The scalars stay reachable as lanes of the vector.
                 for (r, at, lane) in [(r1, at1, 0), (r2, at2, 1)] {
-                    let x = self.b.ins().extractlane(v, lane);
-                    self.values.insert(r, (x, at));
+                    self.values.insert(r, (Held::Lane(v, lane), at));
                 }
                 return v;
             }
@@ -741,8 +802,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
                 let i = start + lane as usize * len + j;
                 let d = f.tape[i].d;
                 self.at = i;
-                let x = self.b.ins().extractlane(v, lane);
-                self.values.insert(d, (x, i));
+                self.values.insert(d, (Held::Lane(v, lane), i));
                 if lane == 1 && stored[j] {
                     continue;
                 }
@@ -769,7 +829,10 @@ impl<'a, 'b> Emitter<'a, 'b> {
                         continue;
                     }
                 }
-                self.put(d, x, store);
+                if store || out.is_some() {
+                    let x = self.b.ins().extractlane(v, lane);
+                    self.put(d, x, store);
+                }
             }
         }
     }
@@ -777,7 +840,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
     /// Sets register `r` to `v`: stored to the work vector if `store`, and to the caller's
     /// output if `r` is an output slot (written once by the tape).
     fn put(&mut self, r: u32, v: Value, store: bool) {
-        self.values.insert(r, (v, self.at));
+        self.values.insert(r, (Held::Scalar(v), self.at));
         if store {
             self.b.ins().store(self.flags, v, self.w, 8 * r as i32);
         }

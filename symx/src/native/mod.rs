@@ -8,9 +8,12 @@
 //! results are bit-identical to the tape's, NaN and infinities included.
 mod c_source;
 #[cfg(feature = "jit")]
+mod constant_pairs;
+#[cfg(feature = "jit")]
 mod jit;
 #[cfg(feature = "jit")]
 mod lanes;
+mod places;
 mod rust_source;
 
 use crate::error::SymxError;

@@ -8,6 +8,7 @@
 //! temporaries (and the arguments gathered for a call of another function), so
 //! `WORK_SIZE` counts only those: the tape's registers from its first temporary on
 //! (`first_temporary`), already reused by liveness when the tape was compiled.
+use super::places::{callee_base, constant_outputs, first_temporary, places, work_need, Place};
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
 use crate::function::{Function, Instr};
@@ -17,84 +18,6 @@ use std::fmt::Write;
 
 /// Tape instructions per generated function (keeps rustc's compile time linear).
 const CHUNK: usize = 1024;
-
-/// Where the generated code finds a register of one function.
-#[derive(Clone, Copy)]
-enum Place {
-    /// Entry `i` of input `k`: `*xk.add(i)`.
-    Input(usize, usize),
-    /// Entry `i` of output `k`: `*yk.add(i)`.
-    Output(usize, usize),
-    /// A constant (a template register no instruction writes): a literal.
-    Constant(f64),
-    /// A temporary: `*w.add(r)`.
-    Work(usize),
-}
-
-/// The first register of `f`'s temporaries: the tape's registers before it are its inputs,
-/// constants and output slots (`[inputs | constants | outputs | temporaries | call
-/// scratch]`), which the generated code keeps elsewhere; register `r` from here on is
-/// `w[r - first_temporary(f)]`.
-fn first_temporary(f: &Function) -> usize {
-    f.template_start + f.template.len()
-}
-
-/// The length of the work vector of `f`'s generated code: its temporaries, then, when it
-/// calls other functions, the largest callee's gathered arguments and work vector.
-fn work_need(f: &Function) -> usize {
-    let callees = f
-        .calls
-        .iter()
-        .map(|c| callee_base(&c.function) + work_need(&c.function));
-    f.call_scratch - first_temporary(f) + callees.max().unwrap_or(0)
-}
-
-/// Where a callee's own work vector starts in its scratch block: after its arguments,
-/// gathered there in the layout of its inputs.
-fn callee_base(g: &Function) -> usize {
-    g.template_start
-}
-
-/// The place of every register of `f`. Inputs and constants are never written (compilation
-/// gives temporaries only registers after the output slots).
-fn places(f: &Function) -> Vec<Place> {
-    let t = first_temporary(f);
-    let mut p: Vec<Place> = (0..f.work_size)
-        .map(|r| Place::Work(r.saturating_sub(t)))
-        .collect();
-    for (k, &v) in f.template.iter().enumerate() {
-        p[f.template_start + k] = Place::Constant(v);
-    }
-    for (k, (&n, &at)) in f.input_sizes.iter().zip(&f.input_offsets).enumerate() {
-        (0..n).for_each(|i| p[at + i] = Place::Input(k, i));
-    }
-    for (k, (&n, &at)) in f.output_sizes.iter().zip(&f.output_offsets).enumerate() {
-        (0..n).for_each(|i| p[at + i] = Place::Output(k, i));
-    }
-    p
-}
-
-/// The output entries no instruction writes (constant outputs), with their values.
-fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
-    let mut written = vec![false; f.work_size];
-    for ins in &f.tape {
-        if ins.op == Op::Call {
-            let call = &f.calls[ins.d as usize];
-            let n: usize = call.function.output_sizes.iter().sum();
-            let out = call.out as usize;
-            written[out..out + n].iter_mut().for_each(|w| *w = true);
-        } else {
-            written[ins.d as usize] = true;
-        }
-    }
-    let mut c = Vec::new();
-    for (k, (&n, &at)) in f.output_sizes.iter().zip(&f.output_offsets).enumerate() {
-        for i in (0..n).filter(|&i| !written[at + i]) {
-            c.push((k, i, f.template[at + i - f.template_start]));
-        }
-    }
-    c
-}
 
 /// The text of one generated function's body, noting the inputs and outputs it uses.
 struct Body<'a> {
