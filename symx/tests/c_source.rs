@@ -15,11 +15,13 @@ use testkit::special::{same_or_both_nan, SPECIAL};
 
 /// Reads the points (every input's entries, as hex bits, one number per line) from stdin
 /// until its end, evaluates each through the CasADi interface (the work sizes from
-/// `f_work`, the input sizes from `f_sparsity_in`) and prints every output's bits. Also
-/// prints the interface's metadata once, first.
+/// `f_work`, the input sizes from `f_sparsity_in`; the work vector exactly `sz_w` numbers,
+/// NaN-filled before every call, and a guard after it that must stay untouched) and prints
+/// every output's bits. Also prints the interface's metadata once, first.
 const DRIVER: &str = r#"
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 typedef long long casadi_int;
 int NAME(const double** arg, double** res, casadi_int* iw, double* w, int mem);
 casadi_int NAME_n_in(void);
@@ -41,7 +43,8 @@ int main(void) {
     printf("\n");
   }
   const double* arg[64]; double* res[64];
-  double* w = malloc(8 * (sw + 1));
+  /* Exactly sz_w numbers, then a guard: NaN-filled before every call. */
+  double* w = malloc(8 * (sw + 16));
   for (casadi_int k = 0; k < n_in; k++) arg[k] = malloc(8 * (nnz(NAME_sparsity_in(k)) + 1));
   for (casadi_int k = 0; k < n_out; k++) res[k] = malloc(8 * (nnz(NAME_sparsity_out(k)) + 1));
   for (;;) {
@@ -51,10 +54,25 @@ int main(void) {
         if (scanf("%llx", &b) != 1) return 0;
         ((unsigned long long*)arg[k])[i] = b;
       }
+    unsigned long long mark = 0x7ff8dead0000beefULL;
+    for (casadi_int i = 0; i < sw + 16; i++) memcpy(w + i, &mark, 8);
     if (NAME(arg, res, 0, w, 0) != 0) return 1;
+    for (casadi_int i = sw; i < sw + 16; i++)
+      if (memcmp(w + i, &mark, 8) != 0) { fprintf(stderr, "a write past sz_w\n"); return 2; }
     for (casadi_int k = 0; k < n_out; k++)
       for (casadi_int i = 0; i < nnz(NAME_sparsity_out(k)); i++)
         printf("%llx\n", ((unsigned long long*)res[k])[i]);
+    /* Again with each output skipped in turn (null res[k]): the others must not change. */
+    for (casadi_int skip = 0; skip < n_out && n_out > 1; skip++) {
+      double* again[64];
+      for (casadi_int k = 0; k < n_out; k++) again[k] = k == skip ? 0 : malloc(8 * (nnz(NAME_sparsity_out(k)) + 1));
+      if (NAME(arg, again, 0, w, 0) != 0) return 1;
+      for (casadi_int k = 0; k < n_out; k++) {
+        if (k == skip) continue;
+        if (memcmp(again[k], res[k], 8 * nnz(NAME_sparsity_out(k))) != 0) { fprintf(stderr, "output %lld changed with res[%lld] null\n", k, skip); return 3; }
+        free(again[k]);
+      }
+    }
   }
 }
 "#;
@@ -252,10 +270,24 @@ fn derivatives_and_calls_match_the_tape() {
         output_sparsity: vec![None, None, Some(h.sparsity().clone())],
     };
     let (meta, _) = run_c(&fun.to_c_with(&opts).unwrap(), "model", &[], "meta");
-    assert_eq!(
-        meta[0],
-        format!("in 2 out 3 arg 2 res 3 iw 0 w {}", fun.work_size())
+    // The work vector: the temporaries as the generated Rust counts them (`WORK_SIZE`),
+    // plus at most one slot per output entry read back, and less than the whole tape.
+    let rust = fun.to_rust().unwrap();
+    let work_size: usize = rust
+        .split("pub const WORK_SIZE: usize = ")
+        .nth(1)
+        .and_then(|t| t.split(';').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let sz_w: usize = meta[0].rsplit(' ').next().unwrap().parse().unwrap();
+    let outputs: usize = fun.output_sizes().iter().sum();
+    assert!(
+        work_size <= sz_w && sz_w <= work_size + outputs && sz_w < fun.work_size(),
+        "sz_w {sz_w}, WORK_SIZE {work_size}, outputs {outputs}, tape {}",
+        fun.work_size()
     );
+    assert_eq!(meta[0], format!("in 2 out 3 arg 2 res 3 iw 0 w {sz_w}"));
     assert_eq!(meta[1], "out f 1 x 1: 0 1 0");
     let s = h.sparsity();
     let mut want = format!("out h {} x {}:", s.nrows(), s.ncols());
@@ -314,6 +346,29 @@ proptest! {
         let f = Function::new(&[&x], &[&outs, j.values()]).unwrap();
         same_as_tape(&f, &[p], "random");
     }
+}
+
+/// Output entries that the computation reads back (an output the tape computes in its
+/// output slot and reads for the other outputs): with `res[0]` null (CasADi: output 0 not
+/// wanted) the other outputs must come out the same (the driver checks every output
+/// skipped in turn), and the work vector of `sz_w` numbers must hold those entries.
+#[test]
+fn outputs_read_back_survive_a_null_res() {
+    let x = Matrix::sym_vec("x", 2);
+    let a = x[0].sin() * x[1];
+    let b = a.exp();
+    let f = Function::named(
+        "back",
+        &[("x", &x)],
+        &[("o", &[a, b]), ("p", &[a * 3.0, b + a])],
+    )
+    .unwrap();
+    let points = vec![
+        vec![0.3, 1.7],
+        vec![-2.0, f64::NAN],
+        vec![f64::INFINITY, 0.0],
+    ];
+    same_as_tape(&f, &points, "back");
 }
 
 /// What cannot be generated is refused with an error naming it.

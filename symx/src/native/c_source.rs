@@ -8,10 +8,16 @@
 //! `f_default_in`, `f_work`, `f_work_bytes`, `f_checkout`, `f_release`, `f_incref`,
 //! `f_decref`. A null `arg[k]` reads as zeros and a null `res[k]` is not written, as in
 //! CasADi. It allocates nothing and keeps no state: `w` (`f_work`'s `sz_w` numbers) is
-//! the only scratch, so calls on distinct `w` may run in parallel.
+//! the only scratch, so calls on distinct `w` may run in parallel. As in the generated Rust
+//! (`super::places`), inputs are read where `arg` points, outputs written where `res`
+//! points and constants are literals: `w` holds the temporaries only (plus the output
+//! entries the computation reads back, which a null `res[k]` must not lose).
+use super::places::{
+    callee_base, constant_outputs, first_temporary, places, read, work_need, Place,
+};
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
-use crate::function::Function;
+use crate::function::{Function, Instr};
 use crate::op::Op;
 use crate::sparsity::Sparsity;
 use rustc_hash::FxHashMap;
@@ -27,117 +33,212 @@ struct Writer {
     names: FxHashMap<u64, String>,
 }
 
+/// Where the C code of one function keeps its registers (see [`places`]). For the function
+/// called through the interface (`top`), a null `res[k]` skips output `k`, as in CasADi:
+/// its entries are written only `if (yk)`, and the entries the tape reads back get a slot
+/// of their own in the work vector after everything else (`w[work_need(f) + j]`).
+struct Registers {
+    places: Vec<Place>,
+    /// For each register of the top function, the output entry `(k, i)` it also goes to
+    /// (only `if (yk)`), when it holds one.
+    optional_output: Vec<Option<(usize, usize)>>,
+    /// The work vector's length.
+    work: usize,
+}
+
+impl Registers {
+    fn of(f: &Function, top: bool) -> Self {
+        let mut places = places(f);
+        let mut optional_output = vec![None; f.work_size];
+        let mut work = work_need(f);
+        if top {
+            let read = read(f);
+            for (k, (&n, &at)) in f.output_sizes.iter().zip(&f.output_offsets).enumerate() {
+                for i in 0..n {
+                    optional_output[at + i] = Some((k, i));
+                    if read[at + i] {
+                        places[at + i] = Place::Work(work);
+                        work += 1;
+                    }
+                }
+            }
+        }
+        Registers {
+            places,
+            optional_output,
+            work,
+        }
+    }
+
+    /// The C expression reading register `r`.
+    fn get(&self, r: u32) -> String {
+        match self.places[r as usize] {
+            Place::Input(k, i) => format!("x{k}[{i}]"),
+            Place::Output(k, i) => format!("y{k}[{i}]"),
+            Place::Constant(v) => literal(v),
+            Place::Work(j) => format!("w[{j}]"),
+        }
+    }
+
+    /// The C statements setting register `r` to `v`.
+    fn set(&self, r: u32, v: &str) -> String {
+        let optional = self.optional_output[r as usize];
+        match (self.places[r as usize], optional) {
+            (Place::Work(j), Some((k, i))) => {
+                format!("  w[{j}] = {v};\n  if (y{k}) y{k}[{i}] = w[{j}];\n")
+            }
+            (_, Some((k, i))) => format!("  if (y{k}) y{k}[{i}] = {v};\n"),
+            _ => format!("  {} = {v};\n", self.get(r)),
+        }
+    }
+}
+
+/// A C literal with the exact bits of `v`: Rust's shortest round-trip decimal, which C
+/// compilers read back correctly rounded; infinities and NaNs by their bits.
+fn literal(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:e}")
+    } else {
+        format!("symx_f64({:#x}ULL)", v.to_bits())
+    }
+}
+
+/// The signature of every generated function running (part of) a tape: inputs at `x[k]`,
+/// outputs to `y[k]`, temporaries in `w`.
+const EXEC_PARAMS: &str = "(casadi_real* w, const casadi_real* const* x, casadi_real* const* y)";
+
 impl Writer {
     /// Emits `f` (callees first) and returns the name of its C function running the tape
-    /// on a work vector whose inputs are filled.
-    fn function(&mut self, f: &Function) -> Result<String, SymxError> {
+    /// (see [`EXEC_PARAMS`]); `top` for the function called through the interface.
+    fn function(&mut self, f: &Function, top: bool) -> Result<String, SymxError> {
         if let Some(n) = self.names.get(&f.uid) {
             return Ok(n.clone());
         }
         let mut callees = Vec::new();
         for c in &f.calls {
-            callees.push(self.function(&c.function)?);
+            callees.push(self.function(&c.function, false)?);
         }
         let name = format!("{}_exec{}", self.prefix, self.names.len());
+        let regs = Registers::of(f, top);
         let mut chunks = Vec::new();
         for (k, part) in f.tape.chunks(CHUNK).enumerate() {
-            let chunk = format!("{name}_{k}");
-            let o = &mut self.out;
-            writeln!(o, "static void {chunk}(casadi_real* w) {{").unwrap();
+            let mut body = String::new();
             for ins in part {
-                let r = |i: u32| format!("w[{i}]");
-                let (a, b, c) = (r(ins.a), r(ins.b), r(ins.c));
-                let t = |cond: String| format!("(({cond}) ? 1.0 : 0.0)");
-                let v = match ins.op {
-                    Op::Add => format!("{a} + {b}"),
-                    Op::Sub => format!("{a} - {b}"),
-                    Op::Mul => format!("{a} * {b}"),
-                    Op::Div => format!("{a} / {b}"),
-                    Op::Neg => format!("-{a}"),
-                    Op::Sq => format!("{a} * {a}"),
-                    Op::Sym => a,
-                    Op::Abs => format!("fabs({a})"),
-                    Op::Sign => format!("symx_sign({a})"),
-                    Op::Not => t(format!("{a} == 0.0")),
-                    Op::Pow => format!("symx_pow({a}, {b})"),
-                    Op::Min => format!("symx_min({a}, {b})"),
-                    Op::Max => format!("symx_max({a}, {b})"),
-                    Op::Lt => t(format!("{a} < {b}")),
-                    Op::Le => t(format!("{a} <= {b}")),
-                    Op::Eq => t(format!("{a} == {b}")),
-                    Op::Ne => t(format!("{a} != {b}")),
-                    Op::And => t(format!("{a} != 0.0 && {b} != 0.0")),
-                    Op::Or => t(format!("{a} != 0.0 || {b} != 0.0")),
-                    Op::StrongMul => format!("{a} == 0.0 ? 0.0 : {a} * {b}"),
-                    Op::IfElse => format!("{a} != 0.0 ? {b} : {c}"),
-                    Op::Call => {
-                        let call = &f.calls[ins.d as usize];
-                        let g = &call.function;
-                        let s = f.call_scratch;
-                        let mut p = 0;
-                        for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
-                            for i in 0..n {
-                                writeln!(o, "  w[{}] = w[{}];", s + at + i, call.args[p]).unwrap();
-                                p += 1;
-                            }
-                        }
-                        writeln!(o, "  {}(w + {s});", callees[ins.d as usize]).unwrap();
-                        let mut q = 0;
-                        for (&n, &at) in g.output_sizes.iter().zip(&g.output_offsets) {
-                            for i in 0..n {
-                                let d = call.out as usize + q;
-                                writeln!(o, "  w[{d}] = w[{}];", s + at + i).unwrap();
-                                q += 1;
-                            }
-                        }
-                        continue;
-                    }
-                    op => match (library_unary(op), library_binary(op)) {
-                        (Some(h), _) => format!("{h}({a})"),
-                        (_, Some(h)) => format!("{h}({a}, {b})"),
-                        _ => return Err(unsupported("C", op)),
-                    },
-                };
-                writeln!(o, "  w[{}] = {v};", ins.d).unwrap();
+                if ins.op == Op::Call {
+                    call(&mut body, f, ins, &callees[ins.d as usize], &regs);
+                    continue;
+                }
+                let v = value(ins, &regs)?;
+                body.push_str(&regs.set(ins.d, &v));
             }
-            writeln!(o, "}}\n").unwrap();
+            let chunk = format!("{name}_{k}");
+            self.emit(&chunk, f, &body);
             chunks.push(chunk);
         }
-        let o = &mut self.out;
-        let bits: Vec<String> = f
-            .template
-            .iter()
-            .map(|v| format!("{:#x}ULL", v.to_bits()))
-            .collect();
-        // The template's bits (exact for every value, NaN payloads included).
-        writeln!(
-            o,
-            "static const unsigned long long {name}_template[{}] = {{{}}};\n",
-            bits.len().max(1),
-            if bits.is_empty() {
-                "0".to_string()
-            } else {
-                bits.join(", ")
-            }
-        )
-        .unwrap();
-        writeln!(o, "static void {name}(casadi_real* w) {{").unwrap();
-        if !f.template.is_empty() {
-            writeln!(
-                o,
-                "  memcpy(w + {}, {name}_template, {} * sizeof(casadi_real));",
-                f.template_start,
-                f.template.len()
-            )
-            .unwrap();
+        let mut body = String::new();
+        for (k, i, v) in constant_outputs(f) {
+            let r = f.output_offsets[k] + i;
+            body.push_str(&regs.set(r as u32, &literal(v)));
         }
         for c in &chunks {
-            writeln!(o, "  {c}(w);").unwrap();
+            writeln!(body, "  {c}(w, x, y);").unwrap();
         }
-        writeln!(o, "}}\n").unwrap();
+        self.emit(&name, f, &body);
         self.names.insert(f.uid, name.clone());
         Ok(name)
     }
+
+    /// Writes the C function `name` running `body`, binding the inputs and outputs it uses.
+    fn emit(&mut self, name: &str, f: &Function, body: &str) {
+        let o = &mut self.out;
+        writeln!(o, "static void {name}{EXEC_PARAMS} {{").unwrap();
+        for k in (0..f.input_sizes.len()).filter(|k| body.contains(&format!("x{k}["))) {
+            writeln!(o, "  const casadi_real* x{k} = x[{k}];").unwrap();
+        }
+        for k in (0..f.output_sizes.len()).filter(|k| body.contains(&format!("y{k}"))) {
+            writeln!(o, "  casadi_real* y{k} = y[{k}];").unwrap();
+        }
+        writeln!(o, "  (void)w; (void)x; (void)y;\n{body}}}\n").unwrap();
+    }
+}
+
+/// The C expression of the value `ins` computes (any instruction but a call).
+fn value(ins: &Instr, regs: &Registers) -> Result<String, SymxError> {
+    let (a, b, c) = (regs.get(ins.a), regs.get(ins.b), regs.get(ins.c));
+    let t = |cond: String| format!("(({cond}) ? 1.0 : 0.0)");
+    Ok(match ins.op {
+        Op::Add => format!("{a} + {b}"),
+        Op::Sub => format!("{a} - {b}"),
+        Op::Mul => format!("{a} * {b}"),
+        Op::Div => format!("{a} / {b}"),
+        Op::Neg => format!("-{a}"),
+        Op::Sq => format!("{a} * {a}"),
+        Op::Sym => a,
+        Op::Abs => format!("fabs({a})"),
+        Op::Sign => format!("symx_sign({a})"),
+        Op::Not => t(format!("{a} == 0.0")),
+        Op::Pow => format!("symx_pow({a}, {b})"),
+        Op::Min => format!("symx_min({a}, {b})"),
+        Op::Max => format!("symx_max({a}, {b})"),
+        Op::Lt => t(format!("{a} < {b}")),
+        Op::Le => t(format!("{a} <= {b}")),
+        Op::Eq => t(format!("{a} == {b}")),
+        Op::Ne => t(format!("{a} != {b}")),
+        Op::And => t(format!("{a} != 0.0 && {b} != 0.0")),
+        Op::Or => t(format!("{a} != 0.0 || {b} != 0.0")),
+        Op::StrongMul => format!("{a} == 0.0 ? 0.0 : {a} * {b}"),
+        Op::IfElse => format!("{a} != 0.0 ? {b} : {c}"),
+        op => match (library_unary(op), library_binary(op)) {
+            (Some(h), _) => format!("{h}({a})"),
+            (_, Some(h)) => format!("{h}({a}, {b})"),
+            _ => return Err(unsupported("C", op)),
+        },
+    })
+}
+
+/// A call of another function (generated as `callee`): its arguments gathered into the
+/// scratch block, laid out as its inputs, its outputs written straight into the call's
+/// block of registers (as the generated Rust does).
+fn call(o: &mut String, f: &Function, ins: &Instr, callee: &str, regs: &Registers) {
+    let call = &f.calls[ins.d as usize];
+    let g = &call.function;
+    let s = f.call_scratch - first_temporary(f);
+    let mut p = 0;
+    for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
+        for i in 0..n {
+            writeln!(o, "  w[{}] = {};", s + at + i, regs.get(call.args[p])).unwrap();
+            p += 1;
+        }
+    }
+    let xs: Vec<String> = g
+        .input_offsets
+        .iter()
+        .map(|at| format!("w + {}", s + at))
+        .collect();
+    let mut q = call.out as usize - first_temporary(f);
+    let ys: Vec<String> = g
+        .output_sizes
+        .iter()
+        .map(|n| {
+            q += n;
+            format!("w + {}", q - n)
+        })
+        .collect();
+    let one = |v: Vec<String>| {
+        if v.is_empty() {
+            "0".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    writeln!(
+        o,
+        "  {{ const casadi_real* const xc[] = {{{}}}; casadi_real* const yc[] = {{{}}}; {callee}(w + {}, xc, yc); }}",
+        one(xs),
+        one(ys),
+        s + callee_base(g)
+    )
+    .unwrap();
 }
 
 /// CasADi's compressed column format: `nrow, ncol, colind[ncol + 1], row[nnz]`.
@@ -203,6 +304,13 @@ typedef char PREFIX_casadi_real_is_double[sizeof(casadi_real) == 8 ? 1 : -1];
   #endif
 #endif
 
+/* The double with the bits b (the infinite and NaN constants, payloads included). */
+static inline casadi_real symx_f64(unsigned long long b) {
+  casadi_real v;
+  memcpy(&v, &b, sizeof v);
+  return v;
+}
+
 /* symx's sign: 1 above 0, -1 below, else a * 0 (signed zeros, NaN). */
 static inline casadi_real symx_sign(casadi_real a) {
   return a > 0.0 ? 1.0 : a < 0.0 ? -1.0 : a * 0.0;
@@ -245,7 +353,9 @@ impl Function {
     /// `f_sparsity_in`, `f_sparsity_out`, `f_default_in`, `f_work`, `f_work_bytes`,
     /// `f_checkout`, `f_release`, `f_incref`, `f_decref`. Every input and output is a dense
     /// column; [`Function::to_c_with`] gives outputs a sparsity pattern. No allocation, no
-    /// state: `w` (`f_work`'s `sz_w` numbers) is the only scratch; `iw` is unused.
+    /// state: `w` (`f_work`'s `sz_w` numbers, the temporaries only, as the generated Rust's
+    /// `WORK_SIZE`, plus the output entries the computation reads back) is the only
+    /// scratch; `iw` is unused.
     ///
     /// Compiled without contraction of multiplies and adds into FMAs (`-ffp-contract=off`,
     /// which gcc's and clang's ISO modes `-std=c99`/`c11` imply; never `-ffast-math`), it
@@ -289,7 +399,7 @@ impl Function {
             out: String::new(),
             names: FxHashMap::default(),
         };
-        let main = w.function(self)?;
+        let main = w.function(self, true)?;
         let mut o = String::new();
         writeln!(
             o,
@@ -319,41 +429,30 @@ impl Function {
         let names_in: Vec<String> = self.input_names.iter().map(|s| c_string(s)).collect();
         let names_out: Vec<String> = self.output_names.iter().map(|s| c_string(s)).collect();
 
-        let mut copy_in = String::new();
-        for (k, (&n, &at)) in self.input_sizes.iter().zip(&self.input_offsets).enumerate() {
-            if n > 0 && self.input_used[k] {
-                writeln!(
-                    copy_in,
-                    "  if (arg[{k}]) memcpy(w + {at}, arg[{k}], {n} * sizeof(casadi_real));\n  else memset(w + {at}, 0, {n} * sizeof(casadi_real));"
-                )
-                .unwrap();
-            }
+        let mut bind = String::new();
+        for k in 0..n_in {
+            writeln!(bind, "  x[{k}] = arg[{k}] ? arg[{k}] : {name}_zeros;").unwrap();
         }
-        let mut copy_out = String::new();
-        for (k, (&n, &at)) in self
-            .output_sizes
-            .iter()
-            .zip(&self.output_offsets)
-            .enumerate()
-        {
-            if n > 0 {
-                writeln!(
-                    copy_out,
-                    "  if (res[{k}]) memcpy(res[{k}], w + {at}, {n} * sizeof(casadi_real));"
-                )
-                .unwrap();
-            }
+        for k in 0..n_out {
+            writeln!(bind, "  y[{k}] = res[{k}];").unwrap();
         }
-        let work = self.work_size;
+        let zeros = self.input_sizes.iter().copied().max().unwrap_or(0).max(1);
+        let work = Registers::of(self, true).work;
         write!(
             o,
             r#"
-/* {name}: the inputs are read from arg (null: zeros), the outputs written to res (null:
-   skipped); w holds {work} numbers. */
+/* Read for a null arg[k]. */
+static const casadi_real {name}_zeros[{zeros}] = {{0}};
+
+/* {name}: the inputs are read where arg points (null: zeros), the outputs written where res
+   points (null: skipped); w holds {work} numbers: the temporaries only (and the output
+   entries the computation reads back). */
 CASADI_SYMBOL_EXPORT int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
+  const casadi_real* x[{xn}];
+  casadi_real* y[{yn}];
   (void)iw; (void)mem;
-{copy_in}  {main}(w);
-{copy_out}  return 0;
+{bind}  {main}(w, x, y);
+  return 0;
 }}
 
 CASADI_SYMBOL_EXPORT int {name}_alloc_mem(void) {{ return 0; }}
@@ -404,6 +503,8 @@ CASADI_SYMBOL_EXPORT int {name}_work_bytes(casadi_int* sz_arg, casadi_int* sz_re
 }} /* extern "C" */
 #endif
 "#,
+            xn = n_in.max(1),
+            yn = n_out.max(1),
             names_in = switch(&names_in, "0"),
             names_out = switch(&names_out, "0"),
             sp_in = switch(&sp_in, "0"),
