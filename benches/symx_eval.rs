@@ -33,9 +33,9 @@
 //! exit, for peak-memory measurement (see `memory_run`). benches/reference/ocp_compare.sh
 //! runs both sides and prints the ratios.
 //!
-//! `native_chain`, `native_gap`, `native_quadrotor` (`cargo bench --bench symx_eval --
-//! native`): the tape against native code (`Function::jit`) on ∇f, ∂g/∂x and the
-//! Hessian, with the JIT's compile times (benches/reference/native_casadi.py measures
+//! `native_chain`, `native_gap`, `native_quadrotor`, `native_quadrotor_calls` (`cargo
+//! bench --bench symx_eval -- native`): the tape against native code (`Function::jit`) on
+//! ∇f, ∂g/∂x and the Hessian, with the JIT's compile times (benches/reference/native_casadi.py measures
 //! CasADi's VM and its generated C on the same functions).
 //!
 //! `native_rust_chain`, `native_rust_gap`, `native_rust_quadrotor` (`cargo bench --bench
@@ -584,9 +584,10 @@ fn native_versus_tape(c: &mut Criterion, group: &str, fns: &Compiled, ins: [&[f6
     g.finish();
 }
 
-/// `native_chain`, `native_gap`, `native_quadrotor` (`cargo bench --bench symx_eval --
-/// native`): tape vs JIT on the hanging chain (1000 links), the gap-crossing model and the
-/// quadrotor OCP at N = 320 (inlined RK4, the size).
+/// `native_chain`, `native_gap`, `native_quadrotor`, `native_quadrotor_calls` (`cargo
+/// bench --bench symx_eval -- native`): tape vs JIT on the hanging chain (1000 links), the
+/// gap-crossing model and the quadrotor OCP at N = 320 (the size; RK4 inlined, or
+/// called through one compiled step).
 fn bench_native(c: &mut Criterion) {
     native_problems("native", NATIVE_STAGES, |group, fns, ins| {
         native_versus_tape(c, group, fns, ins)
@@ -595,7 +596,8 @@ fn bench_native(c: &mut Criterion) {
 
 /// Builds each of the native groups' problems that the filter selects — `{prefix}_chain`
 /// (1000 links), `{prefix}_gap` (the gap-crossing model at its initial point) and
-/// `{prefix}_quadrotor` (`stages` stages, inlined RK4) — and runs `bench` on its group
+/// `{prefix}_quadrotor` and `{prefix}_quadrotor_calls` (`stages` stages, RK4 inlined or
+/// called) — and runs `bench` on its group
 /// name, its compiled ∇f, J and H, and their inputs `[x, σ, λ]`.
 fn native_problems(
     prefix: &str,
@@ -618,17 +620,28 @@ fn native_problems(
         let (x, sigma, lambda) = inputs(compiled.m(), &x0);
         bench(&group("gap"), &fns, [&x, &sigma, &lambda]);
     }
-    if selected(&format!("{}/eval/hess_L", group("quadrotor"))) {
-        let o = quadrotor_ocp::build(stages, false);
-        let fns = compile(&differentiate(Symbolic {
-            f: o.f,
-            g: o.g,
-            x: o.w,
-        }));
-        let m = (stages + 1) * quadrotor_ocp::NX;
-        let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(stages));
-        bench(&group("quadrotor"), &fns, [&x, &sigma, &lambda]);
+    for (problem, calls) in [("quadrotor", false), ("quadrotor_calls", true)] {
+        if selected(&format!("{}/eval/hess_L", group(problem))) {
+            let (fns, x, sigma, lambda) = quadrotor_native(stages, calls);
+            bench(&group(problem), &fns, [&x, &sigma, &lambda]);
+        }
     }
+}
+
+/// The quadrotor OCP with `stages` stages — the RK4 step inlined at every stage, or
+/// (`calls`) one compiled step called at every stage, as CasADi's `F.map` form of
+/// `native_casadi.py --problem quadrotor_calls` — its compiled ∇f, J and H, and the
+/// inputs `[x, σ, λ]`.
+fn quadrotor_native(stages: usize, calls: bool) -> (Compiled, Vec<f64>, [f64; 1], Vec<f64>) {
+    let o = quadrotor_ocp::build(stages, calls);
+    let fns = compile(&differentiate(Symbolic {
+        f: o.f,
+        g: o.g,
+        x: o.w,
+    }));
+    let m = (stages + 1) * quadrotor_ocp::NX;
+    let (x, sigma, lambda) = inputs(m, &quadrotor_ocp::point(stages));
+    (fns, x, sigma, lambda)
 }
 
 /// Rustc's flags for the generated programs: what `cargo build --release` passes for this
@@ -999,7 +1012,7 @@ fn memory_run(mode: &str) {
 }
 
 /// With `SYMX_NATIVE_PROFILE=problem:function:evaluator:calls` in the environment
-/// (`problem` one of `gap`, `quadrotor`, `chain`; `function` one of `grad_f`, `jac_g`,
+/// (`problem` one of `gap`, `quadrotor`, `quadrotor_calls`, `chain`; `function` one of `grad_f`, `jac_g`,
 /// `hess_L`; `evaluator` `tape` or `jit`), the binary calls that function `calls` times
 /// inside [`hot_loop`] and exits: run under `valgrind --tool=callgrind
 /// --collect-atstart=no --toggle-collect='*hot_loop*'`, the instructions counted divided by
@@ -1026,17 +1039,8 @@ fn profile_run(spec: &str) {
             let (x, s, l) = inputs(compiled.m(), &x0);
             (fns, x, s, l)
         }
-        "quadrotor" => {
-            let o = quadrotor_ocp::build(NATIVE_STAGES, false);
-            let fns = compile(&differentiate(Symbolic {
-                f: o.f,
-                g: o.g,
-                x: o.w,
-            }));
-            let m = (NATIVE_STAGES + 1) * quadrotor_ocp::NX;
-            let (x, s, l) = inputs(m, &quadrotor_ocp::point(NATIVE_STAGES));
-            (fns, x, s, l)
-        }
+        "quadrotor" => quadrotor_native(NATIVE_STAGES, false),
+        "quadrotor_calls" => quadrotor_native(NATIVE_STAGES, true),
         "chain" => {
             let (p, x0) = chain(LINKS);
             let fns = compile(&differentiate(p));
@@ -1044,7 +1048,9 @@ fn profile_run(spec: &str) {
             (fns, x, s, l)
         }
         other => {
-            eprintln!("SYMX_NATIVE_PROFILE: unknown problem '{other}' (gap, quadrotor, chain)");
+            eprintln!(
+                "SYMX_NATIVE_PROFILE: unknown problem '{other}' (gap, quadrotor, quadrotor_calls, chain)"
+            );
             std::process::exit(2);
         }
     };

@@ -18,10 +18,14 @@ Run (takes several minutes, mostly gcc):
 With `--problem quadrotor` (and `--stages N`, default 320) the functions are those of the
 quadrotor OCP of benches/reference/ocp_chain_casadi.py (RK4 inlined), the `native_quadrotor`
 group; `--export-bin` is then not needed. `--only grad_f,jac_g` limits the functions (gcc
-on the quadrotor's Hessian takes very long).
-With `--keep DIR` the C files and executables stay in DIR, and a later run with the same DIR
-reuses them (the gcc time recorded the first time), so repeated side-by-side timings take
-seconds.
+on the inlined quadrotor's J and H takes hours). With `--problem quadrotor_calls` the same
+OCP is written as a CasADi user writes it at large N: the RK4 step one `Function`, applied
+to the stages by `F.map(N)` in MX (its C compiles in seconds to minutes); the symx side is
+the `native_quadrotor_calls` group (one compiled step called at every stage). `--gcc-opt
+-O2` changes gcc's level (recorded next to the kept object as NAME.gcc_opt).
+With `--keep DIR` the C files and objects stay in DIR, and a later run with the same DIR
+reuses the objects (the gcc time recorded the first time), so repeated side-by-side timings
+take seconds.
 """
 import argparse
 import contextlib
@@ -56,14 +60,15 @@ int main(int argc, char** argv) {
   int nin = 0; long sizes[8]; int k = 2;
   while (argv[k][0] != '-') sizes[nin++] = atol(argv[k++]);
   long nout = atol(argv[k + 1]);
-  const double* arg[16]; double* res[16];
+  casadi_int sa, sr, si, sw; NAME_work(&sa, &sr, &si, &sw);
+  /* sz_arg and sz_res entries: MX functions use those after the inputs as scratch. */
+  const double** arg = calloc(sa + 1, sizeof(double*)); double** res = calloc(sr + 1, sizeof(double*));
   for (int i = 0; i < nin; i++) { double* a = malloc(8 * (sizes[i] + 1)); fread(a, 8, sizes[i], f); arg[i] = a; }
   double* out = calloc(nout + 1, 8); res[0] = out;
-  casadi_int sa, sr, si, sw; NAME_work(&sa, &sr, &si, &sw);
   casadi_int* iw = calloc(si + 1, sizeof(casadi_int)); double* w = calloc(sw + 1, 8);
   for (int i = nin; i < sa; i++) arg[i] = 0;
   for (int i = 1; i < sr; i++) res[i] = 0;
-  double t0 = now(); NAME(arg, res, iw, w, 0); double once = now() - t0;
+  double t0 = now(); if (NAME(arg, res, iw, w, 0)) return 1; double once = now() - t0;
   int calls = (int)(0.3 / once); if (calls < 10) calls = 10; if (calls > 300) calls = 300;
   double medians[7]; double* times = malloc(sizeof(double) * calls);
   for (int r = 0; r < 7; r++) {
@@ -78,12 +83,12 @@ int main(int argc, char** argv) {
 """
 
 
-def casadi_c(name, F, inputs, out_nnz, tmp):
+def casadi_c(name, F, inputs, out_nnz, tmp, opt="-O3"):
     src = os.path.join(tmp, f"{name}.c")
     exe = os.path.join(tmp, name)
     timing = os.path.join(tmp, f"{name}.gcc_s")
-    if os.path.exists(exe) and os.path.exists(timing):
-        # Kept from an earlier run (--keep): time the executable again, no gcc.
+    if os.path.exists(src + ".o") and os.path.exists(timing):
+        # Kept from an earlier run (--keep): time it again, no gcc on the function.
         with open(timing) as fh:
             gcc_s = float(fh.read())
     else:
@@ -94,14 +99,16 @@ def casadi_c(name, F, inputs, out_nnz, tmp):
         finally:
             os.chdir(cwd)
         t = time.perf_counter()
-        subprocess.run(["gcc", "-O3", "-march=native", "-c", src, "-o", src + ".o"], check=True)
+        subprocess.run(["gcc", opt, "-march=native", "-c", src, "-o", src + ".o"], check=True)
         gcc_s = time.perf_counter() - t
-        drv = os.path.join(tmp, f"{name}_main.c")
-        with open(drv, "w") as fh:
-            fh.write(DRIVER.replace("NAME", name))
-        subprocess.run(["gcc", "-O2", drv, src + ".o", "-o", exe, "-lm"], check=True)
         with open(timing, "w") as fh:
             fh.write(f"{gcc_s}")
+        with open(os.path.join(tmp, f"{name}.gcc_opt"), "w") as fh:
+            fh.write(opt)
+    drv = os.path.join(tmp, f"{name}_main.c")
+    with open(drv, "w") as fh:
+        fh.write(DRIVER.replace("NAME", name))
+    subprocess.run(["gcc", "-O2", drv, src + ".o", "-o", exe, "-lm"], check=True)
     data = os.path.join(tmp, f"{name}.bin")
     np.concatenate([np.atleast_1d(np.asarray(a, dtype=float)) for a in inputs]).tofile(data)
     sizes = [str(np.atleast_1d(a).size) for a in inputs]
@@ -123,9 +130,38 @@ def quadrotor(stages):
     return funcs, exprs, np.array(oc.point(stages)), g.numel()
 
 
+def quadrotor_calls(stages):
+    """The same OCP as a CasADi user writes it for speed at large N: the RK4 step one SX
+    `Function` F, applied to all stages by `F.map(N)` in an MX graph (call nodes; the
+    derivative functions call F's derivatives, so the generated C holds each once and
+    compiles in seconds). Same variables, constraints, objective and point as
+    `quadrotor` (the symx side: testkit's `build(n, true)`, group
+    `native_quadrotor_calls`)."""
+    import ocp_chain_casadi as oc
+    nx, nu, n = oc.NX, oc.NU, stages
+    x, u = ca.SX.sym("x", nx), ca.SX.sym("u", nu)
+    step = ca.Function("F", [x, u], [ca.vertcat(*oc.rk4([x[i] for i in range(nx)],
+                                                         [u[i] for i in range(nu)]))])
+    w = ca.MX.sym("w", n * (nx + nu) + nx)
+    stages_xu = ca.reshape(w[: n * (nx + nu)], nx + nu, n)
+    xs, us = stages_xu[:nx, :], stages_xu[nx:, :]
+    x_all = ca.horzcat(xs, w[n * (nx + nu):])
+    xr = ca.DM([1.0 if i < 3 else 0.0 for i in range(nx)])
+    g = ca.vertcat(ca.vec(step.map(n)(xs, us) - x_all[:, 1:]), x_all[:, 0])
+    f = ca.sumsqr(xs - ca.repmat(xr, 1, n)) + 0.1 * ca.sumsqr(us) + 10 * ca.sumsqr(x_all[:, n] - xr)
+    sigma = ca.MX.sym("sigma")
+    lam = ca.MX.sym("lambda", g.numel())
+    exprs = {"grad_f": ([w], ca.gradient(f, w)), "jac_g": ([w], ca.jacobian(g, w)),
+             "hess_L": ([w, sigma, lam], ca.tril(ca.hessian(sigma * f + ca.dot(lam, g), w)[0]))}
+    funcs = [ca.Function(k, v[0], [v[1]]) for k, v in exprs.items()]
+    return funcs, exprs, np.array(oc.point(stages)), g.numel()
+
+
 def run(d, args):
     if args.problem == "quadrotor":
         funcs, exprs, x0, m = quadrotor(args.stages)
+    elif args.problem == "quadrotor_calls":
+        funcs, exprs, x0, m = quadrotor_calls(args.stages)
     else:
         (x, f, g), funcs, syms, _, exprs = build_all(d)
         x0 = np.array([v["x0"] for v in d["variables"]])
@@ -142,7 +178,7 @@ def run(d, args):
             nnz = F(*ins).nnz()
             rec = ca.Function(name + "_timed", exprs[name][0], [exprs[name][1]], {"record_time": True})
             vm, _, _ = internal_times(rec, ins, 7, 300)
-            gcc_s, c_us, c_sum, size = casadi_c(name, F, inputs[name], nnz, tmp)
+            gcc_s, c_us, c_sum, size = casadi_c(name, F, inputs[name], nnz, tmp, args.gcc_opt)
             rows[name] = {"vm_us": vm * 1e6, "c_us": c_us, "gcc_s": gcc_s, "c_sum": c_sum, "c_bytes": size}
             print(f"{name:7} casadi vm {vm * 1e6:9.2f} us  C {c_us:8.2f} us  gcc {gcc_s:7.1f} s  "
                   f"({size / 1e6:.1f} MB)  sum {c_sum:.16e}", file=sys.stderr)
@@ -152,7 +188,9 @@ def run(d, args):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--export-bin", help="the gap model's export example (for --problem gap)")
-    ap.add_argument("--problem", choices=["gap", "quadrotor"], default="gap")
+    ap.add_argument("--problem", choices=["gap", "quadrotor", "quadrotor_calls"], default="gap")
+    ap.add_argument("--gcc-opt", default="-O3", help="gcc's optimisation level for the generated "
+                    "C (default -O3; the inlined quadrotor's J and H need hours at -O3)")
     ap.add_argument("--stages", type=int, default=320, help="stages of the quadrotor OCP")
     ap.add_argument("--only", help="comma-separated functions to measure (default: all three)")
     ap.add_argument("--no-symx", action="store_true", help="skip running the symx bench")
