@@ -117,17 +117,23 @@ def casadi_c(name, F, inputs, out_nnz, tmp, opt="-O3"):
     return gcc_s, float(out[0]), float(out[1]), os.path.getsize(src)
 
 
+def derivatives(kind, w, f, g):
+    """∇f, ∂g/∂w and the lower triangle of ∇²(σf + λᵀg) (σ, λ symbols of `kind`, SX or
+    MX) as Functions named grad_f, jac_g, hess_L, and their expressions."""
+    sigma = kind.sym("sigma")
+    lam = kind.sym("lambda", g.numel())
+    exprs = {"grad_f": ([w], ca.gradient(f, w)), "jac_g": ([w], ca.jacobian(g, w)),
+             "hess_L": ([w, sigma, lam], ca.tril(ca.hessian(sigma * f + ca.dot(lam, g), w)[0]))}
+    funcs = [ca.Function(k, v[0], [v[1]]) for k, v in exprs.items()]
+    return funcs, exprs
+
+
 def quadrotor(stages):
     """The quadrotor OCP's three functions, expressions and initial point (as
     `build_all` returns them for the gap model)."""
     import ocp_chain_casadi as oc
     w, f, g = oc.build(stages)
-    sigma = ca.SX.sym("sigma")
-    lam = ca.SX.sym("lambda", g.numel())
-    exprs = {"grad_f": ([w], ca.gradient(f, w)), "jac_g": ([w], ca.jacobian(g, w)),
-             "hess_L": ([w, sigma, lam], ca.tril(ca.hessian(sigma * f + ca.dot(lam, g), w)[0]))}
-    funcs = [ca.Function(k, v[0], [v[1]]) for k, v in exprs.items()]
-    return funcs, exprs, np.array(oc.point(stages)), g.numel()
+    return derivatives(ca.SX, w, f, g) + (np.array(oc.point(stages)), g.numel())
 
 
 def quadrotor_calls(stages):
@@ -149,12 +155,7 @@ def quadrotor_calls(stages):
     xr = ca.DM([1.0 if i < 3 else 0.0 for i in range(nx)])
     g = ca.vertcat(ca.vec(step.map(n)(xs, us) - x_all[:, 1:]), x_all[:, 0])
     f = ca.sumsqr(xs - ca.repmat(xr, 1, n)) + 0.1 * ca.sumsqr(us) + 10 * ca.sumsqr(x_all[:, n] - xr)
-    sigma = ca.MX.sym("sigma")
-    lam = ca.MX.sym("lambda", g.numel())
-    exprs = {"grad_f": ([w], ca.gradient(f, w)), "jac_g": ([w], ca.jacobian(g, w)),
-             "hess_L": ([w, sigma, lam], ca.tril(ca.hessian(sigma * f + ca.dot(lam, g), w)[0]))}
-    funcs = [ca.Function(k, v[0], [v[1]]) for k, v in exprs.items()]
-    return funcs, exprs, np.array(oc.point(stages)), g.numel()
+    return derivatives(ca.MX, w, f, g) + (np.array(oc.point(stages)), g.numel())
 
 
 def run(d, args):
