@@ -23,9 +23,10 @@ use crate::plan::Plan;
 use crate::scenario::{dist2, Biped, Foot, Scenario};
 use crate::schedule_search::NULL_MOVE;
 use crate::solve::{
-    record, solve_scheduled, Phase, PlanningError, Run, Settings, Solved, CROSSING_ROUNDS,
+    record, solve_scheduled, Phase, PlanningError, Run, Settings, Solved, Stop, CROSSING_ROUNDS,
 };
 use crate::terrain::Terrain;
+use std::sync::atomic::AtomicBool;
 
 /// Stances kept after the plan's last move in a candidate's walking horizon: room for
 /// the candidate to end its walk a few moves later than the plan.
@@ -78,6 +79,7 @@ fn solve_candidate(
     settings: &Settings,
     horizon: usize,
     round: usize,
+    cancel: Option<&AtomicBool>,
 ) -> Result<Solved, PlanningError> {
     let mut name = format!(
         "crossing search {round}: {} crosses at transition {}",
@@ -92,7 +94,10 @@ fn solve_candidate(
             &c.plan.to_flat(),
             settings,
             &name,
-            false,
+            Stop {
+                on_stall: false,
+                cancel,
+            },
         );
     }
     name.push_str(&format!(" (on {horizon} stances)"));
@@ -110,7 +115,10 @@ fn solve_candidate(
         &guess.to_flat(),
         settings,
         &name,
-        true,
+        Stop {
+            on_stall: true,
+            cancel,
+        },
     )?;
     solved.run.plan = extend(&solved.run.plan, s.n_step);
     solved.run.schedule = schedule.to_vec();
@@ -154,7 +162,7 @@ pub(crate) fn search(
     start: Run,
     phases: &mut Vec<Phase>,
 ) -> Result<Run, PlanningError> {
-    Ok(run(s, terrain, settings, &start)?.record(start, settings, phases))
+    Ok(run(s, terrain, settings, &start, None)?.record(start, settings, phases))
 }
 
 /// The crossing search ([`crate::crossing`]) from a solved run, not yet recorded (so
@@ -162,12 +170,15 @@ pub(crate) fn search(
 /// candidate in which one foot crosses a keep-out zone one move earlier (on the walking
 /// horizon, module docs), and keeps the best that succeeds with a lower objective (and
 /// reaches the goal when the plan it started from does), compared in a fixed order, for
-/// up to [`CROSSING_ROUNDS`] rounds.
+/// up to [`CROSSING_ROUNDS`] rounds. Once `cancel` is set (a speculative search,
+/// [`crate::early_start`]) the solves stop and no further round starts: the result is
+/// then incomplete and must be discarded.
 pub(crate) fn run(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     settings: &Settings,
     start: &Run,
+    cancel: Option<&AtomicBool>,
 ) -> Result<Searched, PlanningError> {
     use rayon::prelude::*;
     // Capped like the schedule search's re-solves: a candidate still running past
@@ -177,7 +188,14 @@ pub(crate) fn run(
         solved: Vec::new(),
         best: None,
     };
+    let stop = Stop {
+        on_stall: false,
+        cancel,
+    };
     for round in 1..=CROSSING_ROUNDS {
+        if stop.cancelled() {
+            break;
+        }
         let current = out.best_run().unwrap_or(start);
         if !current.solution.status.is_success() {
             break;
@@ -190,7 +208,7 @@ pub(crate) fn run(
         let schedule = &current.schedule;
         let solved: Vec<Result<Solved, PlanningError>> = candidates
             .par_iter()
-            .map(|c| solve_candidate(s, terrain, schedule, c, settings, horizon, round))
+            .map(|c| solve_candidate(s, terrain, schedule, c, settings, horizon, round, cancel))
             .collect();
         let needs_goal = reaches_goal(s, &current.plan);
         let mut improved = false;

@@ -12,7 +12,9 @@
 //! - [`terrain`], [`terrain_spec`]: the ground (gap, step, several gaps, stepping stones,
 //!   height map) as expressions and numbers, its allowed regions, and its scenario table;
 //! - [`crossing`]: the crossing search's candidates (which move of each foot first lands
-//!   beyond a gap), [`crossing_search`]: solving them, on the plan's walking horizon;
+//!   beyond a gap), [`crossing_search`]: solving them, on the plan's walking horizon
+//!   (`early_start`: the free gait's later solves started as soon as they are known to be
+//!   needed, or speculatively, while the crawl plan is still being solved);
 //! - [`frame`]: the translation to the start's frame every plan is solved in;
 //! - [`reach`]: geometric certificates that a goal is unreachable; [`footing`]: on a
 //!   height map, the cells no foot can stand on and whether the rest joins start and goal;
@@ -36,6 +38,7 @@ pub mod check;
 pub mod convergence;
 pub mod crossing;
 pub mod crossing_search;
+mod early_start;
 pub mod export;
 pub mod footing;
 pub mod frame;

@@ -32,6 +32,7 @@
 //!   With the SQP back end, 2–4 have an iteration budget ([`SQP_CANDIDATE_MAX_ITER`]).
 use crate::check::{self, GoalCheck, GOAL_TOL};
 use crate::crossing_search;
+use crate::early_start::{self, Early, Verdict};
 use crate::frame;
 use crate::gait;
 use crate::model::{self, Formulation, ModelError};
@@ -46,6 +47,7 @@ use nlp::{
     SolveError, Solver, SolverOptions, SqpOptions, Status,
 };
 use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Largest number of schedule-search rounds (each: evaluate every adjacent swap, then
@@ -190,6 +192,29 @@ impl Settings {
     }
 }
 
+/// When a scheduled solve stops before the solver's own tests end it.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Stop<'a> {
+    /// Stop when the solve stalls ([`STALL_ITERATIONS`]): the run then counts as failed.
+    pub(crate) on_stall: bool,
+    /// Stop as soon as this flag is set: a speculative solve whose result is no longer
+    /// wanted ([`crate::early_start`]); its result is discarded.
+    pub(crate) cancel: Option<&'a AtomicBool>,
+}
+
+impl Stop<'_> {
+    /// Stop on a stall only.
+    pub(crate) const STALL: Stop<'static> = Stop {
+        on_stall: true,
+        cancel: None,
+    };
+
+    /// Whether the flag [`Stop::cancel`] is set.
+    pub(crate) fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::SeqCst))
+    }
+}
+
 /// Counts the consecutive iterations of a solve whose primal step is below
 /// [`STALL_STEP`] ([`STALL_ITERATIONS`] in a row: stalled).
 #[derive(Default)]
@@ -292,6 +317,14 @@ pub(crate) struct Run {
 }
 
 impl Run {
+    /// Its objective when it succeeded (what [`Run::beats`] compares), else `None`.
+    pub(crate) fn verdict(&self) -> Verdict {
+        self.solution
+            .status
+            .is_success()
+            .then_some(self.solution.objective)
+    }
+
     /// Whether this run succeeded with a lower objective than `other` (or `other` failed).
     pub(crate) fn beats(&self, other: &Run) -> bool {
         self.solution.status.is_success()
@@ -318,10 +351,10 @@ pub(crate) fn solve_scheduled(
     guess: &[f64],
     settings: &Settings,
     name: &str,
-    stop_on_stall: bool,
+    stop: Stop<'_>,
 ) -> Result<Solved, PlanningError> {
     symx::with_fresh_arena(|| {
-        solve_scheduled_here(s, terrain, schedule, guess, settings, name, stop_on_stall)
+        solve_scheduled_here(s, terrain, schedule, guess, settings, name, stop)
     })
 }
 
@@ -333,7 +366,7 @@ fn solve_scheduled_here(
     guess: &[f64],
     settings: &Settings,
     name: &str,
-    stop_on_stall: bool,
+    stop: Stop<'_>,
 ) -> Result<Solved, PlanningError> {
     let formulation = Formulation::Scheduled(schedule.to_vec());
     let model = model::build(s, terrain, &formulation, guess)?;
@@ -350,7 +383,8 @@ fn solve_scheduled_here(
     let mut guard = StallGuard::default();
     let solution = quiet.solve(&mut compiled, |v| {
         residuals.push(0.0);
-        if stop_on_stall && guard.stalled(v.record()) {
+        let stalled = stop.on_stall && guard.stalled(v.record());
+        if stalled || stop.cancelled() {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
@@ -409,7 +443,7 @@ fn run(
     phases: &mut Vec<Phase>,
     name: &str,
 ) -> Result<Run, PlanningError> {
-    let solved = solve_scheduled(s, terrain, schedule, guess, settings, name, false)?;
+    let solved = solve_scheduled(s, terrain, schedule, guess, settings, name, Stop::default())?;
     Ok(record(solved, settings, phases))
 }
 
@@ -704,39 +738,12 @@ fn free_gait(
     settings: &Settings,
     phases: &mut Vec<Phase>,
 ) -> Result<(Run, Option<f64>), PlanningError> {
-    // The two starting schedules are independent: solved on two threads.
-    let crawl = gait::crawl_schedule(s.n_step);
-    let pair = gait::pair_schedule(s.n_step);
+    // The two starting schedules are independent: solved on two threads, each going on
+    // with what it can start early ([`crate::early_start`]).
     let candidate = settings.candidate();
-    let (crawl_run, pair_run) = rayon::join(
-        || {
-            let guess = gait::crawl(s);
-            solve_scheduled(
-                s,
-                terrain,
-                &crawl,
-                &guess,
-                settings,
-                "free gait: crawl schedule",
-                false,
-            )
-        },
-        || {
-            let footholds = gait::footholds_for_schedule(s, &pair);
-            let guess = gait::plan_for_footholds(s, &footholds).to_flat();
-            solve_scheduled(
-                s,
-                terrain,
-                &pair,
-                &guess,
-                &candidate,
-                "free gait: biped-pair schedule",
-                false,
-            )
-        },
-    );
-    let crawl_run = record(crawl_run?, settings, phases);
-    let pair_run = record(pair_run?, settings, phases);
+    let (crawl_run, pair_run, early) = early_start::first_phase(s, terrain, settings, &candidate)?;
+    let crawl_run = record(crawl_run, settings, phases);
+    let pair_run = record(pair_run, settings, phases);
     let pair_better = pair_run.beats(&crawl_run);
     let (better, worse) = if pair_better {
         (pair_run, crawl_run)
@@ -762,6 +769,7 @@ fn free_gait(
         (&better, better_label),
         (&worse, worse_label),
         &reference_start,
+        early,
     )?;
     let better = crossed.record(better, settings, phases);
     let (crawl_run, pair_run, from_crawl, from_pair) = if pair_better {
@@ -782,7 +790,8 @@ fn free_gait(
 /// The free gait's solves after the crawl and pair plans, not yet recorded: three
 /// independent chains sharing the threads: the crossing search ([`crossing_search`])
 /// from the better plan then the schedule search from its result; the schedule search
-/// from the other plan; the reference without (10) from `reference_start`. Their logs
+/// from the other plan; the reference without (10) from `reference_start`; each unless
+/// `early` holds it already ([`crate::early_start`]). Their logs
 /// are recorded afterwards, in a fixed order, and the best plan is chosen in that
 /// order, so the outcome does not depend on the number of threads.
 #[allow(clippy::type_complexity)]
@@ -793,6 +802,7 @@ fn chains(
     (better, better_label): (&Run, &str),
     (worse, worse_label): (&Run, &str),
     reference_start: &[f64],
+    early: Early,
 ) -> Result<
     (
         crossing_search::Searched,
@@ -802,22 +812,40 @@ fn chains(
     ),
     PlanningError,
 > {
-    let (better_chain, (from_worse, reference)) = rayon::join(
+    let Early {
+        crossed,
+        from_better,
+        from_worse_and_reference,
+    } = early;
+    let (better_chain, other_chain) = rayon::join(
         || -> Result<_, PlanningError> {
-            let crossed = crossing_search::run(s, terrain, candidate, better)?;
-            let from = crossed.best_run().unwrap_or(better);
-            let searched = search_from(s, terrain, candidate, from, better_label)?;
+            let crossed = match crossed {
+                Some(crossed) => crossed,
+                None => crossing_search::run(s, terrain, candidate, better, None)?,
+            };
+            let searched = match from_better {
+                Some(searched) => searched,
+                None => {
+                    let from = crossed.best_run().unwrap_or(better);
+                    search_from(s, terrain, candidate, from, better_label)?
+                }
+            };
             Ok((crossed, searched))
         },
-        || {
-            rayon::join(
+        || -> Result<_, PlanningError> {
+            if let Some(done) = from_worse_and_reference {
+                return Ok(done);
+            }
+            let (from_worse, reference) = rayon::join(
                 || search_from(s, terrain, candidate, worse, worse_label),
                 || objective_without_10(s, terrain, reference_start, candidate),
-            )
+            );
+            Ok((from_worse?, reference?))
         },
     );
     let (crossed, from_better) = better_chain?;
-    Ok((crossed, from_better, from_worse?, reference?))
+    let (from_worse, reference) = other_chain?;
+    Ok((crossed, from_better, from_worse, reference))
 }
 
 /// The better of the crawl and biped-pair runs (the crawl run on a tie or when both fail).
@@ -834,7 +862,7 @@ fn pair_run_or(crawl: Run, pair: Run) -> Run {
 /// re-solve frees every variable. Stops when no proposal improves, a re-solve does not
 /// beat the plan it started from, or after [`SEARCH_ROUNDS`] rounds. Nothing when
 /// `from` failed.
-fn search_from(
+pub(crate) fn search_from(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     candidate: &Settings,
@@ -866,7 +894,7 @@ fn search_from(
                 if proposal.changed == 1 { "" } else { "s" },
                 proposal.evaluated
             ),
-            true,
+            Stop::STALL,
         )?;
         let improved = next.run.beats(best);
         out.push(next);
