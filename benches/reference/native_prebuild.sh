@@ -21,7 +21,7 @@ cargo bench --workspace --bench symx_eval --no-run
 py=benches/reference/native_casadi.py
 inlined=${QUADROTOR_INLINED:-grad_f}
 python3 $py --export-bin target/release/examples/export --keep "$out/gap" --no-symx
-python3 $py --problem quadrotor --only "${inlined// /,}" --gcc-opt "${GCC_OPT:--O3}" \
+python3 $py --problem quadrotor --only "${inlined// /,}" --gcc-opt="${GCC_OPT:--O3}" \
   --keep "$out/quadrotor" --no-symx
 python3 $py --problem quadrotor_calls --keep "$out/quadrotor_calls" --no-symx
 echo "prebuilt in $out: now bash benches/reference/native_side_by_side.sh $out"
