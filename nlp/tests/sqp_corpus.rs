@@ -60,7 +60,7 @@ fn cold_ocp_set_sqp_against_ipm() {
 /// its iteration log (`SQP_PRINT`, default 5) and a wall-time cap (`MAX_WALL`, default
 /// 10 s): the diagnostics behind the notebook's causes of the failures.
 #[test]
-#[ignore = "diagnostics: INSTANCE=glider_trap_100 cargo test --release -p nlp --test sqp_corpus -- --ignored --nocapture one_instance_log"]
+#[ignore = "diagnostics: INSTANCE=glider_trap_100 cargo test --release --workspace --test sqp_corpus -- --ignored --nocapture one_instance_log"]
 fn one_instance_log() {
     let env = |k: &str| std::env::var(k).ok();
     let name = env("INSTANCE").unwrap_or_else(|| "glider_trap_100".into());
