@@ -56,8 +56,8 @@ fn cold_ocp_set_sqp_against_ipm() {
     );
 }
 
-/// One instance of the set (`INSTANCE`, e.g. `glider_trap_100`) solved by the SQP with
-/// its iteration log (`SQP_PRINT`, default 5) and a wall-time cap (`MAX_WALL`, default
+/// One instance of the set (`INSTANCE`, e.g. `glider_trap_100`) solved by the SQP, cold
+/// or (`WARM_FROM_IPM=1`) from the IPM's solution, with its iteration log (`SQP_PRINT`, default 5) and a wall-time cap (`MAX_WALL`, default
 /// 10 s): the diagnostics behind the notebook's causes of the failures.
 #[test]
 #[ignore = "diagnostics: INSTANCE=glider_trap_100 cargo test --release --workspace --test sqp_corpus -- --ignored --nocapture one_instance_log"]
@@ -69,8 +69,17 @@ fn one_instance_log() {
     o.common.print_level = env("SQP_PRINT").and_then(|s| s.parse().ok()).unwrap_or(5);
     let inst = corpus::instance(&name).expect("INSTANCE names a corpus instance");
     let mut c = inst.build().unwrap().compile().unwrap();
+    // `WARM_FROM_IPM=1`: the SQP started from the IPM's solution (x and multipliers).
+    let warm = env("WARM_FROM_IPM").map(|_| {
+        let ipm = Ipm::default().solve_dyn(&mut c, None, None).unwrap();
+        println!(
+            "ipm: {:?} after {} iterations",
+            ipm.status, ipm.stats.iterations
+        );
+        ipm
+    });
     let t = Instant::now();
-    let sol = Sqp::new(o).solve_dyn(&mut c, None, None).unwrap();
+    let sol = Sqp::new(o).solve_dyn(&mut c, warm.as_ref(), None).unwrap();
     println!(
         "{}: {:?} after {} iterations, {} QPs, f = {:e}, {:.3} s",
         inst.name(),
