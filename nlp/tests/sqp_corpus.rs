@@ -2,10 +2,12 @@
 //! solved as often as the IPM, total time ≤ 1.5× the IPM's): the smallest instance of
 //! every optimal-control family (`corpus/tests/smallest.rs` checks the IPM there against
 //! IPOPT), both back ends with default options from the instance's own guess. A report,
-//! not an assertion of the target (not met): one JSON line per instance and a total.
+//! not an assertion of the target (not met by the SQP alone): one JSON line per instance
+//! and a total. `COLD_START_IPM=1` runs the SQP with `cold_start_ipm` (the IPM's
+//! solution as the SQP's start; its time includes the IPM's).
 //!
 //! ```text
-//! cargo test --release -p nlp --test sqp_corpus -- --ignored --nocapture
+//! cargo test --release --workspace --test sqp_corpus -- --ignored --nocapture cold_ocp_set
 //! ```
 use std::time::Instant;
 
@@ -21,6 +23,7 @@ fn cold_ocp_set_sqp_against_ipm() {
         .unwrap_or(60.0);
     let mut sqp_options = SqpOptions::default();
     sqp_options.common.max_wall_time = max_wall;
+    sqp_options.cold_start_ipm = std::env::var("COLD_START_IPM").is_ok_and(|v| v == "1");
     let sqp = Sqp::new(sqp_options);
     let mut ipm = Ipm::default();
     ipm.options.common.max_wall_time = max_wall;

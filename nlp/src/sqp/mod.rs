@@ -39,7 +39,8 @@
 //! `convexify.rs`, `bfgs.rs`, `iterate.rs` (the iterate and its KKT error), `shape.rs`
 //! (sizes and patterns), `geometry.rs` (bounds, cones, violations), `qp.rs` (the
 //! clarabel subproblem), `active_set.rs` (the warm active-set QP), `polish.rs`,
-//! `stop.rs`, `workspace.rs` (what a solver keeps between solves);
+//! `stop.rs`, `workspace.rs` (what a solver keeps between solves), `cold_start.rs` (the
+//! IPM's solution as the start of a cold solve, option `cold_start_ipm`);
 //! `rti.rs`: real-time iterations ([`Rti`]), one iteration per sampling instant split
 //! into a preparation and a feedback, built on the same parts.
 //! Scaling, evaluation counters and the returned `Solution` are the front end's
@@ -50,6 +51,7 @@
 mod accept;
 mod active_set;
 mod bfgs;
+mod cold_start;
 mod convexify;
 mod geometry;
 mod iterate;
@@ -103,8 +105,12 @@ impl Solver for Sqp {
         warm: Option<&Solution>,
         callback: Option<&mut IterationCallback<'_>>,
     ) -> Result<Solution, SolveError> {
+        let ipm_start = match warm {
+            None if self.options.cold_start_ipm => cold_start::ipm_start(&self.options, nlp)?,
+            _ => None,
+        };
         let mut sol = Solution::empty();
-        self.run_into(nlp, warm, callback, &mut sol)?;
+        self.run_into(nlp, warm.or(ipm_start.as_ref()), callback, &mut sol)?;
         Ok(sol)
     }
 

@@ -93,6 +93,14 @@ pub struct SqpOptions {
     /// takes over. Default 100 (one clarabel solve of the cold cart-pole's QPs costs
     /// about as many instructions as 100 active-set iterations).
     pub qp_active_set_max_iter: u32,
+    // ---------- cold start ----------
+    /// Without a warm start, solve first with the interior-point method ([`crate::Ipm`],
+    /// with these common options) and start the SQP from its solution (x and the
+    /// multipliers λ, z_L, z_U); a cold start when the IPM does not succeed. The SQP then
+    /// confirms a converged IPM solution in 0–2 iterations. For MPC and sequences of
+    /// nearby problems: the IPM is the robust cold solver, the SQP the fast warm one
+    /// (docs/solvers.md). Default false (the SQP alone).
+    pub cold_start_ipm: bool,
 }
 
 crate::frontend::strict_options_serde!(SqpOptions);
@@ -122,6 +130,7 @@ impl Default for SqpOptions {
             qp_polish: true,
             qp_active_set: true,
             qp_active_set_max_iter: 100,
+            cold_start_ipm: false,
         }
     }
 }
