@@ -366,6 +366,9 @@ impl Rti {
     pub fn shift(&mut self, shift: &Shift) -> Result<(), RtiError> {
         shift.apply(&mut self.plan)?;
         self.prepared = false;
+        // The last QP's working set belongs to the unshifted plan: the preparation
+        // guesses the shifted one from the shifted multipliers.
+        self.has_working_set = false;
         Ok(())
     }
 
