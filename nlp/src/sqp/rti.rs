@@ -218,6 +218,21 @@ struct Work {
     mult: Mult,
 }
 
+impl Work {
+    /// Empty work vectors for n variables and m rows.
+    fn new(n: usize, m: usize) -> Work {
+        Work {
+            active: (Vec::with_capacity(m), Vec::with_capacity(n)),
+            convexify: ConvexifyScratch::default(),
+            eq: EqScratch::default(),
+            qp: active_set::Scratch::default(),
+            predictor: Predictor::default(),
+            res: QpResult::empty(),
+            mult: Mult::zeros(n, m, 0),
+        }
+    }
+}
+
 /// How the feedback's QP was solved.
 struct QpOutcome {
     /// Whether a result is in `Work::res`.
@@ -312,15 +327,7 @@ impl Rti {
             residual: RtiResidual::default(),
             lgrad: vec![0.0; n],
             jd: vec![0.0; m],
-            work: Work {
-                active: (Vec::with_capacity(m), Vec::with_capacity(n)),
-                convexify: ConvexifyScratch::default(),
-                eq: EqScratch::default(),
-                qp: active_set::Scratch::default(),
-                predictor: Predictor::default(),
-                res: QpResult::empty(),
-                mult: Mult::zeros(n, m, 0),
-            },
+            work: Work::new(n, m),
         })
     }
 

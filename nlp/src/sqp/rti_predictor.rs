@@ -57,7 +57,7 @@ impl Predictor {
         g: &mut [f64],
         (g_l, g_u): (&[f64], &[f64]),
     ) {
-        for k in 0..self.x0_lin.len() {
+        for (k, x0_k) in self.x0_lin.iter_mut().enumerate() {
             let mut rows = terms.iter().filter(|t| t.1 == k);
             let (Some(&(row, _, c)), None) = (rows.next(), rows.next()) else {
                 continue;
@@ -66,7 +66,7 @@ impl Predictor {
             if g_l[row] == b && b.is_finite() && c != 0.0 {
                 let dx0 = (b - g[row]) / c;
                 g[row] += c * dx0;
-                self.x0_lin[k] += dx0;
+                *x0_k += dx0;
             }
         }
     }
@@ -138,7 +138,7 @@ impl Predictor {
         // target relative to the whole step.
         let size = self.rhs.iter().fold(1.0f64, |a, v| a.max(v.abs()));
         let error = ratio * (correction_max + rhs_max) + ZERO_BLOCK_REG * dl_max;
-        if !size.is_finite() || !(error <= CORRECTION_RATIO * size) {
+        if !size.is_finite() || error.is_nan() || error > CORRECTION_RATIO * size {
             return None;
         }
         Some(self.rhs.split_at(n))
