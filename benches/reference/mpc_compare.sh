@@ -23,7 +23,9 @@ PROBLEMS="${2:-cart_pole,car,quadrotor}"
 SQP_TIMEOUT="${SQP_TIMEOUT:-120}"
 OUT="${OUT:-$HERE/results/mpc_compare.jsonl}"
 cd "$ROOT"
-cargo build --release -q -p symnlp-examples --example mpc_cart_pole --example mpc_car --example mpc_quadrotor
+# The workspace's feature set (as `cargo build --release --workspace`), so that no
+# dependency is rebuilt with another one.
+cargo build --release -q --workspace --examples
 : > "$OUT"
 for round in $(seq 1 "$ROUNDS"); do
     for p in ${PROBLEMS//,/ }; do

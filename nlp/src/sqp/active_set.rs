@@ -224,6 +224,35 @@ pub(super) fn solve_in(
     Err(Failure::IterationLimit)
 }
 
+/// The first iteration of [`solve_in`] for a step of W's equality QP computed by the
+/// caller (`d` and the rows' total multipliers `lambda`; the real-time iteration's
+/// predictor-corrector): the sign test and, when it passes and the step is a KKT point
+/// of the QP (as [`solve_in`] checks it), the result in `res` (one iteration). `None`
+/// when W must change or the step is inaccurate: the caller then runs [`solve_in`].
+pub(super) fn accept_step_in(
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    (w, res): (&WorkingSet, &mut QpResult),
+    (d, lambda): (&[f64], &[f64]),
+    n_elastic: usize,
+    scratch: &mut Scratch,
+) -> Option<Found> {
+    let Scratch { changes, s, jd, .. } = scratch;
+    stationarity_into(p, (jp, hp), d, lambda, s);
+    jac_times_into(p, jp, d, jd);
+    let step = Step { d, lambda, s, jd };
+    sign_test(p, w, &step, changes);
+    if !changes.is_empty() {
+        return None;
+    }
+    let max_multiplier = kkt_point(p, w, step, n_elastic, res).ok()?;
+    res.iterations = 1;
+    Some(Found {
+        iterations: 1,
+        max_multiplier,
+    })
+}
+
 /// A change of the working set: (index, rows then variables; the new side; the size of
 /// the violation).
 type Change = (usize, Side, f64);

@@ -60,6 +60,7 @@ pub mod options;
 mod polish;
 pub(crate) mod qp;
 pub mod rti;
+mod rti_predictor;
 mod shape;
 mod state;
 mod stop;

@@ -163,7 +163,7 @@ pub(super) fn equality_qp_step_into(
 }
 
 /// Regularisation of the zero block of W's rows, removed again by iterative refinement.
-const ZERO_BLOCK_REG: f64 = 1e-10;
+pub(super) const ZERO_BLOCK_REG: f64 = 1e-10;
 
 /// The diagonal weight that fixes a bound of W (far above the Hessian's entries).
 fn fixing_weight(p: &QpData) -> f64 {

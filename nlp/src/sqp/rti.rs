@@ -35,6 +35,7 @@ use super::iterate::{Errors, Iterate, Mult};
 use super::options::{HessianApproximation, SqpOptions};
 use super::polish::{factor_working_set_in, EqScratch, WorkingSet};
 use super::qp::{Qp, QpResult};
+use super::rti_predictor::Predictor;
 use super::shape::Shape;
 use super::state::{new_qp, Curvature};
 use super::subproblem::qp_data;
@@ -209,10 +210,27 @@ struct Work {
     eq: EqScratch,
     /// The active-set method's vectors.
     qp: active_set::Scratch,
+    /// The step prepared for the plan's initial state and its correction.
+    predictor: Predictor,
     /// The QP's result.
     res: QpResult,
     /// The QP's multipliers of the problem (`Mult::set_from_qp`).
     mult: Mult,
+}
+
+impl Work {
+    /// Empty work vectors for n variables and m rows.
+    fn new(n: usize, m: usize) -> Work {
+        Work {
+            active: (Vec::with_capacity(m), Vec::with_capacity(n)),
+            convexify: ConvexifyScratch::default(),
+            eq: EqScratch::default(),
+            qp: active_set::Scratch::default(),
+            predictor: Predictor::default(),
+            res: QpResult::empty(),
+            mult: Mult::zeros(n, m, 0),
+        }
+    }
 }
 
 /// How the feedback's QP was solved.
@@ -309,14 +327,7 @@ impl Rti {
             residual: RtiResidual::default(),
             lgrad: vec![0.0; n],
             jd: vec![0.0; m],
-            work: Work {
-                active: (Vec::with_capacity(m), Vec::with_capacity(n)),
-                convexify: ConvexifyScratch::default(),
-                eq: EqScratch::default(),
-                qp: active_set::Scratch::default(),
-                res: QpResult::empty(),
-                mult: Mult::zeros(n, m, 0),
-            },
+            work: Work::new(n, m),
         })
     }
 
@@ -362,6 +373,9 @@ impl Rti {
     pub fn shift(&mut self, shift: &Shift) -> Result<(), RtiError> {
         shift.apply(&mut self.plan)?;
         self.prepared = false;
+        // The last QP's working set belongs to the unshifted plan: the preparation
+        // guesses the shifted one from the shifted multipliers.
+        self.has_working_set = false;
         Ok(())
     }
 
@@ -386,8 +400,26 @@ impl Rti {
         let mut n_fact = 0;
         let eq = &mut self.work.eq;
         self.factored = factor_working_set_in(&mut self.kkt, &data, w, &mut n_fact, eq);
+        self.predict();
         self.prepared = true;
         Ok(())
+    }
+
+    /// The QP step for the plan's own initial state with the prepared factorisation
+    /// (`Predictor`), when x0 enters g through rows affine in it; the feedback then only
+    /// corrects it for the measured state.
+    fn predict(&mut self) {
+        let pr = &mut self.work.predictor;
+        pr.reset(&self.compiled.parameter_values()[self.x0_entries.clone()]);
+        let Some(terms) = self.x0_terms.as_deref() else {
+            return;
+        };
+        if !self.factored {
+            return;
+        }
+        pr.move_to_plan(terms, &mut self.it.g, (&self.geo.g_l, &self.geo.g_u));
+        let data = qp_data(&self.it, &self.geo, &self.curv, false, self.delta, 0.0);
+        pr.solve(&mut self.kkt, &data, &self.working_set, &mut self.work.eq);
     }
 
     /// The feedback phase with the measured initial state `x0`: the QP of the prepared
@@ -408,7 +440,7 @@ impl Rti {
         }
         self.insert_initial_state(x0)?;
         self.prepared = false;
-        let qp = self.solve_qp();
+        let qp = self.solve_qp(x0);
         let status = if qp.solved {
             self.take_step();
             Status::RealTimeIterationTaken
@@ -470,7 +502,8 @@ impl Rti {
     fn insert_initial_state(&mut self, x0: &[f64]) -> Result<(), RtiError> {
         let start = self.x0_entries.start;
         if let Some(terms) = &self.x0_terms {
-            let old = &self.compiled.parameter_values()[self.x0_entries.clone()];
+            // The values the prepared g corresponds to (the plan's initial state).
+            let old = &self.work.predictor.x0_lin;
             if x0.iter().all(|v| v.is_finite()) {
                 for &(row, k, c) in terms {
                     self.it.g[row] += c * (x0[k] - old[k]);
@@ -550,7 +583,7 @@ impl Rti {
     /// The QP at the prepared linearisation with the current g, its result into
     /// `work.res`: the active-set method from the prepared working set (and
     /// factorisation), else clarabel's elastic QP with ρ = `penalty_max` (which allocates).
-    fn solve_qp(&mut self) -> QpOutcome {
+    fn solve_qp(&mut self, x0: &[f64]) -> QpOutcome {
         let o = &self.options;
         let data = qp_data(
             &self.it,
@@ -561,6 +594,26 @@ impl Rti {
             o.penalty_max,
         );
         let mut n_fact = 0;
+        if o.qp_active_set && self.has_working_set && self.factored {
+            let terms = self.x0_terms.as_deref().unwrap_or_default();
+            let w = &self.working_set;
+            let pats = (&self.shape.jp, &self.shape.hp);
+            let work = &mut self.work;
+            let step = work.predictor.correct(&mut self.kkt, &data, w, terms, x0);
+            let found = step.and_then(|step| {
+                let out = (w, &mut work.res);
+                active_set::accept_step_in(&data, pats, out, step, 0, &mut work.qp)
+            });
+            if let Some(found) = found {
+                self.factored = false;
+                return QpOutcome {
+                    solved: true,
+                    iterations: found.iterations,
+                    factorizations: 0,
+                    fallback: false,
+                };
+            }
+        }
         if o.qp_active_set {
             let w = &mut self.working_set;
             if !self.has_working_set {
