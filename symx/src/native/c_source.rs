@@ -12,9 +12,7 @@
 //! (`super::places`), inputs are read where `arg` points, outputs written where `res`
 //! points and constants are literals: `w` holds the temporaries only (plus the output
 //! entries the computation reads back, which a null `res[k]` must not lose).
-use super::places::{
-    callee_base, constant_outputs, first_temporary, places, read, work_need, Place,
-};
+use super::places::{call_layout, constant_outputs, places, read, work_need, Place};
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
 use crate::function::{Function, Instr};
@@ -200,29 +198,15 @@ fn value(ins: &Instr, regs: &Registers) -> Result<String, SymxError> {
 /// scratch block, laid out as its inputs, its outputs written straight into the call's
 /// block of registers (as the generated Rust does).
 fn call(o: &mut String, f: &Function, ins: &Instr, callee: &str, regs: &Registers) {
-    let call = &f.calls[ins.d as usize];
-    let g = &call.function;
-    let s = f.call_scratch - first_temporary(f);
-    let mut p = 0;
-    for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
-        for i in 0..n {
-            writeln!(o, "  w[{}] = {};", s + at + i, regs.get(call.args[p])).unwrap();
-            p += 1;
-        }
+    let layout = call_layout(f, ins);
+    for &(at, r) in &layout.args {
+        writeln!(o, "  w[{at}] = {};", regs.get(r)).unwrap();
     }
-    let xs: Vec<String> = g
-        .input_offsets
+    let xs: Vec<String> = layout.inputs.iter().map(|at| format!("w + {at}")).collect();
+    let ys: Vec<String> = layout
+        .outputs
         .iter()
-        .map(|at| format!("w + {}", s + at))
-        .collect();
-    let mut q = call.out as usize - first_temporary(f);
-    let ys: Vec<String> = g
-        .output_sizes
-        .iter()
-        .map(|n| {
-            q += n;
-            format!("w + {}", q - n)
-        })
+        .map(|at| format!("w + {at}"))
         .collect();
     let one = |v: Vec<String>| {
         if v.is_empty() {
@@ -236,7 +220,7 @@ fn call(o: &mut String, f: &Function, ins: &Instr, callee: &str, regs: &Register
         "  {{ const casadi_real* const xc[] = {{{}}}; casadi_real* const yc[] = {{{}}}; {callee}(w + {}, xc, yc); }}",
         one(xs),
         one(ys),
-        s + callee_base(g)
+        layout.callee_work
     )
     .unwrap();
 }

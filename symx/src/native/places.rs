@@ -3,7 +3,7 @@
 //! wants them, and only the temporaries (and the arguments gathered for a call of another
 //! function) in the work vector, already reused by liveness when the tape was compiled
 //! ([`Function::to_rust`], [`Function::to_c`]).
-use crate::function::Function;
+use crate::function::{Function, Instr};
 use crate::op::Op;
 
 /// Where the generated code finds a register of one function.
@@ -104,4 +104,48 @@ pub(super) fn read(f: &Function) -> Vec<bool> {
         }
     }
     read
+}
+
+/// Where a call node's data lives in the generated code's work vector (offsets from the
+/// first temporary): the arguments gathered in the callee's input layout, the callee's
+/// own work, and its outputs written straight into the call's block of registers.
+pub(super) struct CallLayout {
+    /// (work offset, caller's register) of every argument, in order.
+    pub args: Vec<(usize, u32)>,
+    /// Work offset of each input of the callee.
+    pub inputs: Vec<usize>,
+    /// Work offset of each output of the callee.
+    pub outputs: Vec<usize>,
+    /// Work offset of the callee's own work.
+    pub callee_work: usize,
+}
+
+/// The layout of the call node `ins` of `f` ([`CallLayout`]).
+pub(super) fn call_layout(f: &Function, ins: &Instr) -> CallLayout {
+    let call = &f.calls[ins.d as usize];
+    let g = &call.function;
+    let s = f.call_scratch - first_temporary(f);
+    let mut args = Vec::with_capacity(call.args.len());
+    let mut p = 0;
+    for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
+        for i in 0..n {
+            args.push((s + at + i, call.args[p]));
+            p += 1;
+        }
+    }
+    let mut q = call.out as usize - first_temporary(f);
+    let outputs = g
+        .output_sizes
+        .iter()
+        .map(|n| {
+            q += n;
+            q - n
+        })
+        .collect();
+    CallLayout {
+        args,
+        inputs: g.input_offsets.iter().map(|at| s + at).collect(),
+        outputs,
+        callee_work: s + callee_base(g),
+    }
 }

@@ -8,7 +8,7 @@
 //! temporaries (and the arguments gathered for a call of another function), so
 //! `WORK_SIZE` counts only those: the tape's registers from its first temporary on
 //! (`first_temporary`), already reused by liveness when the tape was compiled.
-use super::places::{callee_base, constant_outputs, first_temporary, places, work_need, Place};
+use super::places::{call_layout, constant_outputs, places, work_need, Place};
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
 use crate::function::{Function, Instr};
@@ -81,37 +81,23 @@ impl Body<'_> {
     /// block at `s`, laid out as `g`'s inputs, and its outputs written straight into the
     /// call's block of registers.
     fn call(&mut self, f: &Function, ins: &Instr, callee: &str) {
-        let call = &f.calls[ins.d as usize];
-        let g = &call.function;
-        let s = f.call_scratch - first_temporary(f);
-        let mut p = 0;
-        for (&n, &at) in g.input_sizes.iter().zip(&g.input_offsets) {
-            for i in 0..n {
-                let v = self.reg(call.args[p]);
-                writeln!(self.out, "    *w.add({}) = {v};", s + at + i).unwrap();
-                p += 1;
-            }
+        let layout = call_layout(f, ins);
+        for &(at, r) in &layout.args {
+            let v = self.reg(r);
+            writeln!(self.out, "    *w.add({at}) = {v};").unwrap();
         }
-        let xs: Vec<String> = g
-            .input_offsets
-            .iter()
-            .map(|at| format!("w.add({}) as *const f64", s + at))
+        let xs: Vec<String> = (layout.inputs.iter())
+            .map(|at| format!("w.add({at}) as *const f64"))
             .collect();
-        let mut q = call.out as usize - first_temporary(f);
-        let ys: Vec<String> = g
-            .output_sizes
-            .iter()
-            .map(|n| {
-                q += n;
-                format!("w.add({})", q - n)
-            })
+        let ys: Vec<String> = (layout.outputs.iter())
+            .map(|at| format!("w.add({at})"))
             .collect();
         writeln!(
             self.out,
             "    {{ let x = [{}]; let y = [{}]; {callee}(w.add({}), x.as_ptr(), y.as_ptr()); }}",
             xs.join(", "),
             ys.join(", "),
-            s + callee_base(g)
+            layout.callee_work
         )
         .unwrap();
     }
