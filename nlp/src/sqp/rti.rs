@@ -127,6 +127,10 @@ pub struct Feedback {
     pub factorizations: usize,
     /// Whether clarabel solved the QP (the active-set method gave up).
     pub fallback: bool,
+    /// Whether the step prepared for the plan's own initial state, corrected for the
+    /// measured one by one back-substitution, was the QP's solution (the
+    /// predictor-corrector of docs/mpc.md §5.1; no active-set iteration ran).
+    pub corrected: bool,
     /// ‖d‖∞ of the step.
     pub step_norm: f64,
     /// Wall seconds of the feedback.
@@ -241,6 +245,8 @@ struct QpOutcome {
     iterations: usize,
     /// Factorisations.
     factorizations: usize,
+    /// Whether the prepared step's correction was the solution.
+    corrected: bool,
     /// Whether clarabel solved it.
     fallback: bool,
 }
@@ -463,6 +469,7 @@ impl Rti {
             qp_iterations: qp.iterations,
             factorizations: qp.factorizations,
             fallback: qp.fallback,
+            corrected: qp.corrected,
             step_norm,
             seconds: start.elapsed().as_secs_f64(),
         })
@@ -611,6 +618,7 @@ impl Rti {
                     iterations: found.iterations,
                     factorizations: 0,
                     fallback: false,
+                    corrected: true,
                 };
             }
         }
@@ -637,6 +645,7 @@ impl Rti {
                     iterations: found.iterations,
                     factorizations: n_fact,
                     fallback: false,
+                    corrected: false,
                 };
             }
         }
@@ -659,6 +668,7 @@ impl Rti {
             iterations: 0,
             factorizations: n_fact,
             fallback: true,
+            corrected: false,
         }
     }
 
