@@ -266,6 +266,21 @@ fn long_tapes_match_the_tape() {
     assert_eq!(native.tape().evaluator(), Evaluator::Tape);
 }
 
+/// [`SPECIAL`] and NaNs of both signs with different payloads (x86 returns the first
+/// operand's NaN, so a swapped operand would show).
+fn special_with_nan_payloads() -> Vec<f64> {
+    let mut special = SPECIAL.to_vec();
+    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
+    special.push(f64::from_bits(0xfff8_0000_0000_0002));
+    special.push(-f64::NAN);
+    special
+}
+
+/// The binary operations the JIT pairs into SIMD instructions.
+fn pairable_binary() -> [fn(Expr, Expr) -> Expr; 4] {
+    [|a, b| a + b, |a, b| a - b, |a, b| a * b, |a, b| a / b]
+}
+
 /// Independent isomorphic lanes, which the JIT evaluates two at a time in SIMD registers
 /// (`f64x2`): every pairable operation (`+ − × ÷`, negation, square, square root, absolute
 /// value) on every pair of special operands, NaNs of different signs and payloads in both
@@ -274,15 +289,11 @@ fn long_tapes_match_the_tape() {
 /// scattered.
 #[test]
 fn paired_lanes_match_the_tape_on_special_values() {
-    let mut special = SPECIAL.to_vec();
-    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
-    special.push(f64::from_bits(0xfff8_0000_0000_0002));
-    special.push(-f64::NAN);
+    let special = special_with_nan_payloads();
     let n = special.len();
     let x = Matrix::sym_vec("x", n);
     let y = Matrix::sym_vec("y", n);
-    let binary: [fn(Expr, Expr) -> Expr; 4] =
-        [|a, b| a + b, |a, b| a - b, |a, b| a * b, |a, b| a / b];
+    let binary = pairable_binary();
     let unary: [fn(Expr) -> Expr; 4] = [|a| -a, |a| a.sq(), |a| a.sqrt(), |a| a.abs()];
     for (k, op) in binary.iter().enumerate() {
         for (u, un) in unary.iter().enumerate() {
@@ -318,10 +329,7 @@ fn paired_lanes_match_the_tape_on_special_values() {
 /// negations reusing the sign mask.
 #[test]
 fn constants_first_match_the_tape_on_special_values() {
-    let mut special = SPECIAL.to_vec();
-    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
-    special.push(f64::from_bits(0xfff8_0000_0000_0002));
-    special.push(-f64::NAN);
+    let special = special_with_nan_payloads();
     let n = special.len();
     let x = Matrix::sym_vec("x", n);
     let constants = [
@@ -384,14 +392,10 @@ fn a_nan_constant_first_keeps_its_place() {
 /// every special operand.
 #[test]
 fn constant_pairs_keep_their_lanes() {
-    let mut special = SPECIAL.to_vec();
-    special.push(f64::from_bits(0x7ff8_0000_0000_0001));
-    special.push(f64::from_bits(0xfff8_0000_0000_0002));
-    special.push(-f64::NAN);
+    let special = special_with_nan_payloads();
     let n = special.len();
     let x = Matrix::sym_vec("x", n);
-    let binary: [fn(Expr, Expr) -> Expr; 4] =
-        [|a, b| a + b, |a, b| a - b, |a, b| a * b, |a, b| a / b];
+    let binary = pairable_binary();
     for shift in [0, 1, 5] {
         let mut outs = Vec::new();
         for op in binary {

@@ -29,10 +29,10 @@ impl ConstantPairs {
         let mut pairs = ConstantPairs::default();
         let mut pool = Vec::new();
         let operands = steps.iter().flat_map(|s| match s {
-            Step::Pair { operands, .. } => operands.iter().flatten().copied().collect(),
-            Step::Single(_) => Vec::new(),
+            Step::Pair { operands, .. } => operands.as_slice(),
+            Step::Single(_) => &[],
         });
-        for op in operands {
+        for &op in operands.flatten() {
             if let Operand::External(r1, r2) = op {
                 if let (Some(x), Some(y)) = (constant[r1 as usize], constant[r2 as usize]) {
                     let bits = [x.to_bits(), y.to_bits()];

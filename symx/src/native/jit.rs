@@ -13,6 +13,7 @@
 //! calls that function's machine code, compiled once in the same module.
 use super::constant_pairs::{ConstantPairs, Pair};
 use super::lanes::{self, Operand, Step};
+use super::places::written;
 use super::{Entry, SymxError};
 use crate::function::{Function, Instr};
 use crate::op::{self, Op};
@@ -300,7 +301,9 @@ impl Jit {
             .collect();
         let (pairs, pool) = ConstantPairs::of(&steps, &layout.constant);
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
-        let params = prologue(&mut b, layout, Some(pool.as_ptr() as i64));
+        // No pool parameter (one register less) when no SIMD instruction has a constant pair.
+        let pool_address = (!pool.is_empty()).then(|| pool.as_ptr() as i64);
+        let params = prologue(&mut b, layout, pool_address);
         let mut e = Emitter::new(&mut b, &mut self.module, params, layout, pairs);
         if with_template {
             e.template();
@@ -480,19 +483,11 @@ fn stores(f: &Function) -> Vec<bool> {
 
 /// The registers that hold a constant throughout (in the template, never written).
 fn constants(f: &Function) -> Vec<Option<f64>> {
+    let written = written(f);
     let mut c = vec![None; f.work_size];
     for (k, &v) in f.template.iter().enumerate() {
-        c[f.template_start + k] = Some(v);
-    }
-    for ins in &f.tape {
-        if ins.op == Op::Call {
-            let call = &f.calls[ins.d as usize];
-            let n: usize = call.function.output_sizes.iter().sum();
-            let out = call.out as usize;
-            c[out..out + n].iter_mut().for_each(|r| *r = None);
-        } else {
-            c[ins.d as usize] = None;
-        }
+        let r = f.template_start + k;
+        c[r] = (!written[r]).then_some(v);
     }
     c
 }

@@ -62,8 +62,9 @@ pub(super) fn places(f: &Function) -> Vec<Place> {
     p
 }
 
-/// The output entries no instruction writes (constant outputs), with their values.
-pub(super) fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
+/// Whether each register of `f` is written by some instruction of its tape (its
+/// destination, or an output of a call).
+pub(super) fn written(f: &Function) -> Vec<bool> {
     let mut written = vec![false; f.work_size];
     for ins in &f.tape {
         if ins.op == Op::Call {
@@ -75,6 +76,12 @@ pub(super) fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
             written[ins.d as usize] = true;
         }
     }
+    written
+}
+
+/// The output entries no instruction writes (constant outputs), with their values.
+pub(super) fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
+    let written = written(f);
     let mut c = Vec::new();
     for (k, (&n, &at)) in f.output_sizes.iter().zip(&f.output_offsets).enumerate() {
         for i in (0..n).filter(|&i| !written[at + i]) {
