@@ -99,7 +99,8 @@ pub struct SqpOptions {
     /// multipliers λ, z_L, z_U); a cold start when the IPM does not succeed. The SQP then
     /// confirms a converged IPM solution in 0–2 iterations. For MPC and sequences of
     /// nearby problems: the IPM is the robust cold solver, the SQP the fast warm one
-    /// (docs/solvers.md). Default false (the SQP alone).
+    /// (docs/solvers.md). `max_iter` and `max_wall_time` apply to each of the two solves,
+    /// and `Solution::stats` are the SQP's. Default false (the SQP alone).
     pub cold_start_ipm: bool,
 }
 
