@@ -302,7 +302,7 @@ impl Jit {
         let (pairs, pool) = ConstantPairs::of(&steps, &layout.constant);
         let mut b = FunctionBuilder::new(&mut self.ctx.func, &mut self.fbc);
         // No pool parameter (one register less) when no SIMD instruction has a constant pair.
-        let pool_address = (!pool.is_empty()).then(|| pool.as_ptr() as i64);
+        let pool_address = (!pool.is_empty()).then_some(pool.as_ptr() as i64);
         let params = prologue(&mut b, layout, pool_address);
         let mut e = Emitter::new(&mut b, &mut self.module, params, layout, pairs);
         if with_template {
