@@ -360,7 +360,7 @@ fn loop_allocations(evaluator: Evaluator) -> Vec<(usize, usize)> {
 /// measured state is the predicted one to rounding, so every feedback is the prepared
 /// step corrected by one back-substitution (no factorisation, no fallback), with the
 /// control bound in the working set on the first steps (the bound rows of W keep their
-/// prepared values). With a plant that leaves the prediction by more than ≈ 1e-5 the
+/// prepared values). With a plant that leaves the prediction by more than ≈ 1e-6–1e-5 the
 /// unrefined correction misses the 1e-12 accuracy and the active-set path runs
 /// (docs/mpc.md §5.1).
 #[test]
