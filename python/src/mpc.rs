@@ -1,14 +1,16 @@
 //! `Mpc` (nlp::mpc::Mpc, the closed-loop driver) and `Simulator` (a nominal plant).
 use nlp::mpc::{ClosedLoop, Mpc, StepReport};
 use nlp::ocp::{OcpError, Simulator};
+use nlp::{Ipm, Solver, SqpOptions};
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use symx::Evaluator;
 
 use crate::error::{build_err, solve_err};
 use crate::function::numbers;
-use crate::problem::{make_solver, symbol_names};
+use crate::problem::{evaluator_named, make_solver, sqp_options, symbol_names};
 use crate::same_thread::SameThread;
 use crate::solution::PySolution;
 use crate::transcription::PyTranscription;
@@ -68,6 +70,7 @@ fn report_dict<'py>(py: Python<'py>, r: &StepReport) -> PyResult<Bound<'py, PyDi
     d.set_item("iterations", r.iterations)?;
     d.set_item("seconds", r.seconds)?;
     d.set_item("solve_seconds", r.solve_seconds)?;
+    d.set_item("feedback_seconds", r.feedback_seconds)?;
     d.set_item("objective", r.objective)?;
     d.set_item("warm", r.warm)?;
     Ok(d)
@@ -96,25 +99,49 @@ fn closed_loop_dict<'py>(py: Python<'py>, run: &ClosedLoop) -> PyResult<Bound<'p
     Ok(d)
 }
 
+/// What a new controller solves each step with.
+enum Engine {
+    /// A solver, warm from the shifted plan.
+    Solver(Box<dyn Solver>),
+    /// Real-time iterations with these SQP options.
+    Rti(SqpOptions),
+}
+
 #[pymethods]
 impl PyMpc {
-    /// A controller for `transcription` solved by `solver` (`"ipm"` or `"sqp"`) with
-    /// `options` by IPOPT's names; compiles the problem (without the GIL).
+    /// A controller for `transcription`: `solver` `"ipm"` (the default) or `"sqp"` solves
+    /// each step warm from the shifted plan; `"rti"` takes one real-time iteration per
+    /// step (the SQP's `options`; the first step, and the first after `reset`, converged
+    /// by the interior point). `options` by IPOPT's names; `evaluator` `"tape"` (the
+    /// default) or `"jit"` (machine code compiled now, bit-identical iterates, repaid after
+    /// some hundred steps: docs/mpc.md). Compiles without the GIL.
     #[new]
-    #[pyo3(signature = (transcription, solver = "ipm", options = None))]
+    #[pyo3(signature = (transcription, solver = "ipm", options = None, evaluator = "tape"))]
     fn new(
         py: Python<'_>,
         transcription: &mut PyTranscription,
         solver: &str,
         options: Option<&Bound<'_, PyDict>>,
+        evaluator: &str,
     ) -> PyResult<PyMpc> {
-        let backend = make_solver(solver, options)?;
+        let evaluator = evaluator_named(evaluator)?;
+        let engine = match solver {
+            "rti" => Engine::Rti(sqp_options(options)?),
+            _ => Engine::Solver(make_solver(solver, options)?),
+        };
         let live = transcription.live(py)?;
         let names = symbol_names(live.tr.problem());
         let tr = SameThread(&live.tr);
         let mpc = py.allow_threads(move || {
             let tr = tr;
-            Mpc::new(tr.0, backend)
+            let mpc = match engine {
+                Engine::Rti(o) => Mpc::with_rti(tr.0, o, Box::new(Ipm::default()))?,
+                Engine::Solver(backend) => Mpc::new(tr.0, backend)?,
+            };
+            match evaluator {
+                Evaluator::Tape => Ok(mpc),
+                _ => mpc.with_evaluator(evaluator),
+            }
         });
         Ok(PyMpc {
             mpc: mpc.map_err(build_err)?,
@@ -122,9 +149,20 @@ impl PyMpc {
         })
     }
 
+    /// With `solver="rti"`: shifts the plan and runs the preparation phase now (e.g. while
+    /// waiting for the next measurement), so that the next `step` runs only the feedback;
+    /// returns its wall seconds (0 for the other solvers, before the first step, or when
+    /// already prepared). Releases the GIL.
+    fn prepare(&mut self, py: Python<'_>) -> PyResult<f64> {
+        let mpc = &mut self.mpc;
+        py.allow_threads(|| mpc.prepare()).map_err(solve_err)
+    }
+
     /// One step from the measured state `x0`; returns a dict (`status`, `success`,
     /// `residual` (a real-time iteration's KKT residual, else `None`), `iterations`,
-    /// `seconds`, `solve_seconds`, `objective`, `warm`).
+    /// `seconds`, `solve_seconds`, `feedback_seconds` (a real-time iteration's feedback
+    /// phase, the latency from `x0` to the control when `prepare` ran ahead), `objective`,
+    /// `warm`).
     fn step<'py>(
         &mut self,
         py: Python<'py>,

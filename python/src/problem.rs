@@ -11,7 +11,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
 use serde::{Deserialize, Serialize};
-use symx::Expr;
+use symx::{Evaluator, Expr};
 
 use crate::error::{build_err, option_err, solve_err};
 use crate::expr::{operand, symbols, PyConstraint, PyExpr};
@@ -128,6 +128,9 @@ pub struct PyProblem {
     pb: nlp::Problem,
     steps: Vec<Step<Expr>>,
     compiled: Option<Compiled>,
+    /// How `compiled` evaluates (`compile(evaluator=...)`; kept across recompilations,
+    /// not pickled).
+    evaluator: Evaluator,
     sensitivity: Option<nlp::ParametricSensitivity>,
 }
 
@@ -260,7 +263,7 @@ impl PyProblem {
 
     fn ensure_compiled(&mut self, py: Python<'_>) -> PyResult<()> {
         if self.compiled.is_none() {
-            self.compiled = Some(compile_without_gil(py, &self.pb)?);
+            self.compiled = Some(compile_without_gil(py, &self.pb, self.evaluator)?);
         }
         Ok(())
     }
@@ -286,14 +289,47 @@ impl PyProblem {
     }
 }
 
-/// `pb` compiled with the GIL released.
-pub fn compile_without_gil(py: Python<'_>, pb: &nlp::Problem) -> PyResult<Compiled> {
+/// `pb` compiled with the GIL released, its functions evaluated by `evaluator`.
+pub fn compile_without_gil(
+    py: Python<'_>,
+    pb: &nlp::Problem,
+    evaluator: Evaluator,
+) -> PyResult<Compiled> {
     let pb = SameThread(pb);
     let c = py.allow_threads(move || {
         let pb = pb;
-        pb.0.compile()
+        pb.0.compile_with(nlp::CompileOptions { evaluator })
     });
     c.map_err(build_err)
+}
+
+/// The evaluator named `name`: `"tape"` (the interpreter, the default) or `"jit"`
+/// (machine code by Cranelift, bit-identical values).
+pub fn evaluator_named(name: &str) -> PyResult<Evaluator> {
+    match name {
+        "tape" => Ok(Evaluator::Tape),
+        "jit" => Ok(Evaluator::Jit),
+        other => Err(crate::error::OptionError::new_err(format!(
+            "unknown evaluator '{other}': expected 'tape' or 'jit'"
+        ))),
+    }
+}
+
+/// `compiled` evaluated by `evaluator` (converted with the GIL released when it is not).
+pub fn with_evaluator_without_gil(
+    py: Python<'_>,
+    compiled: Compiled,
+    evaluator: Evaluator,
+) -> PyResult<Compiled> {
+    if compiled.evaluator() == evaluator {
+        return Ok(compiled);
+    }
+    let c = SameThread(compiled);
+    py.allow_threads(move || {
+        let c = c;
+        c.0.with_evaluator(evaluator)
+    })
+    .map_err(build_err)
 }
 
 /// The names of `pb`'s variables then parameters, entry by entry (what a [`PySolution`]
@@ -365,25 +401,38 @@ pub fn make_solver(solver: &str, options: Option<&Bound<'_, PyDict>>) -> PyResul
             )))
         }
     };
-    if let Some(d) = options {
-        let mut assignments = Vec::with_capacity(d.len());
-        for (k, v) in d.iter() {
-            let key: String = k.extract()?;
-            let value = if v.is_instance_of::<PyBool>() {
-                if v.extract::<bool>()? {
-                    "true".to_string()
-                } else {
-                    "false".to_string()
-                }
-            } else {
-                v.str()?.to_string()
-            };
-            assignments.push(format!("{key}={value}"));
-        }
-        let refs: Vec<&str> = assignments.iter().map(String::as_str).collect();
-        opts.set_options_by_name(&refs).map_err(option_err)?;
-    }
+    set_options(opts.as_mut(), options)?;
     Ok(opts.solver())
+}
+
+/// The SQP's options with `options` (IPOPT-style names) set.
+pub fn sqp_options(options: Option<&Bound<'_, PyDict>>) -> PyResult<nlp::SqpOptions> {
+    let mut opts = nlp::SqpOptions::default();
+    set_options(&mut opts, options)?;
+    Ok(opts)
+}
+
+/// Sets `options` (a dict of IPOPT-style names to values) on `opts`.
+fn set_options(opts: &mut dyn SolverOptions, options: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
+    let Some(d) = options else {
+        return Ok(());
+    };
+    let mut assignments = Vec::with_capacity(d.len());
+    for (k, v) in d.iter() {
+        let key: String = k.extract()?;
+        let value = if v.is_instance_of::<PyBool>() {
+            if v.extract::<bool>()? {
+                "true".to_string()
+            } else {
+                "false".to_string()
+            }
+        } else {
+            v.str()?.to_string()
+        };
+        assignments.push(format!("{key}={value}"));
+    }
+    let refs: Vec<&str> = assignments.iter().map(String::as_str).collect();
+    opts.set_options_by_name(&refs).map_err(option_err)
 }
 
 #[pymethods]
@@ -397,6 +446,7 @@ impl PyProblem {
             pb: nlp::Problem::new(),
             steps: Vec::new(),
             compiled: None,
+            evaluator: Evaluator::Tape,
             sensitivity: None,
         }
     }
@@ -576,9 +626,18 @@ impl PyProblem {
         Ok(self.pb.n_constraints())
     }
 
-    /// Compiles now (otherwise the first solve does). Releases the GIL.
-    fn compile(&mut self, py: Python<'_>) -> PyResult<()> {
+    /// Compiles now (otherwise the first solve does), its functions evaluated by
+    /// `evaluator`: `"tape"` (the default) or `"jit"` (machine code, CasADi's `jit`
+    /// option: bit-identical values, so identical iterates, several times faster per
+    /// evaluation at a compile time worth it when the problem is solved many times). The
+    /// choice stays for later recompilations of this object. Releases the GIL.
+    #[pyo3(signature = (evaluator = "tape"))]
+    fn compile(&mut self, py: Python<'_>, evaluator: &str) -> PyResult<()> {
         self.bind()?;
+        self.evaluator = evaluator_named(evaluator)?;
+        if let Some(c) = self.compiled.take() {
+            self.compiled = Some(with_evaluator_without_gil(py, c, self.evaluator)?);
+        }
         self.ensure_compiled(py)
     }
 

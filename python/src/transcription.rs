@@ -8,6 +8,7 @@ use nlp::ocp::{Grid, Transcription};
 use nlp::Compiled;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
+use symx::Evaluator;
 
 use crate::error::{build_err, BuildError};
 use crate::expr::PyExpr;
@@ -15,7 +16,8 @@ use crate::function::numbers;
 use crate::method::{MethodSpec, PyGrid, PyMethod};
 use crate::ocp::{ErrorSlot, PyOcp};
 use crate::problem::{
-    compile_without_gil, make_solver, sensitivity_dict, solve_compiled, symbol_names,
+    compile_without_gil, evaluator_named, make_solver, sensitivity_dict, solve_compiled,
+    symbol_names, with_evaluator_without_gil,
 };
 use crate::solution::PySolution;
 use crate::trajectory::PyTrajectory;
@@ -114,7 +116,7 @@ impl PyTranscription {
     fn compiled(&mut self, py: Python<'_>) -> PyResult<&mut Live> {
         let live = self.live(py)?;
         if live.compiled.is_none() {
-            live.compiled = Some(compile_without_gil(py, live.tr.problem())?);
+            live.compiled = Some(compile_without_gil(py, live.tr.problem(), Evaluator::Tape)?);
         }
         Ok(live)
     }
@@ -142,9 +144,16 @@ impl PyTranscription {
 
 #[pymethods]
 impl PyTranscription {
-    /// Compiles now (otherwise the first solve does). Releases the GIL.
-    fn compile(&mut self, py: Python<'_>) -> PyResult<()> {
-        self.compiled(py).map(|_| ())
+    /// Compiles now (otherwise the first solve does), its functions evaluated by
+    /// `evaluator` (`"tape"`, the default, or `"jit"`, as `Problem.compile`). Releases
+    /// the GIL.
+    #[pyo3(signature = (evaluator = "tape"))]
+    fn compile(&mut self, py: Python<'_>, evaluator: &str) -> PyResult<()> {
+        let evaluator = evaluator_named(evaluator)?;
+        let live = self.compiled(py)?;
+        let c = live.compiled.take().expect("compiled above");
+        live.compiled = Some(with_evaluator_without_gil(py, c, evaluator)?);
+        Ok(())
     }
 
     /// Solves the NLP: as `Problem.solve` (`solver="ipm" | "sqp"`, `options` by IPOPT's

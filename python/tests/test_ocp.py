@@ -289,6 +289,39 @@ def test_mpc_step_by_step_equals_shift_and_warm_solves():
         mpc.step([1.0, 2.0])
 
 
+def test_mpc_by_real_time_iterations_and_native_evaluators():
+    ocp = regulator()
+    tr = ocp.transcribe(s.Method.multiple_shooting("rk4", 1), 10)
+    plant = ocp.simulator("rk4", 1)
+    ipm = s.Mpc(tr).run([1.5], 20, plant)
+    # The transcription is a strictly convex QP (linear dynamics, quadratic cost), where
+    # one real-time iteration is the QP's solution: the RTI loop is the converged loop
+    # to the interior point's tolerance (tol 1e-8 on the KKT error; 1e-6 on states).
+    rti = s.Mpc(tr, solver="rti").run([1.5], 20, plant)
+    assert rti["all_succeeded"]
+    assert [r["status"] for r in rti["steps"][1:]] == ["Real_Time_Iteration_Taken"] * 19
+    assert np.allclose(rti["states"], ipm["states"], rtol=0, atol=1e-6)
+    # Step by step with the preparation run ahead: the step is the feedback alone.
+    mpc = s.Mpc(tr, solver="rti", options={"print_level": 0})
+    x = [1.5]
+    mpc.step(x)
+    x = plant.step(x, mpc.control, mpc.sampling_period)
+    assert mpc.prepare() > 0.0 and mpc.prepare() == 0.0  # the second finds it prepared
+    r = mpc.step(x)
+    assert r["status"] == "Real_Time_Iteration_Taken"
+    # The step's seconds count the preparation that ran ahead; the feedback is a part.
+    assert 0.0 < r["feedback_seconds"] < r["solve_seconds"] <= r["seconds"]
+    # Native evaluators: the same iterates bit for bit, so the same loop exactly.
+    for solver in ["ipm", "rti"]:
+        tape = s.Mpc(tr, solver=solver).run([1.5], 20, plant)
+        jit = s.Mpc(tr, solver=solver, evaluator="jit").run([1.5], 20, plant)
+        assert np.array_equal(tape["states"], jit["states"]), solver
+    with pytest.raises(s.OptionError, match="unknown evaluator"):
+        s.Mpc(tr, evaluator="fast")
+    with pytest.raises(s.OptionError, match="toll"):
+        s.Mpc(tr, solver="rti", options={"toll": 1e-8})
+
+
 def test_mpc_refuses_a_fixed_initial_state():
     with pytest.raises(s.BuildError, match="set_initial_state_parameter"):
         s.Mpc(van_der_pol().transcribe(s.Method.trapezoidal(), 10))

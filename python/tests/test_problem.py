@@ -34,6 +34,23 @@ def build_and_solve():
     return sol.objective, tuple(sol.value(x)), tuple(sol.lam_g)
 
 
+def test_native_evaluators_take_the_tape_iterates_bit_for_bit():
+    # The JIT computes every value with the tape's operations in the tape's order
+    # (symx/tests/jit.rs), so a solve takes the same iterates: equality, no tolerance.
+    tape, jit = s.Problem(), s.Problem()
+    xt, xj = build_hs071(tape, s), build_hs071(jit, s)
+    jit.compile(evaluator="jit")
+    a, b = tape.solve(), jit.solve()
+    assert a.success and a.iterations == b.iterations
+    assert tuple(a.value(xt)) == tuple(b.value(xj)) and tuple(a.lam_g) == tuple(b.lam_g)
+    # The choice survives a change that recompiles the problem.
+    jit.subject_to(xj[0] <= 4.5)
+    tape.subject_to(xt[0] <= 4.5)
+    assert tuple(tape.solve().value(xt)) == tuple(jit.solve().value(xj))
+    with pytest.raises(s.OptionError, match="unknown evaluator 'llvm'"):
+        jit.compile(evaluator="llvm")
+
+
 def test_options_by_ipopt_names_and_bad_options():
     pb = s.Problem()
     build_hs071(pb, s)
