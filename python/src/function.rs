@@ -34,8 +34,10 @@ impl PyFunction {
 impl PyFunction {
     /// Compiles `outputs` as functions of the symbols in `inputs` (each an `Expr` of
     /// symbols). `input_names`/`output_names` default to `i0, i1, …` / `o0, o1, …`.
+    /// `evaluator`: `"tape"` (the default) or `"jit"` (machine code, CasADi's `jit`
+    /// option: the same values bit for bit, faster per call).
     #[new]
-    #[pyo3(signature = (name, inputs, outputs, input_names = None, output_names = None))]
+    #[pyo3(signature = (name, inputs, outputs, input_names = None, output_names = None, evaluator = "tape"))]
     fn new(
         py: Python<'_>,
         name: &str,
@@ -43,7 +45,9 @@ impl PyFunction {
         outputs: Vec<Bound<'_, PyAny>>,
         input_names: Option<Vec<String>>,
         output_names: Option<Vec<String>>,
+        evaluator: &str,
     ) -> PyResult<PyFunction> {
+        let evaluator = crate::problem::evaluator_named(evaluator)?;
         let ins: Vec<Vec<symx::Expr>> = inputs
             .iter()
             .enumerate()
@@ -78,7 +82,11 @@ impl PyFunction {
                 .map(|s| s.as_str())
                 .zip(outs.iter().map(|m| m.entries()))
                 .collect();
-            symx::Function::named(&name, &i, &o)
+            let f = symx::Function::named(&name, &i, &o)?;
+            match evaluator {
+                symx::Evaluator::Tape => Ok(f),
+                _ => f.with_evaluator(evaluator),
+            }
         });
         Ok(PyFunction {
             f: f.map_err(build_err)?,

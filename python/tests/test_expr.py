@@ -61,6 +61,21 @@ def test_jacobian_gradient_hessian_against_finite_differences():
     np.testing.assert_allclose(H(x0), fd_jacobian(G, x0), atol=1e-7)
 
 
+def test_a_jit_function_gives_the_tapes_bits():
+    # The JIT runs the tape's operations in the tape's order (symx/tests/jit.rs): equal
+    # bits, NaN and infinities included, no tolerance.
+    x = s.sym("x", 3)
+    f = s.sin(x[0]) * s.exp(x[1]) + x[0] ** 3 * x[2] + s.sqrt(1 + x[1] ** 2) * s.atan2(x[2], 2.0)
+    outs = [s.vertcat(f, x[0] / x[1], s.log(x[2])), s.hessian(f, x)]
+    tape = s.Function("t", [x], outs)
+    jit = s.Function("t", [x], outs, evaluator="jit")
+    for x0 in ([0.3, -0.7, 1.1], [0.0, 0.0, -1.0], [math.inf, 1.0, 0.0], [math.nan, 2.0, 3.0]):
+        for a, b in zip(tape(x0), jit(x0)):
+            assert np.asarray(a).tobytes() == np.asarray(b).tobytes(), x0
+    with pytest.raises(s.OptionError, match="unknown evaluator"):
+        s.Function("t", [x], outs, evaluator="gcc")
+
+
 def test_if_else_and_comparisons():
     x = s.sym("x")
     e = s.if_else(s.gt(x, 0), x ** 2, -x)

@@ -76,6 +76,7 @@ class Function:
         outputs: Sequence[Operand],
         input_names: Optional[Sequence[str]] = None,
         output_names: Optional[Sequence[str]] = None,
+        evaluator: str = "tape",
     ) -> None: ...
     @property
     def name(self) -> str: ...
