@@ -104,7 +104,7 @@ enum Engine {
     /// A solver, warm from the shifted plan.
     Solver(Box<dyn Solver>),
     /// Real-time iterations with these SQP options.
-    Rti(SqpOptions),
+    Rti(Box<SqpOptions>),
 }
 
 #[pymethods]
@@ -126,7 +126,7 @@ impl PyMpc {
     ) -> PyResult<PyMpc> {
         let evaluator = evaluator_named(evaluator)?;
         let engine = match solver {
-            "rti" => Engine::Rti(sqp_options(options)?),
+            "rti" => Engine::Rti(Box::new(sqp_options(options)?)),
             _ => Engine::Solver(make_solver(solver, options)?),
         };
         let live = transcription.live(py)?;
@@ -135,7 +135,7 @@ impl PyMpc {
         let mpc = py.allow_threads(move || {
             let tr = tr;
             let mpc = match engine {
-                Engine::Rti(o) => Mpc::with_rti(tr.0, o, Box::new(Ipm::default()))?,
+                Engine::Rti(o) => Mpc::with_rti(tr.0, *o, Box::new(Ipm::default()))?,
                 Engine::Solver(backend) => Mpc::new(tr.0, backend)?,
             };
             match evaluator {
