@@ -127,7 +127,12 @@ impl PyMpc {
         let evaluator = evaluator_named(evaluator)?;
         let engine = match solver {
             "rti" => Engine::Rti(Box::new(sqp_options(options)?)),
-            _ => Engine::Solver(make_solver(solver, options)?),
+            "ipm" | "ipopt" | "sqp" => Engine::Solver(make_solver(solver, options)?),
+            other => {
+                return Err(crate::error::OptionError::new_err(format!(
+                    "unknown solver '{other}': expected 'ipm', 'sqp' or 'rti'"
+                )))
+            }
         };
         let live = transcription.live(py)?;
         let names = symbol_names(live.tr.problem());

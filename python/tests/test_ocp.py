@@ -320,6 +320,8 @@ def test_mpc_by_real_time_iterations_and_native_evaluators():
         s.Mpc(tr, evaluator="fast")
     with pytest.raises(s.OptionError, match="toll"):
         s.Mpc(tr, solver="rti", options={"toll": 1e-8})
+    with pytest.raises(s.OptionError, match="expected 'ipm', 'sqp' or 'rti'"):
+        s.Mpc(tr, solver="acados")
 
 
 def test_mpc_refuses_a_fixed_initial_state():
