@@ -532,6 +532,9 @@ struct Emitter<'a, 'b> {
     slot: Option<StackSlot>,
     /// The sign mask loaded by [`Emitter::negate`] and the instruction of its last use.
     sign_mask: Option<(Value, usize)>,
+    /// The zero vector compared with by [`Emitter::guard`] and the instruction of its
+    /// last use.
+    zero_vector: Option<(Value, usize)>,
     /// Where the constant pairs of this function's SIMD instructions lie in its pool.
     pairs: ConstantPairs,
 }
@@ -574,6 +577,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
             copy: None,
             slot: None,
             sign_mask: None,
+            zero_vector: None,
             pairs,
         }
     }
@@ -594,7 +598,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
     }
 
     /// [`Emitter::get`]; with `first`, for the first operand of a commutative operation: a
-    /// value loaded here is loaded as bits and moved to a float register, because
+    /// value loaded here is kept out of a memory operand ([`Emitter::unfoldable`]), because
     /// Cranelift folds a single-use load into the instruction by swapping the operands of
     /// `fadd`/`fmul`, and x86 returns the first operand's NaN when both are NaN: the swap
     /// would change a NaN's sign or payload.
@@ -629,14 +633,20 @@ impl<'a, 'b> Emitter<'a, 'b> {
             (None, Some((k, i))) => (self.params.inputs[k as usize], 8 * i as i32),
             (None, None) => (self.w, 8 * r as i32),
         };
-        let v = if first {
-            let bits = self.b.ins().load(types::I64, self.flags, base, offset);
-            self.b.ins().bitcast(types::F64, MemFlags::new(), bits)
-        } else {
-            self.b.ins().load(types::F64, self.flags, base, offset)
-        };
+        let v = self.b.ins().load(types::F64, self.flags, base, offset);
+        if first {
+            self.unfoldable(v);
+        }
         self.values.insert(r, (Held::Scalar(v), self.at));
         v
+    }
+
+    /// Keeps the load `v` out of its user's memory operand: Cranelift folds only a load
+    /// used once, and counts every use, a dead instruction's included; the dead `fabs`
+    /// added here emits no code (an integer load moved to a float register, the way
+    /// before, cost one instruction per load: 1 674 of the gap Jacobian's 50 384).
+    fn unfoldable(&mut self, v: Value) {
+        self.b.ins().fabs(v);
     }
 
     /// Constant register `r` loaded from the function's template, where it is kept (one
@@ -672,6 +682,40 @@ impl<'a, 'b> Emitter<'a, 'b> {
         }
     }
 
+    /// `p` where `a ≠ 0` (NaN included), else `+0`: the result of `a ⊛ b` from its product
+    /// `p = a·b` (scalars or `f64x2` lanes), without a branch: `p` and-ed with the mask of
+    /// `a ≠ 0` (`cmpneqpd`: unordered or not equal), which is all zeros exactly where
+    /// `a = ±0`. (Cranelift lowers a float `select` to two branches: on the derivative
+    /// functions of call nodes, where half the instructions are guarded products, that
+    /// code was twice as long and its taken branches filled the branch predictor.)
+    fn guard(&mut self, a: Value, p: Value) -> Value {
+        let ty = types::F64X2;
+        let scalar = self.b.func.dfg.value_type(a) != ty;
+        let lanes = if scalar { self.b.ins().splat(ty, a) } else { a };
+        let zero = match self.zero_vector {
+            Some((z, last)) if self.at.saturating_sub(last) <= WINDOW => z,
+            _ => {
+                let k = self
+                    .b
+                    .func
+                    .dfg
+                    .constants
+                    .insert(ConstantData::from(vec![0u8; 16]));
+                self.b.ins().vconst(ty, k)
+            }
+        };
+        self.zero_vector = Some((zero, self.at));
+        let mask = self.b.ins().fcmp(FloatCC::NotEqual, lanes, zero);
+        let little = MemFlags::new().with_endianness(Endianness::Little);
+        let mask = self.b.ins().bitcast(ty, little, mask);
+        let mask = if scalar {
+            self.b.ins().extractlane(mask, 0)
+        } else {
+            mask
+        };
+        self.b.ins().band(p, mask)
+    }
+
     /// Whether register `r` holds a constant other than NaN: a commutative operation
     /// gives the same bits with its operands swapped when one of them is such a constant
     /// (x86 returns the one NaN operand, quieted, whichever side it is on).
@@ -700,7 +744,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
     /// The two lanes `(r1 at at1, r2 at at2)` as one `f64x2`: one load when both lie
     /// side by side in memory, one constant when both are constants, else the two scalars
     /// put together. With `first` (the first operand of a commutative operation) a loaded
-    /// vector is loaded as integers, for the reason given at [`Emitter::operand`].
+    /// vector is kept out of a memory operand, for the reason given at [`Emitter::operand`].
     fn lanes(&mut self, (r1, at1): (u32, usize), (r2, at2): (u32, usize), first: bool) -> Value {
         let ty = types::F64X2;
         let c = &self.layout.constant;
@@ -719,13 +763,10 @@ impl<'a, 'b> Emitter<'a, 'b> {
         if let (Some((b1, o1)), Some((b2, o2))) = (self.memory(r1, at1), self.memory(r2, at2)) {
             if b1 == b2 && o2 == o1 + 8 {
                 let flags = MemFlags::new().with_notrap();
-                let v = if first {
-                    let bits = self.b.ins().load(types::I64X2, flags, b1, o1);
-                    let little = MemFlags::new().with_endianness(Endianness::Little);
-                    self.b.ins().bitcast(ty, little, bits)
-                } else {
-                    self.b.ins().load(ty, flags, b1, o1)
-                };
+                let v = self.b.ins().load(ty, flags, b1, o1);
+                if first {
+                    self.unfoldable(v);
+                }
                 // The scalars stay reachable as lanes of the vector.
                 for (r, at, lane) in [(r1, at1, 0), (r2, at2, 1)] {
                     self.values.insert(r, (Held::Lane(v, lane), at));
@@ -860,6 +901,9 @@ impl<'a, 'b> Emitter<'a, 'b> {
                 None => (None, 8 * r as i32),
             }
         };
+        // The integer constants stored recently, by bits, and the store of their last use.
+        let mut recent = FxHashMap::default();
+        let mut stored = 0;
         let mut k = 0;
         while k < needed.len() {
             if !needed[k] {
@@ -874,7 +918,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
             let offset = dest(k).1;
             if end - k < INLINE_TEMPLATE {
                 for (j, &v) in f.template[k..end].iter().enumerate() {
-                    let c = self.constant(v);
+                    let c = self.template_bits(&mut recent, v, stored);
+                    stored += 1;
                     self.b
                         .ins()
                         .store(self.flags, c, base, offset + 8 * j as i32);
@@ -884,6 +929,26 @@ impl<'a, 'b> Emitter<'a, 'b> {
             }
             k = end;
         }
+    }
+
+    /// The bits of `v` as an integer for the `stored`-th immediate store of [`Emitter::template`]:
+    /// the value of an earlier store of the same bits within [`WINDOW`] stores, else a new
+    /// constant (storing the bits from an integer register takes one instruction where a
+    /// float constant takes three: integer immediate, move to a float register, store;
+    /// the gap Jacobian stores 823 constant outputs, mostly ±1 and ±0.5, at every call).
+    fn template_bits(
+        &mut self,
+        recent: &mut FxHashMap<u64, (Value, usize)>,
+        v: f64,
+        stored: usize,
+    ) -> Value {
+        let bits = v.to_bits();
+        let value = match recent.get(&bits) {
+            Some(&(c, last)) if stored - last <= WINDOW => c,
+            _ => self.b.ins().iconst(types::I64, bits as i64),
+        };
+        recent.insert(bits, (value, stored));
+        value
     }
 
     /// Copies template entries `k..end` to `base + offset`.
@@ -1047,10 +1112,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
                 self.truth(c)
             }
             Op::StrongMul => {
-                let z = self.b.ins().f64const(zero());
                 let p = self.b.ins().fmul(a, b);
-                let c = self.b.ins().fcmp(FloatCC::Equal, a, z);
-                self.b.ins().select(c, z, p)
+                self.guard(a, p)
             }
             Op::IfElse => {
                 let c = self.get(ins.c);
