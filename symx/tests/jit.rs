@@ -502,3 +502,56 @@ fn constant_outputs_keep_their_bits() {
     let out = same_bits(&f, &[&[1.5, -2.0]]);
     assert_eq!(out[0][0], 1.0);
 }
+
+/// Outputs read back by later instructions: the JIT keeps such a value in the caller's
+/// output (not also in the work vector) and reloads it from there when it is read far
+/// later or in another chunk; also as the coordinates of a lookup table, and inside a
+/// called function (whose outputs live in the caller's scratch). Evaluated with a work
+/// vector and output buffers full of NaN: every output read back must have been written
+/// first.
+#[test]
+fn outputs_read_back_match_the_tape() {
+    let x = Matrix::sym_vec("x", 3);
+    let grid: Vec<f64> = (0..5).map(|k| k as f64 * 0.5).collect();
+    let vals: Vec<f64> = (0..125).map(|k| (k as f64 * 0.13).sin()).collect();
+    let table = InterpolantN::linear(&[&grid, &grid, &grid], &vals).unwrap();
+    // Early outputs, then a long chain (several chunks), then reads of the early outputs.
+    let early: Vec<Expr> = (0..6)
+        .map(|k| x[k % 3] * (k as f64 + 1.5) - x[(k + 1) % 3])
+        .collect();
+    let mut s = x[2];
+    for k in 0..3_000 {
+        s = s * 0.999 + (early[k % 6] * 1e-3).sin();
+    }
+    let looked_up = table.eval(&early[..3]).unwrap();
+    let late: Vec<Expr> = early.iter().map(|&e| e * s + looked_up).collect();
+    let inner = Function::named("inner", &[("x", &x)], &[("e", &early), ("l", &late)]).unwrap();
+    let z = Matrix::sym_vec("z", 3);
+    let called = inner.apply(&[&z]).unwrap();
+    let top_outs: Vec<Expr> = called[0]
+        .iter()
+        .zip(&called[1])
+        .map(|(&a, &b)| a * b + a)
+        .collect();
+    for f in [
+        inner.clone(),
+        Function::new(&[&z], &[&called[0], &top_outs, &called[1]]).unwrap(),
+    ] {
+        assert!(f.instruction_count() > 1024 || f.name() != "inner");
+        for p in [[0.3, -0.8, 0.5], [1.0, 0.0, -0.0], [f64::NAN, 2.0, 0.25]] {
+            let want = same_bits(&f, &[&p]);
+            let native = f.jit().unwrap();
+            let mut work = vec![f64::NAN; native.work_size()];
+            let mut outs: Vec<Vec<f64>> = f
+                .output_sizes()
+                .iter()
+                .map(|&n| vec![f64::NAN; n])
+                .collect();
+            let mut refs: Vec<&mut [f64]> = outs.iter_mut().map(|v| v.as_mut_slice()).collect();
+            native.eval(&[&p], &mut refs, &mut work).unwrap();
+            for (w, g) in want.iter().zip(&outs) {
+                assert!(w.iter().zip(g).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+    }
+}

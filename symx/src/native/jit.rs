@@ -146,8 +146,14 @@ struct Jit {
 /// Per function being compiled: what each instruction's code needs to know.
 struct Layout<'a> {
     f: &'a Function,
-    /// Whether instruction `i`'s result must be stored to the work vector.
+    /// Whether instruction `i`'s result must be stored to the work vector (never for a
+    /// register kept in its output, see [`Layout::in_output`]).
     store: Vec<bool>,
+    /// Registers whose value lives in the caller's output (output slots that no lookup
+    /// table reads through a pointer): written there once, and read back from there, so
+    /// that no second store goes to the work vector (a value with two uses, the two
+    /// stores, also kept Cranelift from folding its operands' loads into its instruction).
+    in_output: Vec<bool>,
     /// The last instruction reading instruction `i`'s result (see [`lanes::last_reader`]).
     last_reader: Vec<usize>,
     /// Registers holding a constant (never written, in the template): their values.
@@ -188,11 +194,12 @@ impl Jit {
             }
             of
         };
-        let layout = Layout {
+        let mut layout = Layout {
             f,
             input_of: entries(&f.input_sizes, &f.input_offsets),
             output_of: entries(&f.output_sizes, &f.output_offsets),
-            store: stores(f),
+            store: Vec::new(),
+            in_output: Vec::new(),
             last_reader: lanes::last_reader(f, |ins, visit| {
                 reads(f, ins, &mut *visit);
                 if ins.op == Op::InterpolantN {
@@ -205,6 +212,7 @@ impl Jit {
             tables: f.tables.iter().map(|t| Arc::as_ptr(t) as i64).collect(),
             template: template.as_ptr(),
         };
+        (layout.store, layout.in_output) = homes(f, &layout.output_of);
         self.templates.push(template);
         self.tables.extend(f.tables.iter().cloned());
         self.instructions += f.tape.len();
@@ -481,6 +489,23 @@ fn stores(f: &Function) -> Vec<bool> {
     store
 }
 
+/// Which results must be stored to the work vector ([`stores`]) and which registers live in
+/// the caller's output instead ([`Layout::in_output`]): output slots, except those a lookup
+/// table reads through a pointer (into the work vector).
+fn homes(f: &Function, output_of: &[Option<(u32, u32)>]) -> (Vec<bool>, Vec<bool>) {
+    let mut in_output: Vec<bool> = output_of.iter().map(Option::is_some).collect();
+    for ins in f.tape.iter().filter(|i| i.op == Op::InterpolantN) {
+        (ins.a as usize..(ins.a + ins.b) as usize).for_each(|r| in_output[r] = false);
+    }
+    let mut store = stores(f);
+    for (s, ins) in store.iter_mut().zip(&f.tape) {
+        if ins.op != Op::Call && in_output[ins.d as usize] {
+            *s = false;
+        }
+    }
+    (store, in_output)
+}
+
 /// The registers that hold a constant throughout (in the template, never written).
 fn constants(f: &Function) -> Vec<Option<f64>> {
     let written = written(f);
@@ -631,7 +656,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
             (Some(_), _) => return self.template_load(r),
             // Inputs are never written by the tape: read from the caller's input.
             (None, Some((k, i))) => (self.params.inputs[k as usize], 8 * i as i32),
-            (None, None) => (self.w, 8 * r as i32),
+            (None, None) => self.home(r),
         };
         let v = self.b.ins().load(types::F64, self.flags, base, offset);
         if first {
@@ -639,6 +664,17 @@ impl<'a, 'b> Emitter<'a, 'b> {
         }
         self.values.insert(r, (Held::Scalar(v), self.at));
         v
+    }
+
+    /// Where register `r` (neither a constant nor an input) is kept in memory: its entry of
+    /// the caller's output if [`Layout::in_output`], else the work vector.
+    fn home(&self, r: u32) -> (Value, i32) {
+        match self.layout.output_of[r as usize] {
+            Some((k, i)) if self.layout.in_output[r as usize] => {
+                (self.params.outputs[k as usize], 8 * i as i32)
+            }
+            _ => (self.w, 8 * r as i32),
+        }
     }
 
     /// Keeps the load `v` out of its user's memory operand: Cranelift folds only a load
@@ -737,7 +773,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
         ) {
             (Some(_), _) => None,
             (None, Some((k, i))) => Some((self.params.inputs[k as usize], 8 * i as i32)),
-            (None, None) => Some((self.w, 8 * r as i32)),
+            (None, None) => Some(self.home(r)),
         }
     }
 
@@ -1160,7 +1196,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
             for i in 0..n {
                 let off = scratch + 8 * (at + i) as i32;
                 let v = self.b.ins().load(types::F64, self.flags, self.w, off);
-                self.put(call.out + q, v, true);
+                let r = call.out + q;
+                self.put(r, v, !self.layout.in_output[r as usize]);
                 q += 1;
             }
         }
