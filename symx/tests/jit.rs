@@ -414,7 +414,7 @@ fn constant_pairs_keep_their_lanes() {
 /// `strong_mul(a, b)` (`a ⊛ b`: `+0` where `a = ±0`, else `a · b`), which the JIT computes
 /// without a branch (the product and-ed with the mask of `a ≠ 0`), on every pair of special
 /// operands, NaNs of different signs and payloads included, with loaded and computed
-/// operands, and results read again by later instructions.
+/// operands, alone and in paired lanes, and results read again by later instructions.
 #[test]
 fn guarded_products_match_the_tape_on_special_values() {
     let special = special_with_nan_payloads();
@@ -424,7 +424,9 @@ fn guarded_products_match_the_tape_on_special_values() {
     let syms: Vec<Expr> = x.iter().chain(y.iter()).copied().collect();
     // (Built from its printed form: the graph has no public constructor for it.)
     let strong = |a: Expr, b: Expr| parse(&format!("strong_mul({a},{b})"), &syms).unwrap();
-    let mut outs = Vec::new();
+    // Independent alike lanes first (paired into SIMD instructions), then scalar code.
+    let mut outs: Vec<Expr> = (0..n).map(|i| strong(x[i], y[i])).collect();
+    outs.extend((0..n).map(|i| strong(x[i] - y[i], y[i] * 0.5)));
     for i in 0..n {
         let p = strong(x[i], y[i]);
         let q = strong(p, y[(i + 1) % n]);

@@ -852,6 +852,10 @@ impl<'a, 'b> Emitter<'a, 'b> {
                         Op::Sub => self.b.ins().fsub(a, b),
                         Op::Mul => self.b.ins().fmul(a, b),
                         Op::Div => self.b.ins().fdiv(a, b),
+                        Op::StrongMul => {
+                            let p = self.b.ins().fmul(a, b);
+                            self.guard(a, p)
+                        }
                         _ => unreachable!("{op:?} is not paired (lanes::pairable)"),
                     }
                 }
