@@ -8,9 +8,11 @@
 //! a register is loaded at its first read in the chunk, and a result is stored to the work
 //! vector only if a later chunk or a lookup table reads it, or if it is read again more
 //! than [`WINDOW`] instructions later (then reloaded, so that no value lives long enough
-//! to be spilled); a backward liveness pass decides. Constants are immediates, and only
-//! the constant outputs of the template are written. A call of another function gathers its arguments into the scratch block and
-//! calls that function's machine code, compiled once in the same module.
+//! to be spilled); a backward liveness pass decides. An output's value is kept in the
+//! caller's output alone and reloaded from there ([`Layout::in_output`]). Constants are
+//! loaded from the template (or the pool of constant pairs), and only the constant outputs
+//! of the template are written. A call of another function gathers its arguments into the
+//! scratch block and calls that function's machine code, compiled once in the same module.
 use super::constant_pairs::{ConstantPairs, Pair};
 use super::lanes::{self, Operand, Step};
 use super::places::written;
