@@ -410,3 +410,150 @@ fn constant_pairs_keep_their_lanes() {
         }
     }
 }
+
+/// `strong_mul(a, b)` (`a ⊛ b`: `+0` where `a = ±0`, else `a · b`), which the JIT computes
+/// without a branch (the product and-ed with the mask of `a ≠ 0`), on every pair of special
+/// operands, NaNs of different signs and payloads included, with loaded and computed
+/// operands, alone and in paired lanes, and results read again by later instructions.
+#[test]
+fn guarded_products_match_the_tape_on_special_values() {
+    let special = special_with_nan_payloads();
+    let n = special.len();
+    let x = Matrix::sym_vec("x", n);
+    let y = Matrix::sym_vec("y", n);
+    let syms: Vec<Expr> = x.iter().chain(y.iter()).copied().collect();
+    // (Built from its printed form: the graph has no public constructor for it.)
+    let strong = |a: Expr, b: Expr| parse(&format!("strong_mul({a},{b})"), &syms).unwrap();
+    // Independent alike lanes first (paired into SIMD instructions), then scalar code.
+    let mut outs: Vec<Expr> = (0..n).map(|i| strong(x[i], y[i])).collect();
+    outs.extend((0..n).map(|i| strong(x[i] - y[i], y[i] * 0.5)));
+    for i in 0..n {
+        let p = strong(x[i], y[i]);
+        let q = strong(p, y[(i + 1) % n]);
+        let r = strong(x[i] * y[i], p + 1.0);
+        outs.extend([p, q, r, strong(q, Expr::from(2.5)) + strong(r, p)]);
+    }
+    let f = Function::new(&[&x, &y], &[&outs]).unwrap();
+    assert_eq!(outs[0].op().name(), "strong_mul");
+    for shift in 0..n {
+        let xs: Vec<f64> = (0..n).map(|i| special[(i + shift) % n]).collect();
+        let ys: Vec<f64> = (0..n).map(|i| special[(i * 5 + 3) % n]).collect();
+        same_bits(&f, &[&xs, &ys]);
+    }
+}
+
+/// The first operand of `+` and `·` loaded from memory (used once) while the second is
+/// computed: x86 returns the first operand's NaN when both are NaN, so the load must not be
+/// folded into the instruction with the operands swapped (the JIT keeps it in a register).
+/// One chain (nothing pairs into lanes, every value used once), NaNs of different signs and
+/// payloads in both operands.
+#[test]
+fn a_loaded_first_operand_keeps_its_nan() {
+    let special = special_with_nan_payloads();
+    let n = special.len();
+    let x = Matrix::sym_vec("x", n);
+    let y = Matrix::sym_vec("y", n);
+    // `x[i] ∘ (…)`: `x[i]` (made first, so the first operand) is loaded, the second
+    // operand computed.
+    let mut acc = y[0];
+    for i in 0..n {
+        acc = if i % 2 == 0 {
+            x[i] + y[i] * acc
+        } else {
+            x[i] * (y[i] - acc)
+        };
+    }
+    let f = Function::new(&[&x, &y], &[&[acc]]).unwrap();
+    for shift in 0..n {
+        for s in 0..n {
+            let xs: Vec<f64> = (0..n).map(|i| special[(i + shift) % n]).collect();
+            let ys: Vec<f64> = (0..n).map(|i| special[(i * 3 + s) % n]).collect();
+            same_bits(&f, &[&xs, &ys]);
+        }
+    }
+}
+
+/// Constant outputs, which the JIT writes at every call from integer registers holding
+/// their bits (shared by repeated constants): scattered among computed outputs, repeated,
+/// signed zeros, infinities and NaN payloads, and more constants than one register's
+/// reuse window.
+#[test]
+fn constant_outputs_keep_their_bits() {
+    let x = Matrix::sym_vec("x", 2);
+    let constants = [
+        1.0,
+        -1.0,
+        0.5,
+        -0.0,
+        0.0,
+        f64::INFINITY,
+        f64::from_bits(0x7ff8_0000_0000_0005),
+        f64::from_bits(0xfff8_0000_0000_0006),
+        1e-310,
+    ];
+    let mut outs = Vec::new();
+    for k in 0..200 {
+        outs.push(Expr::from(constants[k % constants.len()]));
+        if k % 3 == 0 {
+            outs.push(x[0] * (k as f64) + x[1]);
+        }
+    }
+    // Distinct constants beyond the reuse window.
+    outs.extend((0..100).map(|k| Expr::from(0.125 * k as f64 + 3.0)));
+    let f = Function::new(&[&x], &[&outs]).unwrap();
+    let out = same_bits(&f, &[&[1.5, -2.0]]);
+    assert_eq!(out[0][0], 1.0);
+}
+
+/// Outputs read back by later instructions: the JIT keeps such a value in the caller's
+/// output (not also in the work vector) and reloads it from there when it is read far
+/// later or in another chunk; also as the coordinates of a lookup table, and inside a
+/// called function (whose outputs live in the caller's scratch). Evaluated with a work
+/// vector and output buffers full of NaN: every output read back must have been written
+/// first.
+#[test]
+fn outputs_read_back_match_the_tape() {
+    let x = Matrix::sym_vec("x", 3);
+    let grid: Vec<f64> = (0..5).map(|k| k as f64 * 0.5).collect();
+    let vals: Vec<f64> = (0..125).map(|k| (k as f64 * 0.13).sin()).collect();
+    let table = InterpolantN::linear(&[&grid, &grid, &grid], &vals).unwrap();
+    // Early outputs, then a long chain (several chunks), then reads of the early outputs.
+    let early: Vec<Expr> = (0..6)
+        .map(|k| x[k % 3] * (k as f64 + 1.5) - x[(k + 1) % 3])
+        .collect();
+    let mut s = x[2];
+    for k in 0..3_000 {
+        s = s * 0.999 + (early[k % 6] * 1e-3).sin();
+    }
+    let looked_up = table.eval(&early[..3]).unwrap();
+    let late: Vec<Expr> = early.iter().map(|&e| e * s + looked_up).collect();
+    let inner = Function::named("inner", &[("x", &x)], &[("e", &early), ("l", &late)]).unwrap();
+    let z = Matrix::sym_vec("z", 3);
+    let called = inner.apply(&[&z]).unwrap();
+    let top_outs: Vec<Expr> = called[0]
+        .iter()
+        .zip(&called[1])
+        .map(|(&a, &b)| a * b + a)
+        .collect();
+    for f in [
+        inner.clone(),
+        Function::new(&[&z], &[&called[0], &top_outs, &called[1]]).unwrap(),
+    ] {
+        assert!(f.instruction_count() > 1024 || f.name() != "inner");
+        for p in [[0.3, -0.8, 0.5], [1.0, 0.0, -0.0], [f64::NAN, 2.0, 0.25]] {
+            let want = same_bits(&f, &[&p]);
+            let native = f.jit().unwrap();
+            let mut work = vec![f64::NAN; native.work_size()];
+            let mut outs: Vec<Vec<f64>> = f
+                .output_sizes()
+                .iter()
+                .map(|&n| vec![f64::NAN; n])
+                .collect();
+            let mut refs: Vec<&mut [f64]> = outs.iter_mut().map(|v| v.as_mut_slice()).collect();
+            native.eval(&[&p], &mut refs, &mut work).unwrap();
+            for (w, g) in want.iter().zip(&outs) {
+                assert!(w.iter().zip(g).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+    }
+}

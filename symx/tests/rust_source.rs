@@ -3,7 +3,7 @@
 //! outputs' bits; they must equal the tape's bit for bit (same IEEE operations, same C
 //! library math functions as Rust's std), except for the sign and payload of NaNs.
 use std::process::Command;
-use symx::{gradient, hessian, if_else, lt, Function, Matrix, SymxError};
+use symx::{gradient, hessian, if_else, lt, Expr, Function, Matrix, SymxError};
 use testkit::special::same_or_both_nan;
 
 /// Compiles `f.to_rust()` with a `main` evaluating it at `point` with a work vector of
@@ -194,4 +194,37 @@ pub fn step(x: &[f64; 2], y: &mut [f64; 1]) -> Result<(), &'static str> {
     let bits = u64::from_str_radix(String::from_utf8(out.stdout).unwrap().trim(), 16).unwrap();
     let want = f.call(&[&[0.3, -1.7]]).unwrap()[0][0];
     assert_eq!(bits, want.to_bits());
+}
+
+/// A tape several bodies long (the generated code keeps values in local variables within a
+/// body of 1024 instructions and only those read by a later body in the work vector):
+/// early outputs and temporaries read far later, through a call as well; the values must
+/// equal the tape's, and `WORK_SIZE` hold exactly the slots written (see
+/// [`run_generated`]), fewer than the tape's temporaries.
+#[test]
+fn long_tapes_keep_values_across_bodies() {
+    let y = Matrix::sym_vec("y", 2);
+    let inner =
+        Function::named("inner", &[("y", &y)], &[("v", &[y[0] * y[1], y[1] - y[0]])]).unwrap();
+    let x = Matrix::sym_vec("x", 3);
+    let early: Vec<Expr> = (0..4).map(|k| x[k % 3] * (k as f64 + 0.5) - x[2]).collect();
+    let temp = x[0].sin() * x[1];
+    let mut s = x[2];
+    for k in 0..1500 {
+        s = s * 0.999 + (early[k % 4] * 1e-3).sin();
+    }
+    let c = inner.apply(&[&[s, temp]]).unwrap().remove(0);
+    let late = [early[0] * s + temp, c[0] + early[3], c[1] * temp];
+    let fun = Function::new(&[&x], &[&early, &late]).unwrap();
+    assert!(fun.instruction_count() > 3000);
+    let p = [0.3, -1.2, 0.7];
+    let want = fun.call(&[&p]).unwrap().concat();
+    let (work_size, got) = run_generated(&fun, &p, "long");
+    assert!(work_size < fun.work_size() / 2, "WORK_SIZE {work_size}");
+    for (i, (a, b)) in want.iter().zip(&got).enumerate() {
+        assert!(
+            same_or_both_nan(*a, *b),
+            "output {i}: tape {a:e}, generated {b:e}"
+        );
+    }
 }

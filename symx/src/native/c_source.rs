@@ -337,9 +337,8 @@ impl Function {
     /// `f_sparsity_in`, `f_sparsity_out`, `f_default_in`, `f_work`, `f_work_bytes`,
     /// `f_checkout`, `f_release`, `f_incref`, `f_decref`. Every input and output is a dense
     /// column; [`Function::to_c_with`] gives outputs a sparsity pattern. No allocation, no
-    /// state: `w` (`f_work`'s `sz_w` numbers, the temporaries only, as the generated Rust's
-    /// `WORK_SIZE`, plus the output entries the computation reads back) is the only
-    /// scratch; `iw` is unused.
+    /// state: `w` (`f_work`'s `sz_w` numbers, the temporaries only, plus the output
+    /// entries the computation reads back) is the only scratch; `iw` is unused.
     ///
     /// Compiled without contraction of multiplies and adds into FMAs (`-ffp-contract=off`,
     /// which gcc's and clang's ISO modes `-std=c99`/`c11` imply; never `-ffast-math`), it

@@ -8,9 +8,11 @@
 //! a register is loaded at its first read in the chunk, and a result is stored to the work
 //! vector only if a later chunk or a lookup table reads it, or if it is read again more
 //! than [`WINDOW`] instructions later (then reloaded, so that no value lives long enough
-//! to be spilled); a backward liveness pass decides. Constants are immediates, and only
-//! the constant outputs of the template are written. A call of another function gathers its arguments into the scratch block and
-//! calls that function's machine code, compiled once in the same module.
+//! to be spilled); a backward liveness pass decides. An output's value is kept in the
+//! caller's output alone and reloaded from there ([`Layout::in_output`]). Constants are
+//! loaded from the template (or the pool of constant pairs), and only the constant outputs
+//! of the template are written. A call of another function gathers its arguments into the
+//! scratch block and calls that function's machine code, compiled once in the same module.
 use super::constant_pairs::{ConstantPairs, Pair};
 use super::lanes::{self, Operand, Step};
 use super::places::written;
@@ -146,8 +148,14 @@ struct Jit {
 /// Per function being compiled: what each instruction's code needs to know.
 struct Layout<'a> {
     f: &'a Function,
-    /// Whether instruction `i`'s result must be stored to the work vector.
+    /// Whether instruction `i`'s result must be stored to the work vector (never for a
+    /// register kept in its output, see [`Layout::in_output`]).
     store: Vec<bool>,
+    /// Registers whose value lives in the caller's output (output slots that no lookup
+    /// table reads through a pointer): written there once, and read back from there, so
+    /// that no second store goes to the work vector (a value with two uses, the two
+    /// stores, also kept Cranelift from folding its operands' loads into its instruction).
+    in_output: Vec<bool>,
     /// The last instruction reading instruction `i`'s result (see [`lanes::last_reader`]).
     last_reader: Vec<usize>,
     /// Registers holding a constant (never written, in the template): their values.
@@ -188,11 +196,12 @@ impl Jit {
             }
             of
         };
-        let layout = Layout {
+        let mut layout = Layout {
             f,
             input_of: entries(&f.input_sizes, &f.input_offsets),
             output_of: entries(&f.output_sizes, &f.output_offsets),
-            store: stores(f),
+            store: Vec::new(),
+            in_output: Vec::new(),
             last_reader: lanes::last_reader(f, |ins, visit| {
                 reads(f, ins, &mut *visit);
                 if ins.op == Op::InterpolantN {
@@ -205,6 +214,7 @@ impl Jit {
             tables: f.tables.iter().map(|t| Arc::as_ptr(t) as i64).collect(),
             template: template.as_ptr(),
         };
+        (layout.store, layout.in_output) = homes(f, &layout.output_of);
         self.templates.push(template);
         self.tables.extend(f.tables.iter().cloned());
         self.instructions += f.tape.len();
@@ -481,6 +491,23 @@ fn stores(f: &Function) -> Vec<bool> {
     store
 }
 
+/// Which results must be stored to the work vector ([`stores`]) and which registers live in
+/// the caller's output instead ([`Layout::in_output`]): output slots, except those a lookup
+/// table reads through a pointer (into the work vector).
+fn homes(f: &Function, output_of: &[Option<(u32, u32)>]) -> (Vec<bool>, Vec<bool>) {
+    let mut in_output: Vec<bool> = output_of.iter().map(Option::is_some).collect();
+    for ins in f.tape.iter().filter(|i| i.op == Op::InterpolantN) {
+        (ins.a as usize..(ins.a + ins.b) as usize).for_each(|r| in_output[r] = false);
+    }
+    let mut store = stores(f);
+    for (s, ins) in store.iter_mut().zip(&f.tape) {
+        if ins.op != Op::Call && in_output[ins.d as usize] {
+            *s = false;
+        }
+    }
+    (store, in_output)
+}
+
 /// The registers that hold a constant throughout (in the template, never written).
 fn constants(f: &Function) -> Vec<Option<f64>> {
     let written = written(f);
@@ -532,6 +559,9 @@ struct Emitter<'a, 'b> {
     slot: Option<StackSlot>,
     /// The sign mask loaded by [`Emitter::negate`] and the instruction of its last use.
     sign_mask: Option<(Value, usize)>,
+    /// The zero vector compared with by [`Emitter::guard`] and the instruction of its
+    /// last use.
+    zero_vector: Option<(Value, usize)>,
     /// Where the constant pairs of this function's SIMD instructions lie in its pool.
     pairs: ConstantPairs,
 }
@@ -574,6 +604,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
             copy: None,
             slot: None,
             sign_mask: None,
+            zero_vector: None,
             pairs,
         }
     }
@@ -594,7 +625,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
     }
 
     /// [`Emitter::get`]; with `first`, for the first operand of a commutative operation: a
-    /// value loaded here is loaded as bits and moved to a float register, because
+    /// value loaded here is kept out of a memory operand ([`Emitter::unfoldable`]), because
     /// Cranelift folds a single-use load into the instruction by swapping the operands of
     /// `fadd`/`fmul`, and x86 returns the first operand's NaN when both are NaN: the swap
     /// would change a NaN's sign or payload.
@@ -627,16 +658,33 @@ impl<'a, 'b> Emitter<'a, 'b> {
             (Some(_), _) => return self.template_load(r),
             // Inputs are never written by the tape: read from the caller's input.
             (None, Some((k, i))) => (self.params.inputs[k as usize], 8 * i as i32),
-            (None, None) => (self.w, 8 * r as i32),
+            (None, None) => self.home(r),
         };
-        let v = if first {
-            let bits = self.b.ins().load(types::I64, self.flags, base, offset);
-            self.b.ins().bitcast(types::F64, MemFlags::new(), bits)
-        } else {
-            self.b.ins().load(types::F64, self.flags, base, offset)
-        };
+        let v = self.b.ins().load(types::F64, self.flags, base, offset);
+        if first {
+            self.unfoldable(v);
+        }
         self.values.insert(r, (Held::Scalar(v), self.at));
         v
+    }
+
+    /// Where register `r` (neither a constant nor an input) is kept in memory: its entry of
+    /// the caller's output if [`Layout::in_output`], else the work vector.
+    fn home(&self, r: u32) -> (Value, i32) {
+        match self.layout.output_of[r as usize] {
+            Some((k, i)) if self.layout.in_output[r as usize] => {
+                (self.params.outputs[k as usize], 8 * i as i32)
+            }
+            _ => (self.w, 8 * r as i32),
+        }
+    }
+
+    /// Keeps the load `v` out of its user's memory operand: Cranelift folds only a load
+    /// used once, and counts every use, a dead instruction's included; the dead `fabs`
+    /// added here emits no code (an integer load moved to a float register, the way
+    /// before, cost one instruction per load: 1 674 of the gap Jacobian's 50 384).
+    fn unfoldable(&mut self, v: Value) {
+        self.b.ins().fabs(v);
     }
 
     /// Constant register `r` loaded from the function's template, where it is kept (one
@@ -672,6 +720,40 @@ impl<'a, 'b> Emitter<'a, 'b> {
         }
     }
 
+    /// `p` where `a ≠ 0` (NaN included), else `+0`: the result of `a ⊛ b` from its product
+    /// `p = a·b` (scalars or `f64x2` lanes), without a branch: `p` and-ed with the mask of
+    /// `a ≠ 0` (`cmpneqpd`: unordered or not equal), which is all zeros exactly where
+    /// `a = ±0`. (Cranelift lowers a float `select` to two branches: on the derivative
+    /// functions of call nodes, where half the instructions are guarded products, that
+    /// code was twice as long and its taken branches filled the branch predictor.)
+    fn guard(&mut self, a: Value, p: Value) -> Value {
+        let ty = types::F64X2;
+        let scalar = self.b.func.dfg.value_type(a) != ty;
+        let lanes = if scalar { self.b.ins().splat(ty, a) } else { a };
+        let zero = match self.zero_vector {
+            Some((z, last)) if self.at.saturating_sub(last) <= WINDOW => z,
+            _ => {
+                let k = self
+                    .b
+                    .func
+                    .dfg
+                    .constants
+                    .insert(ConstantData::from(vec![0u8; 16]));
+                self.b.ins().vconst(ty, k)
+            }
+        };
+        self.zero_vector = Some((zero, self.at));
+        let mask = self.b.ins().fcmp(FloatCC::NotEqual, lanes, zero);
+        let little = MemFlags::new().with_endianness(Endianness::Little);
+        let mask = self.b.ins().bitcast(ty, little, mask);
+        let mask = if scalar {
+            self.b.ins().extractlane(mask, 0)
+        } else {
+            mask
+        };
+        self.b.ins().band(p, mask)
+    }
+
     /// Whether register `r` holds a constant other than NaN: a commutative operation
     /// gives the same bits with its operands swapped when one of them is such a constant
     /// (x86 returns the one NaN operand, quieted, whichever side it is on).
@@ -693,14 +775,14 @@ impl<'a, 'b> Emitter<'a, 'b> {
         ) {
             (Some(_), _) => None,
             (None, Some((k, i))) => Some((self.params.inputs[k as usize], 8 * i as i32)),
-            (None, None) => Some((self.w, 8 * r as i32)),
+            (None, None) => Some(self.home(r)),
         }
     }
 
     /// The two lanes `(r1 at at1, r2 at at2)` as one `f64x2`: one load when both lie
     /// side by side in memory, one constant when both are constants, else the two scalars
     /// put together. With `first` (the first operand of a commutative operation) a loaded
-    /// vector is loaded as integers, for the reason given at [`Emitter::operand`].
+    /// vector is kept out of a memory operand, for the reason given at [`Emitter::operand`].
     fn lanes(&mut self, (r1, at1): (u32, usize), (r2, at2): (u32, usize), first: bool) -> Value {
         let ty = types::F64X2;
         let c = &self.layout.constant;
@@ -719,13 +801,10 @@ impl<'a, 'b> Emitter<'a, 'b> {
         if let (Some((b1, o1)), Some((b2, o2))) = (self.memory(r1, at1), self.memory(r2, at2)) {
             if b1 == b2 && o2 == o1 + 8 {
                 let flags = MemFlags::new().with_notrap();
-                let v = if first {
-                    let bits = self.b.ins().load(types::I64X2, flags, b1, o1);
-                    let little = MemFlags::new().with_endianness(Endianness::Little);
-                    self.b.ins().bitcast(ty, little, bits)
-                } else {
-                    self.b.ins().load(ty, flags, b1, o1)
-                };
+                let v = self.b.ins().load(ty, flags, b1, o1);
+                if first {
+                    self.unfoldable(v);
+                }
                 // The scalars stay reachable as lanes of the vector.
                 for (r, at, lane) in [(r1, at1, 0), (r2, at2, 1)] {
                     self.values.insert(r, (Held::Lane(v, lane), at));
@@ -775,6 +854,10 @@ impl<'a, 'b> Emitter<'a, 'b> {
                         Op::Sub => self.b.ins().fsub(a, b),
                         Op::Mul => self.b.ins().fmul(a, b),
                         Op::Div => self.b.ins().fdiv(a, b),
+                        Op::StrongMul => {
+                            let p = self.b.ins().fmul(a, b);
+                            self.guard(a, p)
+                        }
                         _ => unreachable!("{op:?} is not paired (lanes::pairable)"),
                     }
                 }
@@ -860,6 +943,9 @@ impl<'a, 'b> Emitter<'a, 'b> {
                 None => (None, 8 * r as i32),
             }
         };
+        // The integer constants stored recently, by bits, and the store of their last use.
+        let mut recent = FxHashMap::default();
+        let mut stored = 0;
         let mut k = 0;
         while k < needed.len() {
             if !needed[k] {
@@ -874,7 +960,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
             let offset = dest(k).1;
             if end - k < INLINE_TEMPLATE {
                 for (j, &v) in f.template[k..end].iter().enumerate() {
-                    let c = self.constant(v);
+                    let c = self.template_bits(&mut recent, v, stored);
+                    stored += 1;
                     self.b
                         .ins()
                         .store(self.flags, c, base, offset + 8 * j as i32);
@@ -884,6 +971,26 @@ impl<'a, 'b> Emitter<'a, 'b> {
             }
             k = end;
         }
+    }
+
+    /// The bits of `v` as an integer for the `stored`-th immediate store of [`Emitter::template`]:
+    /// the value of an earlier store of the same bits within [`WINDOW`] stores, else a new
+    /// constant (storing the bits from an integer register takes one instruction where a
+    /// float constant takes three: integer immediate, move to a float register, store;
+    /// the gap Jacobian stores 823 constant outputs, mostly ±1 and ±0.5, at every call).
+    fn template_bits(
+        &mut self,
+        recent: &mut FxHashMap<u64, (Value, usize)>,
+        v: f64,
+        stored: usize,
+    ) -> Value {
+        let bits = v.to_bits();
+        let value = match recent.get(&bits) {
+            Some(&(c, last)) if stored - last <= WINDOW => c,
+            _ => self.b.ins().iconst(types::I64, bits as i64),
+        };
+        recent.insert(bits, (value, stored));
+        value
     }
 
     /// Copies template entries `k..end` to `base + offset`.
@@ -1047,10 +1154,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
                 self.truth(c)
             }
             Op::StrongMul => {
-                let z = self.b.ins().f64const(zero());
                 let p = self.b.ins().fmul(a, b);
-                let c = self.b.ins().fcmp(FloatCC::Equal, a, z);
-                self.b.ins().select(c, z, p)
+                self.guard(a, p)
             }
             Op::IfElse => {
                 let c = self.get(ins.c);
@@ -1097,7 +1202,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
             for i in 0..n {
                 let off = scratch + 8 * (at + i) as i32;
                 let v = self.b.ins().load(types::F64, self.flags, self.w, off);
-                self.put(call.out + q, v, true);
+                let r = call.out + q;
+                self.put(r, v, !self.layout.in_output[r as usize]);
                 q += 1;
             }
         }

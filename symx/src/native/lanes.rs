@@ -8,7 +8,7 @@
 //! or a register that neither group writes before reading it (nothing flows from the
 //! first group into the second). Only operations whose SIMD form computes exactly the
 //! scalar IEEE result in each lane are paired (`+ − × ÷`, negation, square, square root,
-//! absolute value), so the lanes are bit-identical to the tape.
+//! absolute value, the guarded product `⊛`), so the lanes are bit-identical to the tape.
 use crate::function::{Function, Instr};
 use crate::op::Op;
 
@@ -74,11 +74,20 @@ pub(crate) enum Step {
     },
 }
 
-/// Whether `op` computes in SIMD lanes exactly what it computes on scalars.
+/// Whether `op` computes in SIMD lanes exactly what it computes on scalars (the guarded
+/// product `a ⊛ b`: the product and-ed with the mask of `a ≠ 0`, as on scalars).
 pub(crate) fn pairable(op: Op) -> bool {
     matches!(
         op,
-        Op::Add | Op::Sub | Op::Mul | Op::Div | Op::Neg | Op::Sq | Op::Sqrt | Op::Abs
+        Op::Add
+            | Op::Sub
+            | Op::Mul
+            | Op::Div
+            | Op::Neg
+            | Op::Sq
+            | Op::Sqrt
+            | Op::Abs
+            | Op::StrongMul
     )
 }
 

@@ -96,21 +96,25 @@ pub(super) fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
 pub(super) fn read(f: &Function) -> Vec<bool> {
     let mut read = vec![false; f.work_size];
     for ins in &f.tape {
-        let n = match ins.op {
-            Op::Call => {
-                let call = &f.calls[ins.d as usize];
-                call.args.iter().for_each(|&r| read[r as usize] = true);
-                0
-            }
-            // The copy `w[d] = w[a]`.
-            Op::Sym => 1,
-            op => op.arity().min(3),
-        };
-        for &r in &[ins.a, ins.b, ins.c][..n] {
-            read[r as usize] = true;
-        }
+        operands(f, ins, |r| read[r as usize] = true);
     }
     read
+}
+
+/// Visits the registers instruction `ins` of `f` reads: its operands, or a call's arguments.
+pub(super) fn operands(f: &Function, ins: &Instr, mut visit: impl FnMut(u32)) {
+    let n = match ins.op {
+        Op::Call => {
+            f.calls[ins.d as usize].args.iter().for_each(|&r| visit(r));
+            0
+        }
+        // The copy `w[d] = w[a]`.
+        Op::Sym => 1,
+        op => op.arity().min(3),
+    };
+    for &r in &[ins.a, ins.b, ins.c][..n] {
+        visit(r);
+    }
 }
 
 /// Where a call node's data lives in the generated code's work vector (offsets from the
@@ -155,4 +159,27 @@ pub(super) fn call_layout(f: &Function, ins: &Instr) -> CallLayout {
         outputs,
         callee_work: s + callee_base(g),
     }
+}
+
+/// For each instruction of `f`'s tape: whether its result is read by an instruction of a
+/// later chunk (chunks of `chunk` instructions) before its register is written again, so
+/// that code keeping values in local variables within a chunk must also keep it in memory.
+pub(super) fn read_by_later_chunk(f: &Function, chunk: usize) -> Vec<bool> {
+    // Per register: 1 + the last chunk reading its current value (going backwards), or 0.
+    let mut reader = vec![0; f.work_size];
+    let mut later = vec![false; f.tape.len()];
+    for (i, ins) in f.tape.iter().enumerate().rev() {
+        let c = i / chunk + 1;
+        if ins.op == Op::Call {
+            let call = &f.calls[ins.d as usize];
+            let n: usize = call.function.output_sizes.iter().sum();
+            let out = call.out as usize;
+            reader[out..out + n].fill(0);
+        } else {
+            later[i] = reader[ins.d as usize] > c;
+            reader[ins.d as usize] = 0;
+        }
+        operands(f, ins, |r| reader[r as usize] = reader[r as usize].max(c));
+    }
+    later
 }

@@ -4,11 +4,14 @@
 //!
 //! Nothing is copied per call: each generated function `exec(w, x, y)` reads its inputs
 //! where the caller keeps them (`x[k]`), writes its outputs where the caller wants them
-//! (`y[k]`), and has its constants as literals; the work vector `w` holds only the
-//! temporaries (and the arguments gathered for a call of another function), so
-//! `WORK_SIZE` counts only those: the tape's registers from its first temporary on
-//! (`first_temporary`), already reused by liveness when the tape was compiled.
-use super::places::{call_layout, constant_outputs, places, work_need, Place};
+//! (`y[k]`), and has its constants as literals. Temporaries live in local variables of
+//! the generated function of each chunk of the tape ([`Body`]); the work vector `w` holds
+//! only those a later chunk reads, the outputs of calls and the arguments gathered for a
+//! call of another function, packed ([`Slots`]): `WORK_SIZE` counts only those.
+use super::places::{
+    call_layout, callee_base, constant_outputs, first_temporary, operands, places,
+    read_by_later_chunk, Place,
+};
 use super::{library_binary, library_unary, unsupported, SourceOptions};
 use crate::error::SymxError;
 use crate::function::{Function, Instr};
@@ -20,20 +23,36 @@ use std::fmt::Write;
 const CHUNK: usize = 1024;
 
 /// The text of one generated function's body, noting the inputs and outputs it uses.
+///
+/// Within a body, values live in local variables (`let v{i}`: the result of instruction
+/// `i`; `x{k}_{i}`: input entry `(k, i)`, loaded at its first read), which the compiler
+/// keeps in registers; only results read by a later body go to the work vector, and
+/// outputs are written once to the caller's output. (With every temporary in the work
+/// vector, behind raw pointers that may alias the outputs, rustc had to store every
+/// result and reload operands after each output store.)
 struct Body<'a> {
     out: String,
     places: &'a [Place],
+    slots: &'a Slots,
     inputs: Vec<bool>,
     outputs: Vec<bool>,
+    /// The local variable holding each register's current value in this body.
+    locals: FxHashMap<u32, String>,
 }
 
 impl Body<'_> {
-    /// The expression reading register `r` (or the place writing it).
+    /// The expression reading register `r`: its local variable, or where it is kept.
     fn reg(&mut self, r: u32) -> String {
+        if let Some(name) = self.locals.get(&r) {
+            return name.clone();
+        }
         match self.places[r as usize] {
             Place::Input(k, i) => {
                 self.inputs[k] = true;
-                format!("*x{k}.add({i})")
+                let name = format!("x{k}_{i}");
+                writeln!(self.out, "    let {name} = *x{k}.add({i});").unwrap();
+                self.locals.insert(r, name.clone());
+                name
             }
             Place::Output(k, i) => {
                 self.outputs[k] = true;
@@ -44,9 +63,34 @@ impl Body<'_> {
         }
     }
 
+    /// Instruction `i` of `f` (other than a call): its value into the local `v{i}`,
+    /// then to the caller's output if the register is an output slot, and to the work
+    /// vector if `keep` (read by a later body).
+    fn assign(&mut self, f: &Function, i: usize, keep: bool) -> Result<(), SymxError> {
+        let ins = &f.tape[i];
+        let v = self.value(f, ins)?;
+        let name = format!("v{i}");
+        writeln!(self.out, "    let {name} = {v};").unwrap();
+        match self.places[ins.d as usize] {
+            Place::Output(k, j) => {
+                self.outputs[k] = true;
+                writeln!(self.out, "    *y{k}.add({j}) = {name};").unwrap();
+            }
+            Place::Work(r) if keep => writeln!(self.out, "    *w.add({r}) = {name};").unwrap(),
+            _ => {}
+        }
+        self.locals.insert(ins.d, name);
+        Ok(())
+    }
+
     /// The value computed by `ins`, other than a call.
-    fn value(&mut self, ins: &Instr) -> Result<String, SymxError> {
-        let (a, b, c) = (self.reg(ins.a), self.reg(ins.b), self.reg(ins.c));
+    fn value(&mut self, f: &Function, ins: &Instr) -> Result<String, SymxError> {
+        // Only the operands the instruction reads (the first read of an input loads it).
+        let mut read = Vec::with_capacity(3);
+        operands(f, ins, |r| read.push(r));
+        let mut regs: Vec<String> = read.into_iter().map(|r| self.reg(r)).collect();
+        regs.resize(3, String::new());
+        let [a, b, c]: [String; 3] = regs.try_into().expect("three operands");
         Ok(match ins.op {
             Op::Add => format!("{a} + {b}"),
             Op::Sub => format!("{a} - {b}"),
@@ -82,24 +126,32 @@ impl Body<'_> {
     /// call's block of registers.
     fn call(&mut self, f: &Function, ins: &Instr, callee: &str) {
         let layout = call_layout(f, ins);
-        for &(at, r) in &layout.args {
-            let v = self.reg(r);
-            writeln!(self.out, "    *w.add({at}) = {v};").unwrap();
-        }
+        let at = |x: usize| self.slots.at(x);
         let xs: Vec<String> = (layout.inputs.iter())
-            .map(|at| format!("w.add({at}) as *const f64"))
+            .map(|&x| format!("w.add({}) as *const f64", at(x)))
             .collect();
         let ys: Vec<String> = (layout.outputs.iter())
-            .map(|at| format!("w.add({at})"))
+            .map(|&x| format!("w.add({})", at(x)))
             .collect();
+        let callee_work = at(layout.callee_work);
+        for &(x, r) in &layout.args {
+            let (x, v) = (self.slots.at(x), self.reg(r));
+            writeln!(self.out, "    *w.add({x}) = {v};").unwrap();
+        }
         writeln!(
             self.out,
             "    {{ let x = [{}]; let y = [{}]; {callee}(w.add({}), x.as_ptr(), y.as_ptr()); }}",
             xs.join(", "),
             ys.join(", "),
-            layout.callee_work
+            callee_work
         )
         .unwrap();
+        // The outputs are in the work vector now.
+        let call = &f.calls[ins.d as usize];
+        let n: u32 = call.function.output_sizes.iter().sum::<usize>() as u32;
+        (call.out..call.out + n).for_each(|r| {
+            self.locals.remove(&r);
+        });
     }
 }
 
@@ -120,23 +172,32 @@ impl Writer {
             callees.push(self.function(&c.function)?);
         }
         let name = format!("exec{}", self.names.len());
-        let places = places(f);
+        let keep = read_by_later_chunk(f, CHUNK);
+        let slots = Slots::new(f, &keep);
+        let places: Vec<Place> = places(f)
+            .into_iter()
+            .map(|p| match p {
+                Place::Work(x) => Place::Work(slots.at(x)),
+                p => p,
+            })
+            .collect();
         let mut chunks = Vec::new();
-        for (k, part) in f.tape.chunks(CHUNK).enumerate() {
+        for k in 0..f.tape.len().div_ceil(CHUNK) {
             let chunk = format!("{name}_{k}");
             let mut body = Body {
                 out: String::new(),
                 places: &places,
+                slots: &slots,
                 inputs: vec![false; f.input_sizes.len()],
                 outputs: vec![false; f.output_sizes.len()],
+                locals: FxHashMap::default(),
             };
-            for ins in part {
+            let range = k * CHUNK..((k + 1) * CHUNK).min(f.tape.len());
+            for (i, ins) in range.clone().zip(&f.tape[range]) {
                 if ins.op == Op::Call {
                     body.call(f, ins, &callees[ins.d as usize]);
                 } else {
-                    let v = body.value(ins)?;
-                    let d = body.reg(ins.d);
-                    writeln!(body.out, "    {d} = {v};").unwrap();
+                    body.assign(f, i, keep[i])?;
                 }
             }
             self.emit(&chunk, &body);
@@ -176,6 +237,59 @@ impl Writer {
         o.push_str(&body.out);
         writeln!(o, "}}\n").unwrap();
     }
+}
+
+/// Where the generated Rust keeps a function's work vector: the temporaries a later body
+/// reads ([`read_by_later_chunk`]) and the blocks of call outputs, packed in register
+/// order, then the call scratch; every other temporary lives in a local variable.
+struct Slots {
+    /// The packed offset of each temporary (register `first_temporary(f) + x`), if kept.
+    packed: Vec<usize>,
+    /// The number of temporaries kept: where the call scratch starts.
+    scratch: usize,
+}
+
+impl Slots {
+    fn new(f: &Function, keep: &[bool]) -> Slots {
+        let t = first_temporary(f);
+        let mut kept = vec![false; f.call_scratch - t];
+        for (i, ins) in f.tape.iter().enumerate() {
+            if ins.op == Op::Call {
+                let call = &f.calls[ins.d as usize];
+                let n: usize = call.function.output_sizes.iter().sum();
+                let out = call.out as usize - t;
+                kept[out..out + n].fill(true);
+            } else if keep[i] && ins.d as usize >= t {
+                kept[ins.d as usize - t] = true;
+            }
+        }
+        let mut packed = Vec::with_capacity(kept.len());
+        let mut n = 0;
+        for &k in &kept {
+            packed.push(n);
+            n += usize::from(k);
+        }
+        Slots { packed, scratch: n }
+    }
+
+    /// The packed offset of offset `x` of the unpacked layout ([`places`], [`call_layout`]).
+    fn at(&self, x: usize) -> usize {
+        match self.packed.get(x) {
+            Some(&p) => p,
+            None => self.scratch + (x - self.packed.len()),
+        }
+    }
+}
+
+/// `WORK_SIZE` of the generated Rust of `f`: its packed [`Slots`], then the largest
+/// callee's gathered arguments and work vector.
+fn packed_work_need(f: &Function) -> usize {
+    let slots = Slots::new(f, &read_by_later_chunk(f, CHUNK));
+    let callees = f
+        .calls
+        .iter()
+        .map(|c| callee_base(&c.function) + packed_work_need(&c.function));
+    slots.scratch + callees.max().unwrap_or(0)
 }
 
 /// An `f64` literal with the exact bits of `v`.
@@ -304,7 +418,7 @@ impl Function {
         writeln!(
             o,
             "/// Length of the work vector (the temporaries only).\npub const WORK_SIZE: usize = {};",
-            work_need(self)
+            packed_work_need(self)
         )
         .unwrap();
         writeln!(
