@@ -32,8 +32,8 @@ use faer::sparse::SymbolicSparseColMat;
 
 use super::iterate::Mult;
 use super::polish::{
-    equality_qp_step_into, jac_times_into, solve_working_set_into, stationarity_into, EqScratch,
-    Side, WorkingSet,
+    correct_working_set_step_in, equality_qp_step_into, jac_times_into, solve_working_set_into,
+    stationarity_into, EqScratch, Side, WorkingSet,
 };
 use super::qp::{QpData, QpResult};
 use crate::frontend::scaled::refill;
@@ -53,6 +53,9 @@ pub(super) enum Failure {
     /// `max_iter` iterations without a KKT point.
     IterationLimit,
 }
+
+/// How often one QP step may raise the ℓ1 penalty ρ (elastic mode, [`penalty_for`]).
+pub(super) const MAX_PENALTY_INCREASES: usize = 11;
 
 /// The ℓ1 penalty for which a QP solution with multipliers up to `max_multiplier` is
 /// also the elastic QP's: `rho` itself when it suffices, otherwise the first of
@@ -189,10 +192,17 @@ pub(super) fn solve_in(
         if !solved {
             return Err(Failure::EqualityQp);
         }
-        stationarity_into(p, (jp, hp), d, lambda, s);
-        jac_times_into(p, jp, d, jd);
+        let pats = (jp, hp);
+        test_step(
+            kkt,
+            p,
+            pats,
+            w,
+            eq,
+            (&mut *d, &mut *lambda, &mut *s, &mut *jd),
+            changes,
+        );
         let step = Step { d, lambda, s, jd };
-        sign_test(p, w, &step, changes);
         if changes.is_empty() {
             let max_multiplier = kkt_point(p, w, step, n_elastic, res)?;
             res.iterations = iteration as u32;
@@ -222,6 +232,34 @@ pub(super) fn solve_in(
         }
     }
     Err(Failure::IterationLimit)
+}
+
+/// The residuals of W's step `(d, lambda)` (into `s` and `jd`) and its sign test (into
+/// `changes`). A candidate solution (nothing to change) whose rows of W are off by more
+/// than the feasibility tolerance gets one more refinement step
+/// ([`correct_working_set_step_in`]) before it is judged, and the test is repeated on
+/// the corrected step.
+#[allow(clippy::type_complexity)]
+fn test_step(
+    kkt: &mut Kkt,
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    w: &WorkingSet,
+    eq: &mut EqScratch,
+    (d, lambda, s, jd): (&mut [f64], &mut [f64], &mut Vec<f64>, &mut Vec<f64>),
+    changes: &mut Vec<Change>,
+) {
+    stationarity_into(p, (jp, hp), d, lambda, s);
+    jac_times_into(p, jp, d, jd);
+    sign_test(p, w, &Step { d, lambda, s, jd }, changes);
+    if changes.is_empty()
+        && !rows_met(p, w, jd)
+        && correct_working_set_step_in(kkt, p, w, (s, jd), eq, (d, lambda))
+    {
+        stationarity_into(p, (jp, hp), d, lambda, s);
+        jac_times_into(p, jp, d, jd);
+        sign_test(p, w, &Step { d, lambda, s, jd }, changes);
+    }
 }
 
 /// The first iteration of [`solve_in`] for a step of W's equality QP computed by the
@@ -269,6 +307,18 @@ struct Step<'s> {
 /// The feasibility tolerance of a constraint with bound `b`.
 fn feas_tol(b: f64) -> f64 {
     1e-9 * (1.0 + b.abs())
+}
+
+/// Whether the step with J d = `jd` meets every row of W to its feasibility tolerance.
+fn rows_met(p: &QpData, w: &WorkingSet, jd: &[f64]) -> bool {
+    (0..p.g.len()).all(|i| {
+        let lin = p.g[i] + jd[i];
+        match w.rows[i] {
+            Side::Free => true,
+            Side::Lower => (lin - p.g_l[i]).abs() <= feas_tol(p.g_l[i]),
+            Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= feas_tol(p.g_u[i]),
+        }
+    })
 }
 
 /// The sign test of the primal-dual active-set strategy: into `changes`, every row and
@@ -392,16 +442,8 @@ fn kkt_point(
 ) -> Result<f64, Failure> {
     let (n, m) = (p.x.len(), p.g.len());
     let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let met = |i: usize| {
-        let lin = p.g[i] + st.jd[i];
-        match w.rows[i] {
-            Side::Free => true,
-            Side::Lower => (lin - p.g_l[i]).abs() <= feas_tol(p.g_l[i]),
-            Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= feas_tol(p.g_u[i]),
-        }
-    };
     if (0..n).any(|j| w.vars[j] == Side::Free && st.s[j].abs() > 1e-8 * grad_max)
-        || !(0..m).all(met)
+        || !rows_met(p, w, st.jd)
     {
         return Err(Failure::EqualityQp);
     }
