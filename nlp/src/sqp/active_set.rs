@@ -788,6 +788,51 @@ mod tests {
         true
     }
 
+    /// min ½‖d‖² + 1e4·d₀ + 2e4·d₁ s.t. d₀ + d₁ = 0 (row, g = 0), x₁ + d₁ ≥ x₁ + 5 (bound):
+    /// by hand, d = (−5, 5), the row's multiplier λ = −(1e4 + d₀) = −9995 and the bound's
+    /// z_l = d₁ + 2e4 + λ = 10010 > 0. The bound's fixing weight (1e14 × target 5) makes
+    /// the solve's refinement stop with the row off by the zero block's 1e-10·|λ| ≈ 1e-6;
+    /// the candidate must be refined once more and accepted, not handed back
+    /// (`Failure::EqualityQp`, as before the correction). Tolerances: an exact solve of a
+    /// 3×3 system to rounding, relative 1e-9.
+    #[test]
+    fn a_candidate_with_large_multipliers_is_refined_not_refused() {
+        let hp = pattern(2, 2, &[(0, 0), (1, 1)]);
+        let jp = pattern(1, 2, &[(0, 0), (0, 1)]);
+        let c = Case {
+            n: 2,
+            m: 1,
+            hp,
+            jp,
+            hess: vec![1.0, 1.0],
+            jac: vec![1.0, 1.0],
+            x: vec![0.0, 0.0],
+            x_l: vec![f64::NEG_INFINITY, 5.0],
+            x_u: vec![f64::INFINITY, f64::INFINITY],
+            g: vec![0.0],
+            g_l: vec![0.0],
+            g_u: vec![0.0],
+            grad: vec![1e4, 2e4],
+            zeros_n: vec![0.0; 2],
+            zeros_m: vec![0.0; 1],
+        };
+        let mut kkt = Kkt::new(c.n, c.m, &c.hp, &c.jp).unwrap();
+        let mut n_fact = 0;
+        let data = c.data();
+        let pats = (&c.jp, &c.hp);
+        let s = solve(&mut kkt, &data, pats, cold(&c), (50, 0), &mut n_fact, false)
+            .unwrap_or_else(|f| panic!("refused: {f:?}"));
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + b.abs());
+        assert!(
+            close(s.res.d[0], -5.0) && close(s.res.d[1], 5.0),
+            "d {:?}",
+            s.res.d
+        );
+        assert!(close(s.res.lambda[0], -9995.0), "λ {:?}", s.res.lambda);
+        assert!(close(s.res.z_l[1], 10010.0), "z_l {:?}", s.res.z_l);
+        assert_eq!(s.working_set.vars[1], Side::Lower);
+    }
+
     #[test]
     fn matches_clarabel_on_random_convex_qps() {
         let mut solved = 0u64;

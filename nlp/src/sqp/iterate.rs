@@ -157,11 +157,16 @@ impl Iterate {
             ny += 1;
             ysum += mult.lambda[i].abs();
             if geo.g_l[i] != geo.g_u[i] {
+                // The slack of a side, clamped at 0: a violation is inf_pr's, not
+                // complementarity's (IPOPT's slacks are ≥ 0 by construction). Unclamped,
+                // a rounding-level violation (5e-11) times a large multiplier (1e4) kept
+                // the error above tol for good, and the MPCC phases of qpec2 and ralph1
+                // ran to their iteration limits.
                 if geo.g_l[i].is_finite() {
-                    compl = compl.max(((g[i] - geo.g_l[i]) * (-mult.lambda[i]).max(0.0)).abs());
+                    compl = compl.max((g[i] - geo.g_l[i]).max(0.0) * (-mult.lambda[i]).max(0.0));
                 }
                 if geo.g_u[i].is_finite() {
-                    compl = compl.max(((geo.g_u[i] - g[i]) * mult.lambda[i].max(0.0)).abs());
+                    compl = compl.max((geo.g_u[i] - g[i]).max(0.0) * mult.lambda[i].max(0.0));
                 }
             }
         }
