@@ -234,18 +234,8 @@ pub(super) fn solve_working_set_into(
             Side::Upper | Side::Both => p.g_u[i] - p.g[i],
         };
     }
-    // Remove the regularisation of the W rows (solve with the exact zero block).
-    shift.clear();
-    shift.extend((0..n + m).map(|k| {
-        if k >= n && w.rows[k - n] != Side::Free {
-            ZERO_BLOCK_REG
-        } else {
-            0.0
-        }
-    }));
-    match kkt.solve_shifted(rhs, Some(shift)) {
-        Ok(ratio) if ratio <= 1e-8 => {}
-        _ => return false,
+    if !solve_exact_zero_block(kkt, w, rhs, shift) {
+        return false;
     }
     d.clear();
     d.extend_from_slice(&rhs[..n]);
@@ -262,6 +252,27 @@ pub(super) fn solve_working_set_into(
         }
     }
     true
+}
+
+/// Solves with the factorisation of W's equality QP in `kkt` in place of `rhs`, the
+/// regularisation of W's rows removed by refinement (the exact zero block; `shift`: its
+/// work vector). `false` when the solve is inaccurate.
+fn solve_exact_zero_block(
+    kkt: &mut Kkt,
+    w: &WorkingSet,
+    rhs: &mut [f64],
+    shift: &mut Vec<f64>,
+) -> bool {
+    let n = kkt.n();
+    shift.clear();
+    shift.extend((0..rhs.len()).map(|k| {
+        if k >= n && w.rows[k - n] != Side::Free {
+            ZERO_BLOCK_REG
+        } else {
+            0.0
+        }
+    }));
+    matches!(kkt.solve_shifted(rhs, Some(shift)), Ok(ratio) if ratio <= 1e-8)
 }
 
 /// One more step of iterative refinement of W's equality QP solution `(d, lambda)` (from
@@ -299,17 +310,8 @@ pub(super) fn correct_working_set_step_in(
             (Side::Upper | Side::Both, _) => p.g_u[i] - p.g[i] - jd[i],
         };
     }
-    shift.clear();
-    shift.extend((0..n + m).map(|k| {
-        if k >= n && w.rows[k - n] != Side::Free {
-            ZERO_BLOCK_REG
-        } else {
-            0.0
-        }
-    }));
-    match kkt.solve_shifted(rhs, Some(shift)) {
-        Ok(ratio) if ratio <= 1e-8 => {}
-        _ => return false,
+    if !solve_exact_zero_block(kkt, w, rhs, shift) {
+        return false;
     }
     for j in 0..n {
         if w.vars[j] == Side::Free {
