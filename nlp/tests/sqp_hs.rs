@@ -24,7 +24,7 @@ hs_suite!();
 /// a change of behaviour (better or worse) fails the test and the list must be updated.
 /// The IPM solves all of them (`tests/hs.rs`).
 const KNOWN_FAILURES: &[(&str, Status, &str)] = &[
-    // No KKT point at the solution (degenerate constraints); f = 0.99884 ≈ f* but the
+    // No KKT point at the solution (degenerate constraints); f = 0.9989 ≈ f* but the
     // dual error never reaches tol. With clarabel's QP steps the run ended at the
     // acceptable level (41 iterations); with the active-set QP (issue 19) it runs into
     // the iteration limit near the cusp.

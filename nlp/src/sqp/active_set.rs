@@ -32,8 +32,8 @@ use faer::sparse::SymbolicSparseColMat;
 
 use super::iterate::Mult;
 use super::polish::{
-    equality_qp_step_into, jac_times_into, solve_working_set_into, stationarity_into, EqScratch,
-    Side, WorkingSet,
+    correct_working_set_step_in, equality_qp_step_into, jac_times_into, solve_working_set_into,
+    stationarity_into, EqScratch, Side, WorkingSet,
 };
 use super::qp::{QpData, QpResult};
 use crate::frontend::scaled::refill;
@@ -53,6 +53,9 @@ pub(super) enum Failure {
     /// `max_iter` iterations without a KKT point.
     IterationLimit,
 }
+
+/// How often one QP step may raise the ℓ1 penalty ρ (elastic mode, [`penalty_for`]).
+pub(super) const MAX_PENALTY_INCREASES: usize = 11;
 
 /// The ℓ1 penalty for which a QP solution with multipliers up to `max_multiplier` is
 /// also the elastic QP's: `rho` itself when it suffices, otherwise the first of
@@ -189,10 +192,17 @@ pub(super) fn solve_in(
         if !solved {
             return Err(Failure::EqualityQp);
         }
-        stationarity_into(p, (jp, hp), d, lambda, s);
-        jac_times_into(p, jp, d, jd);
+        let pats = (jp, hp);
+        test_step(
+            kkt,
+            p,
+            pats,
+            w,
+            eq,
+            (&mut *d, &mut *lambda, &mut *s, &mut *jd),
+            changes,
+        );
         let step = Step { d, lambda, s, jd };
-        sign_test(p, w, &step, changes);
         if changes.is_empty() {
             let max_multiplier = kkt_point(p, w, step, n_elastic, res)?;
             res.iterations = iteration as u32;
@@ -222,6 +232,34 @@ pub(super) fn solve_in(
         }
     }
     Err(Failure::IterationLimit)
+}
+
+/// The residuals of W's step `(d, lambda)` (into `s` and `jd`) and its sign test (into
+/// `changes`). A candidate solution (nothing to change) whose rows of W are off by more
+/// than the feasibility tolerance gets one more refinement step
+/// ([`correct_working_set_step_in`]) before it is judged, and the test is repeated on
+/// the corrected step.
+#[allow(clippy::type_complexity)]
+fn test_step(
+    kkt: &mut Kkt,
+    p: &QpData,
+    (jp, hp): (&SymbolicSparseColMat<usize>, &SymbolicSparseColMat<usize>),
+    w: &WorkingSet,
+    eq: &mut EqScratch,
+    (d, lambda, s, jd): (&mut [f64], &mut [f64], &mut Vec<f64>, &mut Vec<f64>),
+    changes: &mut Vec<Change>,
+) {
+    stationarity_into(p, (jp, hp), d, lambda, s);
+    jac_times_into(p, jp, d, jd);
+    sign_test(p, w, &Step { d, lambda, s, jd }, changes);
+    if changes.is_empty()
+        && !rows_met(p, w, jd)
+        && correct_working_set_step_in(kkt, p, w, (s, jd), eq, (d, lambda))
+    {
+        stationarity_into(p, (jp, hp), d, lambda, s);
+        jac_times_into(p, jp, d, jd);
+        sign_test(p, w, &Step { d, lambda, s, jd }, changes);
+    }
 }
 
 /// The first iteration of [`solve_in`] for a step of W's equality QP computed by the
@@ -269,6 +307,18 @@ struct Step<'s> {
 /// The feasibility tolerance of a constraint with bound `b`.
 fn feas_tol(b: f64) -> f64 {
     1e-9 * (1.0 + b.abs())
+}
+
+/// Whether the step with J d = `jd` meets every row of W to its feasibility tolerance.
+fn rows_met(p: &QpData, w: &WorkingSet, jd: &[f64]) -> bool {
+    (0..p.g.len()).all(|i| {
+        let lin = p.g[i] + jd[i];
+        match w.rows[i] {
+            Side::Free => true,
+            Side::Lower => (lin - p.g_l[i]).abs() <= feas_tol(p.g_l[i]),
+            Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= feas_tol(p.g_u[i]),
+        }
+    })
 }
 
 /// The sign test of the primal-dual active-set strategy: into `changes`, every row and
@@ -392,16 +442,8 @@ fn kkt_point(
 ) -> Result<f64, Failure> {
     let (n, m) = (p.x.len(), p.g.len());
     let grad_max = p.grad.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let met = |i: usize| {
-        let lin = p.g[i] + st.jd[i];
-        match w.rows[i] {
-            Side::Free => true,
-            Side::Lower => (lin - p.g_l[i]).abs() <= feas_tol(p.g_l[i]),
-            Side::Upper | Side::Both => (lin - p.g_u[i]).abs() <= feas_tol(p.g_u[i]),
-        }
-    };
     if (0..n).any(|j| w.vars[j] == Side::Free && st.s[j].abs() > 1e-8 * grad_max)
-        || !(0..m).all(met)
+        || !rows_met(p, w, st.jd)
     {
         return Err(Failure::EqualityQp);
     }
@@ -744,6 +786,51 @@ mod tests {
         assert_eq!(n_fact - before, 1, "{label}");
         assert_eq!(warm.res.d, s.res.d, "{label}");
         true
+    }
+
+    /// min ½‖d‖² + 1e4·d₀ + 2e4·d₁ s.t. d₀ + d₁ = 0 (row, g = 0), x₁ + d₁ ≥ x₁ + 5 (bound):
+    /// by hand, d = (−5, 5), the row's multiplier λ = −(1e4 + d₀) = −9995 and the bound's
+    /// z_l = d₁ + 2e4 + λ = 10010 > 0. The bound's fixing weight (1e14 × target 5) makes
+    /// the solve's refinement stop with the row off by the zero block's 1e-10·|λ| ≈ 1e-6;
+    /// the candidate must be refined once more and accepted, not handed back
+    /// (`Failure::EqualityQp`, as before the correction). Tolerances: an exact solve of a
+    /// 3×3 system to rounding, relative 1e-9.
+    #[test]
+    fn a_candidate_with_large_multipliers_is_refined_not_refused() {
+        let hp = pattern(2, 2, &[(0, 0), (1, 1)]);
+        let jp = pattern(1, 2, &[(0, 0), (0, 1)]);
+        let c = Case {
+            n: 2,
+            m: 1,
+            hp,
+            jp,
+            hess: vec![1.0, 1.0],
+            jac: vec![1.0, 1.0],
+            x: vec![0.0, 0.0],
+            x_l: vec![f64::NEG_INFINITY, 5.0],
+            x_u: vec![f64::INFINITY, f64::INFINITY],
+            g: vec![0.0],
+            g_l: vec![0.0],
+            g_u: vec![0.0],
+            grad: vec![1e4, 2e4],
+            zeros_n: vec![0.0; 2],
+            zeros_m: vec![0.0; 1],
+        };
+        let mut kkt = Kkt::new(c.n, c.m, &c.hp, &c.jp).unwrap();
+        let mut n_fact = 0;
+        let data = c.data();
+        let pats = (&c.jp, &c.hp);
+        let s = solve(&mut kkt, &data, pats, cold(&c), (50, 0), &mut n_fact, false)
+            .unwrap_or_else(|f| panic!("refused: {f:?}"));
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + b.abs());
+        assert!(
+            close(s.res.d[0], -5.0) && close(s.res.d[1], 5.0),
+            "d {:?}",
+            s.res.d
+        );
+        assert!(close(s.res.lambda[0], -9995.0), "λ {:?}", s.res.lambda);
+        assert!(close(s.res.z_l[1], 10010.0), "z_l {:?}", s.res.z_l);
+        assert_eq!(s.working_set.vars[1], Side::Lower);
     }
 
     #[test]

@@ -130,6 +130,11 @@ impl Iterate {
     }
 
     /// The IPM's scaled KKT error on the scaled problem (`lgrad`: scratch of length n).
+    /// Complementarity takes an inequality side's slack clamped at 0: a violation is
+    /// inf_pr's, not complementarity's (IPOPT's slacks are ≥ 0 by construction).
+    /// Unclamped, a rounding-level violation (5e-11) times a large multiplier (1e4) kept
+    /// the error above tol for good, and the MPCC phases of qpec2 and ralph1 ran to their
+    /// iteration limits.
     pub fn kkt_errors(
         &self,
         s_max: f64,
@@ -158,10 +163,10 @@ impl Iterate {
             ysum += mult.lambda[i].abs();
             if geo.g_l[i] != geo.g_u[i] {
                 if geo.g_l[i].is_finite() {
-                    compl = compl.max(((g[i] - geo.g_l[i]) * (-mult.lambda[i]).max(0.0)).abs());
+                    compl = compl.max((g[i] - geo.g_l[i]).max(0.0) * (-mult.lambda[i]).max(0.0));
                 }
                 if geo.g_u[i].is_finite() {
-                    compl = compl.max(((geo.g_u[i] - g[i]) * mult.lambda[i].max(0.0)).abs());
+                    compl = compl.max((geo.g_u[i] - g[i]).max(0.0) * mult.lambda[i].max(0.0));
                 }
             }
         }

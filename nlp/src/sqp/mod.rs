@@ -260,6 +260,9 @@ fn iterate(
             Err(e) => return e.into(),
         };
         let elastic = res.e.iter().any(|v| *v > s.o.elastic_tol);
+        if s.o.print_level >= 6 {
+            print_penalty_line(s, &res);
+        }
         s.update_merit_weights(&res, *iter == 1);
         let mut ls = s.line_search(&res, delta);
         s.record = IterationRecord {
@@ -299,4 +302,19 @@ fn iterate(
             return e.into();
         }
     }
+}
+
+/// At `print_level` ≥ 6, under the iteration's row: the ℓ1 penalty ρ after the QP, the
+/// largest multiplier in the Hessian ∇²L (the iterate's) and of the QP's solution, and
+/// the QP's Σe (the diagnostics of elastic mode: ρ → λ → δ).
+fn print_penalty_line(s: &SqpState<'_>, res: &qp::QpResult) {
+    let max_abs = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let e_sum: f64 = res.e.iter().map(|v| v.max(0.0)).sum();
+    println!(
+        "      rho {:.2e}  max|lambda| Hessian {:.2e}  QP {:.2e}  sum e {:.2e}",
+        s.rho,
+        max_abs(&s.it.mult.lambda),
+        max_abs(&res.lambda),
+        e_sum
+    );
 }

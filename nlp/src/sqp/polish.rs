@@ -234,18 +234,8 @@ pub(super) fn solve_working_set_into(
             Side::Upper | Side::Both => p.g_u[i] - p.g[i],
         };
     }
-    // Remove the regularisation of the W rows (solve with the exact zero block).
-    shift.clear();
-    shift.extend((0..n + m).map(|k| {
-        if k >= n && w.rows[k - n] != Side::Free {
-            ZERO_BLOCK_REG
-        } else {
-            0.0
-        }
-    }));
-    match kkt.solve_shifted(rhs, Some(shift)) {
-        Ok(ratio) if ratio <= 1e-8 => {}
-        _ => return false,
+    if !solve_exact_zero_block(kkt, w, rhs, shift) {
+        return false;
     }
     d.clear();
     d.extend_from_slice(&rhs[..n]);
@@ -259,6 +249,78 @@ pub(super) fn solve_working_set_into(
     for i in 0..m {
         if w.rows[i] == Side::Free && p.row_weight[i] == 0.0 {
             lambda[i] = 0.0;
+        }
+    }
+    true
+}
+
+/// Solves with the factorisation of W's equality QP in `kkt` in place of `rhs`, the
+/// regularisation of W's rows removed by refinement (the exact zero block; `shift`: its
+/// work vector). `false` when the solve is inaccurate.
+fn solve_exact_zero_block(
+    kkt: &mut Kkt,
+    w: &WorkingSet,
+    rhs: &mut [f64],
+    shift: &mut Vec<f64>,
+) -> bool {
+    let n = kkt.n();
+    shift.clear();
+    shift.extend((0..rhs.len()).map(|k| {
+        if k >= n && w.rows[k - n] != Side::Free {
+            ZERO_BLOCK_REG
+        } else {
+            0.0
+        }
+    }));
+    matches!(kkt.solve_shifted(rhs, Some(shift)), Ok(ratio) if ratio <= 1e-8)
+}
+
+/// One more step of iterative refinement of W's equality QP solution `(d, lambda)` (from
+/// [`solve_working_set_into`] with the factorisation still in `kkt`), on its residual
+/// computed in the QP's own terms: `s` the stationarity B d + ∇f + Jᵀλ, `jd` = J d. The
+/// refinement inside the solve judges its residual relative to the whole right-hand side,
+/// which the fixing weights of W's bounds dominate (≈ 1e14·|H|·|target|): it can stop
+/// with W's rows still off by the zero block's regularisation ε·λ_i, which with large
+/// multipliers exceeds the feasibility tolerance (rows of hs116 at the IPM's optimum:
+/// λ ≈ 16, off by 1.6e-9). Here the right-hand side is that residual alone. `false` when
+/// the correction's solve is inaccurate.
+pub(super) fn correct_working_set_step_in(
+    kkt: &mut Kkt,
+    p: &QpData,
+    w: &WorkingSet,
+    (s, jd): (&[f64], &[f64]),
+    scratch: &mut EqScratch,
+    (d, lambda): (&mut [f64], &mut [f64]),
+) -> bool {
+    let (n, m) = (p.x.len(), p.g.len());
+    let EqScratch { rhs, shift, .. } = scratch;
+    refill(rhs, n + m, 0.0);
+    for j in 0..n {
+        // A bound of W is met exactly (d_j is its target); its equation holds with the
+        // implicit bound multiplier.
+        if w.vars[j] == Side::Free {
+            rhs[j] = -s[j];
+        }
+    }
+    for i in 0..m {
+        rhs[n + i] = match (w.rows[i], p.row_weight[i]) {
+            (Side::Free, r) if r > 0.0 => lambda[i] / r - jd[i],
+            (Side::Free, _) => 0.0,
+            (Side::Lower, _) => p.g_l[i] - p.g[i] - jd[i],
+            (Side::Upper | Side::Both, _) => p.g_u[i] - p.g[i] - jd[i],
+        };
+    }
+    if !solve_exact_zero_block(kkt, w, rhs, shift) {
+        return false;
+    }
+    for j in 0..n {
+        if w.vars[j] == Side::Free {
+            d[j] += rhs[j];
+        }
+    }
+    for i in 0..m {
+        if w.rows[i] != Side::Free || p.row_weight[i] != 0.0 {
+            lambda[i] += rhs[n + i];
         }
     }
     true

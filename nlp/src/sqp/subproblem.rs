@@ -7,7 +7,7 @@ use std::time::Instant;
 use clarabel::solver::SolverStatus as S;
 use faer::sparse::SymbolicSparseColMat;
 
-use super::active_set;
+use super::active_set::{self, MAX_PENALTY_INCREASES};
 use super::geometry::Geometry;
 use super::iterate::Iterate;
 use super::options::SqpOptions;
@@ -20,10 +20,10 @@ use crate::kkt::Kkt;
 /// Retry policies of one QP step, each with its own budget: how often an unbounded QP
 /// is solved again with a pure shift ×100, how often another clarabel failure is solved
 /// again with the shift ×10, and how often elastic mode raises ρ. (Before, one counter of
-/// all QP solves in the step served all three, with limits 8, 4 and 12 solves.)
+/// all QP solves in the step served all three, with limits 8, 4 and 12 solves.) The
+/// third, `MAX_PENALTY_INCREASES`, is the active-set method's (`penalty_for`).
 const MAX_UNBOUNDED_RETRIES: usize = 7;
 const MAX_FAILED_QP_RETRIES: usize = 3;
-const MAX_PENALTY_INCREASES: usize = 11;
 
 impl SqpState<'_> {
     /// The QP at the iterate with shift `delta` (and the constraint values `g` instead
