@@ -32,6 +32,29 @@ fn the_sqps_hs_failures_are_solved_from_the_ipms_solution() {
     }
 }
 
+/// hs013 (Kuhn–Tucker fails at its optimum, a cusp: Hock and Schittkowski 1981, f* = 1):
+/// the IPM reaches it to its tolerance, the SQP from there does not converge (no KKT
+/// point), and the option returns the IPM's solution, bit for bit, with its status.
+#[test]
+fn without_the_sqps_convergence_the_ipms_solution_stands() {
+    let (name, build) = harness::find(SUITE, "hs013");
+    let ipm = harness::run(name, build, |nlp| Ipm::default().solve_dyn(nlp, None, None));
+    let ipm = ipm.result.expect("IPM solve");
+    assert!(ipm.status.is_success(), "IPM {:?}", ipm.status);
+    // The SQP alone from the IPM's solution fails (why the fallback exists).
+    let sqp = harness::run(name, build, |nlp| {
+        Sqp::default().solve_dyn(nlp, Some(&ipm), None)
+    });
+    assert!(!sqp.result.expect("SQP solve").status.is_success());
+    let run = harness::run(name, build, |nlp| ipm_started().solve_dyn(nlp, None, None));
+    let sol = run.result.as_ref().expect("solve");
+    run.assert_solved(sol);
+    assert_eq!(
+        (sol.status, &sol.x, sol.stats.iterations),
+        (ipm.status, &ipm.x, ipm.stats.iterations)
+    );
+}
+
 /// From the IPM's optimum of hs116 (f = 97.5875, published f* 97.5874731) the SQP keeps
 /// it: two iterations that polish the IPM's point onto the active constraints. Before,
 /// its first QP was elastic: the ℓ1 penalty started at ρ = 10 below the start's

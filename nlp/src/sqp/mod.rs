@@ -112,7 +112,11 @@ impl Solver for Sqp {
         };
         let mut sol = Solution::empty();
         self.run_into(nlp, warm.or(ipm_start.as_ref()), callback, &mut sol)?;
-        Ok(sol)
+        match ipm_start {
+            // The SQP did not converge from the IPM's solution: that solution stands.
+            Some(ipm) if !sol.status.is_success() => Ok(ipm),
+            _ => Ok(sol),
+        }
     }
 
     fn solve_warm_into(

@@ -100,7 +100,9 @@ pub struct SqpOptions {
     /// confirms a converged IPM solution in 0–2 iterations. For MPC and sequences of
     /// nearby problems: the IPM is the robust cold solver, the SQP the fast warm one
     /// (docs/solvers.md). `max_iter` and `max_wall_time` apply to each of the two solves,
-    /// and `Solution::stats` are the SQP's. Default false (the SQP alone).
+    /// and `Solution::stats` are the SQP's; when the SQP does not succeed from the IPM's
+    /// solution, that solution is returned (the IPM's status and stats: e.g. hs013, whose
+    /// optimum has no KKT point). Default false (the SQP alone).
     pub cold_start_ipm: bool,
 }
 
