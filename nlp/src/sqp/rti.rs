@@ -251,6 +251,20 @@ struct QpOutcome {
     fallback: bool,
 }
 
+impl QpOutcome {
+    /// Solved by the active-set method in `iterations` (`corrected`: the prepared step's
+    /// correction was the solution).
+    fn by_active_set(iterations: usize, factorizations: usize, corrected: bool) -> QpOutcome {
+        QpOutcome {
+            solved: true,
+            iterations,
+            factorizations,
+            corrected,
+            fallback: false,
+        }
+    }
+}
+
 impl Rti {
     /// A real-time iteration on `compiled` whose initial state is the parameter
     /// `x0_parameter`, with the SQP's Hessian and QP options. The plan starts at the
@@ -613,13 +627,7 @@ impl Rti {
             });
             if let Some(found) = found {
                 self.factored = false;
-                return QpOutcome {
-                    solved: true,
-                    iterations: found.iterations,
-                    factorizations: 0,
-                    fallback: false,
-                    corrected: true,
-                };
+                return QpOutcome::by_active_set(found.iterations, 0, true);
             }
         }
         if o.qp_active_set {
@@ -640,13 +648,7 @@ impl Rti {
             // On failure `w` is the last working set tried: the next preparation guesses.
             self.has_working_set = solved.is_ok();
             if let Ok(found) = solved {
-                return QpOutcome {
-                    solved: true,
-                    iterations: found.iterations,
-                    factorizations: n_fact,
-                    fallback: false,
-                    corrected: false,
-                };
+                return QpOutcome::by_active_set(found.iterations, n_fact, false);
             }
         }
         let qp = self
