@@ -9,6 +9,7 @@ use nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Simulator, Transcription};
 use nlp::{Ipm, Relation, Rti, RtiError, Solution, SqpOptions, Status};
 use symx::{Evaluator, Matrix};
 use testkit::alloc::ThreadCounting;
+use testkit::rti_loop::rti_feedbacks;
 
 #[global_allocator]
 static GLOBAL: ThreadCounting = ThreadCounting;
@@ -370,26 +371,18 @@ fn pendulum_rti_feedbacks_are_corrected_when_the_plant_is_the_model() {
     let mut rti = Rti::from_transcription(&tr, SqpOptions::default()).unwrap();
     rti.initialize(&converged(&tr, &x_init)).unwrap();
     let mut plant = Simulator::new(&ocp, ButcherTableau::rk4(), 1).unwrap();
-    let shift = tr.shift_plan().unwrap();
-    let u_first = tr
-        .problem()
-        .variable_indices(&tr.controls().column(0).unwrap())
-        .unwrap();
-    let dt = 3.0 / 20.0;
-    let (mut x, mut next) = (x_init.to_vec(), x_init.to_vec());
-    let mut flags = Vec::new();
-    let mut saturated = 0;
-    for _ in 0..30 {
-        let u: Vec<f64> = u_first.iter().map(|&k| rti.plan().x[k]).collect();
-        saturated += usize::from(u[0].abs() >= 1.5 - 1e-9);
-        plant.step_into(&x, &u, dt, &mut next).unwrap();
-        std::mem::swap(&mut x, &mut next);
-        rti.shift(&shift).unwrap();
-        rti.prepare().unwrap();
-        let fb = rti.feedback(&x).unwrap();
-        assert_eq!(fb.status, Status::RealTimeIterationTaken);
-        flags.push((fb.corrected, fb.factorizations, fb.fallback));
-    }
+    let steps = rti_feedbacks(&tr, &mut rti, &mut plant, (&x_init, 3.0 / 20.0), 30);
+    let saturated = steps
+        .iter()
+        .filter(|(u, _)| u[0].abs() >= 1.5 - 1e-9)
+        .count();
+    assert!(steps
+        .iter()
+        .all(|(_, fb)| fb.status == Status::RealTimeIterationTaken));
+    let flags: Vec<_> = steps
+        .iter()
+        .map(|(_, fb)| (fb.corrected, fb.factorizations, fb.fallback))
+        .collect();
     assert!(saturated > 0, "the control bound was never active");
     assert!(flags.iter().all(|&f| f == (true, 0, false)), "{flags:?}");
 }

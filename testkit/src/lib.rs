@@ -12,6 +12,7 @@
 //! | [`hanging_chain`], [`quadrotor_ocp`] | the symbolic problems of `benches/symx_eval.rs` |
 //! | [`trees`] | random expression trees with an independent evaluator (property tests) |
 //! | [`ode`] | right-hand sides of the integrators' tests (Van der Pol, Robertson) |
+//! | [`rti_loop`] | a real-time-iteration loop driven step by step, its feedbacks |
 //! | [`special`] | special floating-point operands, the NaN-tolerant bit comparison (native evaluators against the tape) |
 //! | [`alloc`] | counting global allocators (allocation-free spans) |
 //! | [`corpus`] | the test corpus crate (optimal-control families, CUTEst-style problems), re-exported |
@@ -25,6 +26,7 @@ pub mod hs;
 pub mod mpcc;
 pub mod ode;
 pub mod quadrotor_ocp;
+pub mod rti_loop;
 pub mod socp;
 pub mod solve_problems;
 pub mod special;
