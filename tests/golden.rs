@@ -207,7 +207,13 @@ fn solve_ipm(c: &mut Compiled) -> Result<Solution, SolveError> {
 }
 
 fn solve_sqp(c: &mut Compiled) -> Result<Solution, SolveError> {
-    Sqp::new(SqpOptions::default()).solve(c)
+    // The SQP alone from the problem's guess: the records guard its own iterations (by
+    // default a cold solve starts from the IPM's solution, whose records are hs/ipm's).
+    let options = SqpOptions {
+        cold_start_ipm: false,
+        ..SqpOptions::default()
+    };
+    Sqp::new(options).solve(c)
 }
 
 fn hs(backend: &str, solve: SolveFn) {

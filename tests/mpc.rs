@@ -264,6 +264,10 @@ fn cart_pole_closed_loop_matches_ipopt() {
         run.steps.iter().map(|s| s.status).collect::<Vec<_>>()
     );
     assert!(run.steps[1..].iter().all(|s| s.warm) && !run.steps[0].warm);
+    // The warm latency is over the warm steps alone: the cold first step left out.
+    let mut warm = run.clone();
+    warm.steps.remove(0);
+    assert_eq!(run.warm_latency(), warm.latency());
     let cost = example.cost(&run).unwrap();
     let rel = ((cost - IPOPT_CART_POLE_LOOP_COST) / IPOPT_CART_POLE_LOOP_COST).abs();
     assert!(

@@ -124,6 +124,7 @@ impl MpcExample {
             Ok(mpc)
         })?;
         let (median, max) = run.latency();
+        let (warm_median, warm_max) = run.warm_latency();
         // The steps after the first (RTI's first step is a converged solve).
         let later = ClosedLoop {
             steps: run.steps[1.min(run.steps.len())..].to_vec(),
@@ -141,6 +142,7 @@ impl MpcExample {
                 "problem": self.name, "solver": name, "closed_loop_cost": cost,
                 "all_succeeded": run.all_succeeded(), "failed_steps": failed,
                 "median_ms": 1e3 * median, "max_ms": 1e3 * max,
+                "warm_median_ms": 1e3 * warm_median, "warm_max_ms": 1e3 * warm_max,
                 "later_median_ms": 1e3 * later_median,
                 "feedback_median_ms": 1e3 * feedback_median,
                 "feedback_max_ms": 1e3 * feedback_max,

@@ -123,6 +123,14 @@ impl ClosedLoop {
         median_and_max(self.steps.iter().map(|s| s.seconds))
     }
 
+    /// Median and maximum of the warm-started steps' wall seconds: every step but the
+    /// cold first one (and the first after [`Mpc::reset`]), which solves from the
+    /// transcription's guess and is the loop's initialisation (acados and CasADi users
+    /// solve it before the loop starts); `(0, 0)` for no warm step.
+    pub fn warm_latency(&self) -> (f64, f64) {
+        median_and_max(self.steps.iter().filter(|s| s.warm).map(|s| s.seconds))
+    }
+
     /// Median and maximum of the steps' feedback seconds
     /// ([`StepReport::feedback_seconds`]); `(0, 0)` for no step.
     pub fn feedback_latency(&self) -> (f64, f64) {

@@ -70,7 +70,8 @@ pub enum MpccBackend {
 /// Options of [`solve_mpcc`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct MpccOptions {
-    /// Options of the SQP back end.
+    /// Options of the SQP back end (default: [`SqpOptions::default`] with
+    /// `cold_start_ipm` off: the SQP phase's problem has no strict interior).
     pub sqp: SqpOptions,
     /// Options of the IPM back end.
     pub ipm: IpmOptions,
@@ -232,7 +233,12 @@ impl MpccOptions {
 impl Default for MpccOptions {
     fn default() -> Self {
         MpccOptions {
-            sqp: SqpOptions::default(),
+            // The SQP phase's problem (the products as constraints) has no strict interior
+            // and fails MFCQ everywhere: the IPM is no start for it, the SQP runs alone.
+            sqp: SqpOptions {
+                cold_start_ipm: false,
+                ..SqpOptions::default()
+            },
             ipm: IpmOptions::default(),
             penalty_init: 10.0,
             penalty_increase: 10.0,

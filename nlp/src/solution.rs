@@ -326,6 +326,12 @@ pub struct Stats {
     /// Seconds in QP solves (SQP only).
     #[serde(default)]
     pub qp_seconds: f64,
+    /// Iterations of the interior-point method that started a cold SQP solve
+    /// ([`SqpOptions::cold_start_ipm`](crate::SqpOptions::cold_start_ipm)), included in
+    /// `iterations` (as its evaluations, factorisations and seconds are in theirs); 0
+    /// otherwise.
+    #[serde(default)]
+    pub start_iterations: usize,
 }
 
 /// Result of a solve. Multipliers use IPOPT's sign convention:

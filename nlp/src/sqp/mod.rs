@@ -76,7 +76,7 @@ use crate::frontend::user_solution::conclude;
 use crate::frontend::validate::validate_into;
 use crate::frontend::{Solver, Termination};
 use crate::numeric::NumericNlp;
-use crate::solution::{BackendColumns, IterationRecord, Solution};
+use crate::solution::{BackendColumns, IterationRecord, Solution, Status};
 
 pub use options::{HessianApproximation, SqpOptions};
 pub use rti::{Feedback, Rti, RtiError, RtiResidual};
@@ -106,17 +106,12 @@ impl Solver for Sqp {
         warm: Option<&Solution>,
         callback: Option<&mut IterationCallback<'_>>,
     ) -> Result<Solution, SolveError> {
-        let ipm_start = match warm {
-            None if self.options.cold_start_ipm => cold_start::ipm_start(&self.options, nlp)?,
-            _ => None,
-        };
-        let mut sol = Solution::empty();
-        self.run_into(nlp, warm.or(ipm_start.as_ref()), callback, &mut sol)?;
-        match ipm_start {
-            // The SQP did not converge from the IPM's solution: that solution stands.
-            Some(ipm) if !sol.status.is_success() => Ok(ipm),
-            _ => Ok(sol),
+        if warm.is_some() || !self.options.cold_start_ipm {
+            let mut sol = Solution::empty();
+            self.run_into(nlp, warm, callback, &mut sol)?;
+            return Ok(sol);
         }
+        self.solve_from_ipm(nlp, callback)
     }
 
     fn solve_warm_into(
@@ -130,6 +125,49 @@ impl Solver for Sqp {
 }
 
 impl Sqp {
+    /// A cold solve with [`SqpOptions::cold_start_ipm`]: the IPM, then the SQP from its
+    /// solution (cold when the IPM fails); the IPM's solution stands when the SQP does
+    /// not converge from it. The callback sees both solves' iterations, numbered on.
+    fn solve_from_ipm(
+        &self,
+        nlp: &mut dyn NumericNlp,
+        mut callback: Option<&mut IterationCallback<'_>>,
+    ) -> Result<Solution, SolveError> {
+        let mut ipm = match cold_start::ipm_start(&self.options, nlp, callback.as_deref_mut())? {
+            cold_start::IpmStart::Stopped(sol) => return Ok(sol),
+            cold_start::IpmStart::Failed => {
+                let mut sol = Solution::empty();
+                self.run_into(nlp, None, callback, &mut sol)?;
+                return Ok(sol);
+            }
+            cold_start::IpmStart::Solved(ipm) => ipm,
+        };
+        let mut sol = Solution::empty();
+        match callback {
+            Some(cb) => {
+                let mut numbered = cold_start::continue_numbering(cb, ipm.stats.iterations);
+                self.run_into(nlp, Some(&ipm), Some(&mut numbered), &mut sol)?;
+            }
+            None => self.run_into(nlp, Some(&ipm), None, &mut sol)?,
+        }
+        if sol.status.is_success() || sol.status == Status::UserRequestedStop {
+            cold_start::count_start_in(&ipm.stats, &mut sol.stats);
+            return Ok(sol);
+        }
+        // The SQP did not converge from the IPM's solution: that solution stands, with
+        // the time and work of both solves.
+        let mut stats = std::mem::take(&mut sol.stats);
+        cold_start::count_start_in(&ipm.stats, &mut stats);
+        ipm.message = format!(
+            "{}{}the interior-point solution: the SQP started from it ended with {:?}",
+            ipm.message,
+            if ipm.message.is_empty() { "" } else { "; " },
+            sol.status
+        );
+        ipm.stats = stats;
+        Ok(ipm)
+    }
+
     /// A solver with the given options.
     pub fn new(options: SqpOptions) -> Self {
         Sqp {
