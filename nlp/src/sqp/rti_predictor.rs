@@ -13,8 +13,10 @@
 //! solve of K + diag(ε) on W's rows, which converges in one refinement step where the
 //! exact K needs three or four), and accepts it only when the error this leaves in W's
 //! rows, ε·|δλ_i|, is within the residual ratio the refined solve targets (1e-12,
-//! `Kkt::residual_ratio_max`'s default); the active-set method then checks the step like
-//! any of its own (`active_set::accept_step_in`), and otherwise runs from W as before.
+//! `Kkt::residual_ratio_max`'s default), first after one back-substitution, then (a
+//! measured state off the prediction) after one refinement sweep; the active-set method
+//! then checks the step like any of its own (`active_set::accept_step_in`), and otherwise
+//! runs from W as before.
 
 use super::polish::{solve_working_set_into, EqScratch, Side, WorkingSet, ZERO_BLOCK_REG};
 use super::qp::QpData;
@@ -80,6 +82,9 @@ impl Predictor {
     /// `x0`: the prepared one plus the correction for `x0 − x0_lin` (see the module
     /// documentation). `None` when nothing was prepared, the solve fails or the
     /// correction is not accurate enough (the caller solves the QP from W instead).
+    /// The correction is first one back-substitution; when that misses the accuracy (a
+    /// measured state off the prediction by more than ≈ 1e-6, as any plant that is not
+    /// the model gives), it is solved again with one refinement sweep.
     pub fn correct(
         &mut self,
         kkt: &mut Kkt,
@@ -91,6 +96,27 @@ impl Predictor {
         if !self.ready {
             return None;
         }
+        let mut accurate = false;
+        for sweeps in [0, 1] {
+            accurate = self.try_correction(kkt, p, w, terms, x0, sweeps)?;
+            if accurate {
+                break;
+            }
+        }
+        accurate.then(|| self.rhs.split_at(p.x.len()))
+    }
+
+    /// The corrected step into `rhs` with `sweeps` refinement sweeps; whether it is
+    /// accurate enough (`None` when the solve fails).
+    fn try_correction(
+        &mut self,
+        kkt: &mut Kkt,
+        p: &QpData,
+        w: &WorkingSet,
+        terms: &[(usize, usize, f64)],
+        x0: &[f64],
+        sweeps: usize,
+    ) -> Option<bool> {
         let (n, m) = (p.x.len(), p.g.len());
         refill(&mut self.rhs, n + m, 0.0);
         let mut moved = false;
@@ -103,9 +129,9 @@ impl Predictor {
         let rhs_max = self.rhs.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let mut ratio = 0.0;
         if moved {
-            // One back-substitution and its residual, no refinement sweep (see below).
+            // A back-substitution and its residual, with `sweeps` refinement sweeps.
             let limits = (kkt.min_refinement_steps, kkt.max_refinement_steps);
-            (kkt.min_refinement_steps, kkt.max_refinement_steps) = (0, 0);
+            (kkt.min_refinement_steps, kkt.max_refinement_steps) = (sweeps, sweeps);
             let solved = kkt.solve_shifted(&mut self.rhs, None);
             (kkt.min_refinement_steps, kkt.max_refinement_steps) = limits;
             ratio = solved.ok()?;
@@ -138,9 +164,6 @@ impl Predictor {
         // target relative to the whole step.
         let size = self.rhs.iter().fold(1.0f64, |a, v| a.max(v.abs()));
         let error = ratio * (correction_max + rhs_max) + ZERO_BLOCK_REG * dl_max;
-        if !size.is_finite() || error.is_nan() || error > CORRECTION_RATIO * size {
-            return None;
-        }
-        Some(self.rhs.split_at(n))
+        Some(size.is_finite() && !error.is_nan() && error <= CORRECTION_RATIO * size)
     }
 }
