@@ -116,6 +116,7 @@ impl Body<'_> {
             Op::Or => format!("b2f({a} != 0.0 || {b} != 0.0)"),
             Op::StrongMul => format!("{{ let a = {a}; if a == 0.0 {{ 0.0 }} else {{ a * {b} }} }}"),
             Op::IfElse => format!("if {a} != 0.0 {{ {b} }} else {{ {c} }}"),
+            Op::Sqrt => format!("sqrt_({a})"),
             op => match (library_unary(op), library_binary(op)) {
                 (Some(h), _) => format!("{h}({a})"),
                 (_, Some(h)) => format!("{h}({a}, {b})"),
@@ -371,6 +372,24 @@ unsafe fn pow_(a: f64, b: f64) -> f64 {
 
 unsafe extern "C" {
     fn trunc(x: f64) -> f64;
+}
+
+/// The square root (IEEE, correctly rounded, as `f64::sqrt`). On x86-64 the SSE2
+/// instruction itself: the C library's `sqrt`, which LLVM inlines as that instruction
+/// behind a test and a call for negative arguments (to set `errno`), cut the code into
+/// basic blocks at every square root.
+#[inline(always)]
+fn sqrt_(a: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unused_unsafe)]
+    unsafe {
+        use core::arch::x86_64::{_mm_cvtsd_f64, _mm_set_sd, _mm_sqrt_pd};
+        _mm_cvtsd_f64(_mm_sqrt_pd(_mm_set_sd(a)))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    unsafe {
+        sqrt(a)
+    }
 }
 "#;
 
