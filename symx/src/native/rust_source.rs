@@ -1,6 +1,6 @@
 //! [`Function::to_rust`]: a function as a self-contained Rust module for deployment
 //! (`no_std`, no allocation, no dependency: the math functions are the C library's, which
-//! Rust's `std` calls too).
+//! Rust's `std` calls too, but for square roots, the processor's instruction on x86-64).
 //!
 //! Nothing is copied per call: each generated function `exec(w, x, y)` reads its inputs
 //! where the caller keeps them (`x[k]`), writes its outputs where the caller wants them
@@ -396,7 +396,7 @@ fn sqrt_(a: f64) -> f64 {
 impl Function {
     /// This function as the text of a self-contained Rust module: `no_std`, no allocation,
     /// no dependency (the math functions are the C library's, which Rust's `std` calls
-    /// too, so the results equal the tape's bit for bit on the same platform, but for the
+    /// too, and square roots correctly rounded as `f64::sqrt`, so the results equal the tape's bit for bit on the same platform, but for the
     /// sign and payload of NaNs, which rustc need not keep). It defines the constants
     /// `INPUT_SIZES`, `OUTPUT_SIZES` and `WORK_SIZE` and
     /// `pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> Result<(), &'static str>`
