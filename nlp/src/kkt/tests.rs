@@ -251,3 +251,55 @@ fn refinement_continues_while_it_gains_on_ill_conditioned_systems() {
     assert!((x[1] - 1.5).abs() < 1e-3, "{x:?}");
     assert!((x[2] + 2.25).abs() < 1e-3, "{x:?}");
 }
+
+/// `factorize_for_inertia` against dense eigenvalues on indefinite cases, on every
+/// factorisation kind: exactly when the eigenvalues give (n, m, 0) it returns (n, m, 0)
+/// and a factor that solves as the full factorisation's does, bit for bit; otherwise it
+/// returns counts that are not (n, m, 0) and no factor to solve with.
+#[test]
+fn inertia_trial_stops_only_on_a_wrong_inertia() {
+    let mut rng = Rng(2718);
+    let (mut wrong, mut right, mut stopped_early) = (0, 0, 0);
+    for k in 0..24 {
+        let (n, m) = (6 + k, 2 + k / 3);
+        let mut c = random_case(&mut rng, n, m, 0.3, true);
+        // Half of the cases get a δ_w large enough for the quasi-definite inertia.
+        let delta = if k % 2 == 0 { 0.0 } else { 40.0 };
+        c.dx.iter_mut().for_each(|d| *d = delta);
+        let eig = dense(&c).self_adjoint_eigenvalues(Side::Lower).unwrap();
+        let pos = eig.iter().filter(|&&e| e > 0.0).count();
+        let neg = eig.iter().filter(|&&e| e < 0.0).count();
+        let correct = (pos, neg) == (n, m);
+        for kind in [KktFactorization::Supernodal, KktFactorization::Simplicial] {
+            let mut kkt = Kkt::with_factorization(n, m, &c.h, &c.j, kind).unwrap();
+            let trial = kkt.factorize_for_inertia(&c.hv, &c.dx, &c.jv, &c.dc).unwrap();
+            let got = (trial.positive, trial.negative, trial.zero);
+            let b: Vec<f64> = (0..n + m).map(|i| (i as f64).sin()).collect();
+            if correct {
+                assert_eq!(got, (n, m, 0), "case {k} {kind:?}");
+                let mut x = b.clone();
+                kkt.solve(&mut x).unwrap();
+                let mut full = Kkt::with_factorization(n, m, &c.h, &c.j, kind).unwrap();
+                full.factorize(&c.hv, &c.dx, &c.jv, &c.dc).unwrap();
+                let mut y = b.clone();
+                full.solve(&mut y).unwrap();
+                assert_eq!(x, y, "case {k} {kind:?}: same factor");
+            } else {
+                assert_ne!(got, (n, m, 0), "case {k} {kind:?}");
+                if trial.positive + trial.negative < n + m {
+                    stopped_early += 1;
+                    let mut x = b.clone();
+                    assert_eq!(kkt.solve(&mut x), Err(KktError::NotFactorized));
+                }
+            }
+        }
+        if correct {
+            right += 1;
+        } else {
+            wrong += 1;
+        }
+    }
+    // The cases cover both outcomes, and the simplicial factorisation did stop early.
+    assert!(right >= 4 && wrong >= 4, "right {right}, wrong {wrong}");
+    assert!(stopped_early >= wrong / 2, "{stopped_early} of {wrong} stopped early");
+}
