@@ -23,36 +23,6 @@ impl Kkt {
         j_vals: &[f64],
         dc: &[f64],
     ) -> Result<Inertia, KktError> {
-        self.factorize_limited(h_vals, dx, j_vals, dc, None)
-    }
-
-    /// As [`Kkt::factorize`] for a trial of an inertia correction that wants the inertia
-    /// (n, m, 0): our simplicial factorisation stops as soon as it has found more than n
-    /// positive or m negative pivots (Sylvester's law: the inertia is then wrong whatever
-    /// the remaining pivots are), saving the rest of the work on a rejected trial. A
-    /// stopped factorisation returns the counts so far (they sum to less than n + m, so
-    /// they are not (n, m, 0)) and leaves no factor to solve with. A zero pivot after the
-    /// stop point goes unseen: the trial counts as wrong inertia, not singular. The
-    /// supernodal factorisation always runs to the end.
-    pub(crate) fn factorize_for_inertia(
-        &mut self,
-        h_vals: &[f64],
-        dx: &[f64],
-        j_vals: &[f64],
-        dc: &[f64],
-    ) -> Result<Inertia, KktError> {
-        let limit = Some((self.n, self.m));
-        self.factorize_limited(h_vals, dx, j_vals, dc, limit)
-    }
-
-    fn factorize_limited(
-        &mut self,
-        h_vals: &[f64],
-        dx: &[f64],
-        j_vals: &[f64],
-        dc: &[f64],
-        limit: Option<(usize, usize)>,
-    ) -> Result<Inertia, KktError> {
         self.factored = false;
         self.assemble(h_vals, dx, j_vals, dc)?;
         if let Some(simp) = self.simplicial.as_mut() {
@@ -61,9 +31,8 @@ impl Kkt {
                 self.pattern.row_idx(),
                 &self.values,
                 &mut self.l_values,
-                limit,
             )?;
-            self.factored = inertia.positive + inertia.negative == self.n + self.m;
+            self.factored = true;
             return Ok(inertia);
         }
         let Kkt {

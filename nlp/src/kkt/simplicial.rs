@@ -191,18 +191,14 @@ impl Simplicial {
     /// Numeric LDLᵀ of the permuted upper triangle (`col_ptr`, `row_idx`, `values`) into
     /// `l` (the L pattern's values, D on the diagonal slots). Returns the inertia;
     /// `ZeroPivot` (permuted index) on an exactly zero pivot, `NonFinite` on a
-    /// non-finite one. With `limit` = (p, q) it stops as soon as more than p positive or
-    /// q negative pivots are found (the inertia cannot be (p, q, 0) any more) and returns
-    /// the counts so far, which then sum to less than the dimension and leave `l` partial.
+    /// non-finite one.
     pub(super) fn factorize(
         &mut self,
         col_ptr: &[usize],
         row_idx: &[usize],
         values: &[f64],
         l: &mut [f64],
-        limit: Option<(usize, usize)>,
     ) -> Result<Inertia, KktError> {
-        let (max_pos, max_neg) = limit.unwrap_or((usize::MAX, usize::MAX));
         let dim = self.d_inv.len();
         let x = &mut self.x[..dim];
         let lcp = &self.l_col_ptr;
@@ -241,10 +237,6 @@ impl Simplicial {
                 inertia.positive += 1;
             } else {
                 inertia.negative += 1;
-            }
-            // Row k is done, so the accumulator is clean: a stop here leaves it ready.
-            if inertia.positive > max_pos || inertia.negative > max_neg {
-                break;
             }
         }
         Ok(inertia)

@@ -186,7 +186,7 @@ impl Core<'_> {
         self.update_eq_reg();
         let (mut pert, opts) = (std::mem::take(&mut self.pert), self.opts.clone());
         let ok = pert.correct_inertia(&opts, self.mu_update.mu(), m > 0, |delta_w, delta_c| {
-            Factored::of(&self.factor_kkt_trial(shared, delta_w, delta_c, true), n, m)
+            Factored::of(&self.factor_kkt(shared, delta_w, delta_c), n, m)
         });
         self.pert = pert;
         ok
@@ -200,19 +200,6 @@ impl Core<'_> {
         shared: &mut Shared,
         delta_w: f64,
         delta_c: f64,
-    ) -> Result<crate::kkt::Inertia, crate::kkt::KktError> {
-        self.factor_kkt_trial(shared, delta_w, delta_c, false)
-    }
-
-    /// [`Core::factor_kkt`]; with `trial` (a trial of the inertia correction, which only
-    /// wants to know whether the inertia is (n, m, 0)) the factorisation stops as soon as
-    /// the inertia is known to be wrong (`Kkt::factorize_for_inertia`).
-    fn factor_kkt_trial(
-        &mut self,
-        shared: &mut Shared,
-        delta_w: f64,
-        delta_c: f64,
-        trial: bool,
     ) -> Result<crate::kkt::Inertia, crate::kkt::KktError> {
         let (n, m) = (self.lay.n, self.lay.m);
         // The static Hessian regularisation only keeps exact zero pivots away while
@@ -271,7 +258,6 @@ impl Core<'_> {
         let (h, dx, j, dc) = (&self.it.hess, &self.kw.kdx, &self.it.jac, &self.kw.kdc);
         let res = match self.kw.lm.as_mut() {
             Some(lm) => lm.factorize(&mut self.kw.kkt, h, dx, j, dc),
-            None if trial => self.kw.kkt.factorize_for_inertia(h, dx, j, dc),
             None => self.kw.kkt.factorize(h, dx, j, dc),
         };
         shared.stats.factor_seconds += t.elapsed().as_secs_f64();
