@@ -41,11 +41,13 @@ const CASES: &[(&str, f64, usize)] = &[
 /// multipliers after every step with constraint violation below `recalc_y_feas_tol`.
 /// With monotone μ (set explicitly: the limited-memory default is adaptive μ since
 /// s9-lbfgs, with which quadrotor_rk4_50 takes 22 iterations with and 26 without
-/// `recalc_y`), quadrotor_rk4_50 takes 421 iterations without it (IPOPT's
-/// limited-memory mode 28, benches/reference/results/corpus_lbfgs_ipopt.jsonl); with it,
-/// at most 1.5× IPOPT's. Set by name as IPOPT spells it.
+/// `recalc_y`), quadrotor_rk4_50 took 421 iterations without it until session 18 (IPOPT's
+/// limited-memory mode 28, benches/reference/results/corpus_lbfgs_ipopt.jsonl); since
+/// `residual_ratio_floor` = 1e-13 (refinement of the low-rank KKT solves stops at 1e-13
+/// instead of 1e-14) it takes 32 without it. With it or without it, at most 1.5× IPOPT's.
+/// Set by name as IPOPT spells it.
 #[test]
-fn recalc_y_is_what_brings_quadrotor_to_ipopt() {
+fn recalc_y_by_name_and_quadrotor_near_ipopt() {
     use nlp::NamedOptions;
     let inst = corpus::instance("quadrotor_rk4_50").expect("instance exists");
     let mut off = lm_options(120.0);
@@ -75,9 +77,10 @@ fn recalc_y_is_what_brings_quadrotor_to_ipopt() {
         on_out.iterations
     );
     assert!(
-        off.iterations > 3 * on_out.iterations,
-        "off: {}",
-        off.iterations
+        2 * off.iterations <= 3 * 28,
+        "off: {} (on: {})",
+        off.iterations,
+        on_out.iterations
     );
     // Never with the exact Hessian unless asked for.
     let exact = run::solve(&inst, &run::options(120.0)).expect("solves");

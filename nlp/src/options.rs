@@ -329,6 +329,15 @@ pub struct IpmOptions {
     pub max_refinement_steps: usize,
     /// Target relative residual of the linear solves. Default 1e-10.
     pub residual_ratio_max: f64,
+    /// Iterative refinement goes on past `residual_ratio_max` while a step still halves
+    /// the residual ratio (the ratio is a backward error dominated by the largest entries
+    /// of the solution; the static regularisations are removed by refinement), until the
+    /// ratio is at most this. Default 1e-13 (until session 18 refinement went on to
+    /// 1e-14: on the gap-crossing default 3.6 solves with the factor per KKT solve; see
+    /// benches/reference/results/performance-notebook.md, "Planner speed, session 18").
+    /// A value of at least `residual_ratio_max` stops at the target, as IPOPT does. Not
+    /// an IPOPT option.
+    pub residual_ratio_floor: f64,
     /// IPOPT's `residual_ratio_singular`: a solve whose refinement ends above
     /// `residual_ratio_max` is taken as it is if its residual ratio is at most this, and
     /// treated as singular (δ_c, then δ_w) only above it. Default `None`: the value of
@@ -464,6 +473,7 @@ const IPOPT_DEFAULTS: IpmOptions = IpmOptions {
     min_refinement_steps: 1,
     max_refinement_steps: 10,
     residual_ratio_max: 1e-10,
+    residual_ratio_floor: 1e-13,
     residual_ratio_singular: None,
     hessian_approximation: IpmHessian::Exact,
     limited_memory_max_history: 6,
@@ -582,6 +592,7 @@ impl IpmOptions {
             resto_penalty_parameter,
             bound_mult_reset_threshold,
             residual_ratio_max,
+            residual_ratio_floor,
             recalc_y_feas_tol,
             kkt_static_regularization,
             limited_memory_init_val,

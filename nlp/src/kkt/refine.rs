@@ -4,7 +4,8 @@
 use super::error::KktError;
 use super::system::Kkt;
 
-/// Residual ratio below which refinement stops even while it still improves.
+/// Residual ratio below which refinement stops even while it still improves (the
+/// default of [`Kkt::residual_ratio_floor`]).
 pub(super) const REFINEMENT_FLOOR: f64 = 1e-14;
 
 /// Max-norm of `v`.
@@ -153,6 +154,7 @@ impl Refinable for Plain<'_> {
 #[derive(Clone, Copy)]
 pub(super) struct RefineLimits {
     residual_ratio_max: f64,
+    residual_ratio_floor: f64,
     min_steps: usize,
     max_steps: usize,
 }
@@ -161,6 +163,7 @@ impl RefineLimits {
     pub(super) fn of(kkt: &Kkt) -> RefineLimits {
         RefineLimits {
             residual_ratio_max: kkt.residual_ratio_max,
+            residual_ratio_floor: kkt.residual_ratio_floor,
             min_steps: kkt.min_refinement_steps,
             max_steps: kkt.max_refinement_steps,
         }
@@ -207,11 +210,12 @@ pub(super) fn refine<R: Refinable>(
         // ill-conditioned K (huge multipliers) it can pass the target while the small
         // entries are still far off. So keep refining past the target while a step
         // still gains a lot (at most ½ of the previous ratio) and the ratio is above
-        // round-off; a well-conditioned system reaches round-off in one step.
+        // the floor (round-off by default); a well-conditioned system reaches round-off
+        // in one step.
         let fast = new_ratio <= 0.5 * ratio;
         ratio = new_ratio;
         let converged = ratio <= limits.residual_ratio_max
-            && (ratio <= REFINEMENT_FLOOR || (steps > 0 && !fast));
+            && (ratio <= limits.residual_ratio_floor || (steps > 0 && !fast));
         if (steps >= limits.min_steps && converged) || steps >= limits.max_steps {
             break;
         }

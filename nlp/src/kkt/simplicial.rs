@@ -216,7 +216,9 @@ impl Simplicial {
                 x[j] = 0.0;
                 let start = lcp[j] + 1;
                 for (&i, &lij) in lri[start..pos].iter().zip(&l[start..pos]) {
-                    x[i] -= lij * xj;
+                    // SAFETY: every row index of L is below `dim` = x.len() (checked
+                    // in `Simplicial::new`, the only place L's pattern is set).
+                    unsafe { *x.get_unchecked_mut(i) -= lij * xj };
                 }
                 let lkj = xj * self.d_inv[j];
                 d -= lkj * xj;

@@ -59,6 +59,10 @@ pub struct Kkt {
     pub max_refinement_steps: usize,
     /// Target relative residual (default 1e-12).
     pub residual_ratio_max: f64,
+    /// Refinement goes on past `residual_ratio_max` while a step at least halves the
+    /// ratio, until the ratio is at most this (default 1e-14, round-off; a value of at
+    /// least `residual_ratio_max` stops at the target, as IPOPT does).
+    pub residual_ratio_floor: f64,
     pub(super) last_residual_ratio: f64,
 }
 
@@ -161,6 +165,7 @@ impl Kkt {
             min_refinement_steps: 1,
             max_refinement_steps: 10,
             residual_ratio_max: 1e-12,
+            residual_ratio_floor: super::refine::REFINEMENT_FLOOR,
             last_residual_ratio: 0.0,
         })
     }

@@ -251,3 +251,43 @@ fn refinement_continues_while_it_gains_on_ill_conditioned_systems() {
     assert!((x[1] - 1.5).abs() < 1e-3, "{x:?}");
     assert!((x[2] + 2.25).abs() < 1e-3, "{x:?}");
 }
+
+/// `residual_ratio_floor`: refinement that removes a regularisation of 1e-4 gains a
+/// factor of roughly 1e-4 per step; with the floor at the target it stops at the first
+/// ratio below the target, with the default floor it goes on to round-off. The ratios
+/// are the solver's own, checked against a dense residual.
+#[test]
+fn refinement_floor_decides_how_far_past_the_target_refinement_goes() {
+    let mut rng = Rng(8080);
+    let c = random_case(&mut rng, 30, 12, 0.2, false);
+    let reg = 1e-4;
+    let dc_reg: Vec<f64> = c.dc.iter().map(|d| d + reg).collect();
+    let mut shift = vec![0.0; c.n + c.m];
+    shift[c.n..].iter_mut().for_each(|s| *s = reg);
+    let b: Vec<f64> = (0..c.n + c.m).map(|_| rng.sym()).collect();
+    let kd = dense(&c);
+    let dense_ratio = |x: &[f64]| {
+        let dim = c.n + c.m;
+        let r = (0..dim)
+            .map(|i| ((0..dim).map(|j| kd[(i, j)] * x[j]).sum::<f64>() - b[i]).abs())
+            .fold(0.0, f64::max);
+        let xn = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let bn = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        r / (xn + bn)
+    };
+    let mut ratios = Vec::new();
+    for floor in [1e-10, 1e-14] {
+        let mut kkt = Kkt::new(c.n, c.m, &c.h, &c.j).unwrap();
+        kkt.residual_ratio_max = 1e-10;
+        kkt.residual_ratio_floor = floor;
+        kkt.factorize(&c.hv, &c.dx, &c.jv, &dc_reg).unwrap();
+        let mut x = b.clone();
+        let ratio = kkt.solve_shifted(&mut x, Some(&shift)).unwrap();
+        assert!(ratio <= 1e-10, "floor {floor}: {ratio}");
+        // The solver's ratio is the dense one (to rounding of the residual itself).
+        assert!(dense_ratio(&x) <= ratio.max(1e-15) * 10.0, "floor {floor}");
+        ratios.push(ratio);
+    }
+    assert!(ratios[0] > 1e-14, "stopped at the target: {}", ratios[0]);
+    assert!(ratios[1] <= 1e-14 && ratios[1] < ratios[0], "{ratios:?}");
+}

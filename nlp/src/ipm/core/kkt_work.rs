@@ -82,6 +82,7 @@ impl KktWork {
         self.kkt.min_refinement_steps = opts.min_refinement_steps;
         self.kkt.max_refinement_steps = opts.max_refinement_steps;
         self.kkt.residual_ratio_max = opts.residual_ratio_max;
+        self.kkt.residual_ratio_floor = opts.residual_ratio_floor;
         for (v, len) in [
             (&mut self.kdx, n),
             (&mut self.kdc, m),
