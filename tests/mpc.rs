@@ -11,7 +11,7 @@ use symnlp::nlp::ocp::{
 };
 use symnlp::nlp::{Compiled, Constraint, Ipm, Relation, Rti, Solution, SqpOptions, Status};
 use symnlp::symx::{Evaluator, Matrix};
-use testkit::rti_loop::rti_feedbacks;
+use testkit::rti_loop::{assert_every_feedback_corrected, rti_feedbacks};
 
 const N: usize = 5;
 
@@ -427,12 +427,5 @@ fn cart_pole_rti_feedbacks_are_corrected_prepared_steps() {
     let mut rti = Rti::from_transcription(&tr, SqpOptions::default()).unwrap();
     rti.initialize(&first).unwrap();
     let steps = rti_feedbacks(&tr, &mut rti, &mut plant, (&ex.x_init, ex.dt), 30);
-    assert!(steps
-        .iter()
-        .all(|(_, fb)| fb.status == Status::RealTimeIterationTaken));
-    let flags: Vec<_> = steps
-        .iter()
-        .map(|(_, fb)| (fb.corrected, fb.factorizations, fb.fallback))
-        .collect();
-    assert!(flags.iter().all(|&f| f == (true, 0, false)), "{flags:?}");
+    assert_every_feedback_corrected(&steps);
 }

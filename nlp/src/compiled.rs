@@ -144,8 +144,8 @@ impl Compiled {
 
     /// This problem with every evaluator (f, ∇f, g, the Jacobian, the Hessian and the cone
     /// functions) evaluated by `evaluator`; the values are bit-identical, so any solver
-    /// takes identical iterates. `Err` if native code cannot be generated (e.g. symx built
-    /// without its `jit` feature).
+    /// takes identical iterates; `self` unchanged when it already evaluates so. `Err` if
+    /// native code cannot be generated (e.g. symx built without its `jit` feature).
     ///
     /// ```
     /// use nlp::{Ipm, Problem, Solver};
@@ -158,6 +158,9 @@ impl Compiled {
     /// assert!((sol.x[0] - 1.0).abs() < 1e-6);
     /// ```
     pub fn with_evaluator(mut self, evaluator: Evaluator) -> Result<Compiled, BuildError> {
+        if self.evaluator() == evaluator {
+            return Ok(self);
+        }
         let convert = |f: &Function| f.with_evaluator(evaluator).map(Arc::new);
         self.f_fn = convert(&self.f_fn)?;
         self.grad_fn = convert(&self.grad_fn)?;

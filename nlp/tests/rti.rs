@@ -9,7 +9,7 @@ use nlp::ocp::{ButcherTableau, Horizon, Method, Ocp, Simulator, Transcription};
 use nlp::{Ipm, Relation, Rti, RtiError, Solution, SqpOptions, Status};
 use symx::{Evaluator, Matrix};
 use testkit::alloc::ThreadCounting;
-use testkit::rti_loop::rti_feedbacks;
+use testkit::rti_loop::{assert_every_feedback_corrected, rti_feedbacks};
 
 #[global_allocator]
 static GLOBAL: ThreadCounting = ThreadCounting;
@@ -383,15 +383,8 @@ fn pendulum_rti_feedbacks_are_corrected_when_the_plant_is_the_model() {
         .iter()
         .filter(|(u, _)| u[0].abs() >= 1.5 - 1e-9)
         .count();
-    assert!(steps
-        .iter()
-        .all(|(_, fb)| fb.status == Status::RealTimeIterationTaken));
-    let flags: Vec<_> = steps
-        .iter()
-        .map(|(_, fb)| (fb.corrected, fb.factorizations, fb.fallback))
-        .collect();
     assert!(saturated > 0, "the control bound was never active");
-    assert!(flags.iter().all(|&f| f == (true, 0, false)), "{flags:?}");
+    assert_every_feedback_corrected(&steps);
 }
 
 /// With a plant that is not the model (damping 0.3 against the model's 0.2), the measured
@@ -411,11 +404,7 @@ fn pendulum_rti_feedbacks_are_corrected_when_the_plant_is_not_the_model() {
     rti.initialize(&converged(&tr, &x_init)).unwrap();
     let mut plant = Simulator::new(&plant_ocp, ButcherTableau::rk4(), 1).unwrap();
     let steps = rti_feedbacks(&tr, &mut rti, &mut plant, (&x_init, dt), 30);
-    let flags: Vec<_> = steps
-        .iter()
-        .map(|(_, fb)| (fb.corrected, fb.factorizations, fb.fallback))
-        .collect();
-    assert!(flags.iter().all(|&f| f == (true, 0, false)), "{flags:?}");
+    assert_every_feedback_corrected(&steps);
     // The converged loop against the same plant, and both loops' costs.
     let mut mpc = Mpc::new(&tr, Box::new(Ipm::default())).unwrap();
     let mut plant = Simulator::new(&plant_ocp, ButcherTableau::rk4(), 1).unwrap();

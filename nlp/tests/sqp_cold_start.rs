@@ -160,6 +160,11 @@ fn an_infeasible_problem_ends_with_the_sqps_own_status() {
     let sol = ipm_started().solve_dyn(&mut c, None, None).unwrap();
     assert!(!sol.status.is_success(), "status {:?}", sol.status);
     assert_ne!(sol.status, Status::SolveSucceeded);
+    // The failed IPM's work is counted too, its records first.
+    let s = &sol.stats;
+    assert!(s.start_iterations > 0 && s.iterations > s.start_iterations);
+    assert_eq!(s.records.len(), s.iterations + 1);
+    assert!(s.records.iter().enumerate().all(|(k, r)| r.iter == k));
 }
 
 #[test]

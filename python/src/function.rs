@@ -82,11 +82,7 @@ impl PyFunction {
                 .map(|s| s.as_str())
                 .zip(outs.iter().map(|m| m.entries()))
                 .collect();
-            let f = symx::Function::named(&name, &i, &o)?;
-            match evaluator {
-                symx::Evaluator::Tape => Ok(f),
-                _ => f.with_evaluator(evaluator),
-            }
+            symx::Function::named(&name, &i, &o)?.with_evaluator(evaluator)
         });
         Ok(PyFunction {
             f: f.map_err(build_err)?,

@@ -6,7 +6,6 @@ use numpy::IntoPyArray;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use symx::Evaluator;
 
 use crate::error::{build_err, solve_err};
 use crate::function::numbers;
@@ -143,10 +142,7 @@ impl PyMpc {
                 Engine::Rti(o) => Mpc::with_rti(tr.0, *o, Box::new(Ipm::default()))?,
                 Engine::Solver(backend) => Mpc::new(tr.0, backend)?,
             };
-            match evaluator {
-                Evaluator::Tape => Ok(mpc),
-                _ => mpc.with_evaluator(evaluator),
-            }
+            mpc.with_evaluator(evaluator)
         });
         Ok(PyMpc {
             mpc: mpc.map_err(build_err)?,

@@ -315,15 +315,12 @@ pub fn evaluator_named(name: &str) -> PyResult<Evaluator> {
     }
 }
 
-/// `compiled` evaluated by `evaluator` (converted with the GIL released when it is not).
+/// `compiled` evaluated by `evaluator` (converted with the GIL released).
 pub fn with_evaluator_without_gil(
     py: Python<'_>,
     compiled: Compiled,
     evaluator: Evaluator,
 ) -> PyResult<Compiled> {
-    if compiled.evaluator() == evaluator {
-        return Ok(compiled);
-    }
     let c = SameThread(compiled);
     py.allow_threads(move || {
         let c = c;

@@ -150,8 +150,11 @@ impl PyTranscription {
     #[pyo3(signature = (evaluator = "tape"))]
     fn compile(&mut self, py: Python<'_>, evaluator: &str) -> PyResult<()> {
         let evaluator = evaluator_named(evaluator)?;
-        let live = self.compiled(py)?;
-        let c = live.compiled.take().expect("compiled above");
+        let live = self.live(py)?;
+        let c = match live.compiled.take() {
+            Some(c) => c,
+            None => compile_without_gil(py, live.tr.problem(), evaluator)?,
+        };
         live.compiled = Some(with_evaluator_without_gil(py, c, evaluator)?);
         Ok(())
     }

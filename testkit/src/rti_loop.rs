@@ -3,7 +3,7 @@
 
 use nlp::ocp::{Simulator, Transcription};
 use nlp::sqp::rti::Feedback;
-use nlp::Rti;
+use nlp::{Rti, Status};
 
 /// Runs `steps` real-time iterations of `rti` (already initialised) against `plant` from
 /// `x_init`: each step applies the plan's first control for `dt`, shifts the plan,
@@ -32,4 +32,18 @@ pub fn rti_feedbacks(
             (u, rti.feedback(&x).expect("feedback"))
         })
         .collect()
+}
+
+/// Asserts that every feedback of `steps` (from [`rti_feedbacks`]) took its step
+/// (`RealTimeIterationTaken`) as the prepared step corrected for the measured state
+/// (`Feedback::corrected`), with no factorisation and no clarabel fallback.
+pub fn assert_every_feedback_corrected(steps: &[(Vec<f64>, Feedback)]) {
+    assert!(steps
+        .iter()
+        .all(|(_, fb)| fb.status == Status::RealTimeIterationTaken));
+    let flags: Vec<_> = steps
+        .iter()
+        .map(|(_, fb)| (fb.corrected, fb.factorizations, fb.fallback))
+        .collect();
+    assert!(flags.iter().all(|&f| f == (true, 0, false)), "{flags:?}");
 }

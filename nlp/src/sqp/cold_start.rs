@@ -24,8 +24,8 @@ use super::SqpOptions;
 pub(super) enum IpmStart {
     /// A solution: the SQP starts from it.
     Solved(Solution),
-    /// The IPM did not succeed: the SQP starts cold.
-    Failed,
+    /// The IPM did not succeed (its solution, for its statistics): the SQP starts cold.
+    Failed(Solution),
     /// The user's callback asked to stop during the IPM: the solve ends with it.
     Stopped(Solution),
 }
@@ -45,14 +45,14 @@ pub(super) fn ipm_start(
     Ok(match sol.status {
         Status::UserRequestedStop => IpmStart::Stopped(sol),
         s if s.is_success() => IpmStart::Solved(sol),
-        _ => IpmStart::Failed,
+        _ => IpmStart::Failed(sol),
     })
 }
 
 /// The user's callback for the SQP's iterations after an IPM start of `offset`
-/// iterations: numbered on from the IPM's, the SQP's row 0 (the IPM's solution, which
-/// the callback has seen as the IPM's last row) left out, as in the merged
-/// [`Stats::records`] of [`count_start_in`].
+/// iterations: numbered on from the IPM's, the SQP's row 0 left out (its start: the
+/// IPM's solution, seen as the IPM's last row, or after a failed IPM the problem's guess,
+/// seen as the IPM's row 0), as in the merged [`Stats::records`] of [`count_start_in`].
 pub(super) fn continue_numbering<'a, 'c: 'a>(
     callback: &'a mut IterationCallback<'c>,
     offset: usize,
@@ -72,8 +72,8 @@ pub(super) fn continue_numbering<'a, 'c: 'a>(
 
 /// `sqp`'s statistics with the interior-point start's counted in: iterations,
 /// evaluations, factorisations and seconds summed, the IPM's iteration records followed
-/// by the SQP's (the SQP's row 0, the IPM's solution again, left out; its numbers
-/// continue the IPM's), `start_iterations` the IPM's iterations.
+/// by the SQP's (the SQP's row 0, its start again, left out: see [`continue_numbering`];
+/// its numbers continue the IPM's), `start_iterations` the IPM's iterations.
 pub(super) fn count_start_in(ipm: &Stats, sqp: &mut Stats) {
     let offset = ipm.iterations;
     let mut records = ipm.records.clone();

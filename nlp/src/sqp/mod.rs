@@ -127,44 +127,41 @@ impl Solver for Sqp {
 impl Sqp {
     /// A cold solve with [`SqpOptions::cold_start_ipm`]: the IPM, then the SQP from its
     /// solution (cold when the IPM fails); the IPM's solution stands when the SQP does
-    /// not converge from it. The callback sees both solves' iterations, numbered on.
+    /// not converge from it. The callback sees both solves' iterations, numbered on, and
+    /// the statistics count both.
     fn solve_from_ipm(
         &self,
         nlp: &mut dyn NumericNlp,
         mut callback: Option<&mut IterationCallback<'_>>,
     ) -> Result<Solution, SolveError> {
-        let mut ipm = match cold_start::ipm_start(&self.options, nlp, callback.as_deref_mut())? {
-            cold_start::IpmStart::Stopped(sol) => return Ok(sol),
-            cold_start::IpmStart::Failed => {
-                let mut sol = Solution::empty();
-                self.run_into(nlp, None, callback, &mut sol)?;
-                return Ok(sol);
-            }
-            cold_start::IpmStart::Solved(ipm) => ipm,
-        };
+        let (mut ipm, solved) =
+            match cold_start::ipm_start(&self.options, nlp, callback.as_deref_mut())? {
+                cold_start::IpmStart::Stopped(sol) => return Ok(sol),
+                cold_start::IpmStart::Failed(ipm) => (ipm, false),
+                cold_start::IpmStart::Solved(ipm) => (ipm, true),
+            };
+        let start = solved.then_some(&ipm);
         let mut sol = Solution::empty();
         match callback {
             Some(cb) => {
                 let mut numbered = cold_start::continue_numbering(cb, ipm.stats.iterations);
-                self.run_into(nlp, Some(&ipm), Some(&mut numbered), &mut sol)?;
+                self.run_into(nlp, start, Some(&mut numbered), &mut sol)?;
             }
-            None => self.run_into(nlp, Some(&ipm), None, &mut sol)?,
+            None => self.run_into(nlp, start, None, &mut sol)?,
         }
-        if sol.status.is_success() || sol.status == Status::UserRequestedStop {
-            cold_start::count_start_in(&ipm.stats, &mut sol.stats);
+        cold_start::count_start_in(&ipm.stats, &mut sol.stats);
+        if !solved || sol.status.is_success() || sol.status == Status::UserRequestedStop {
             return Ok(sol);
         }
         // The SQP did not converge from the IPM's solution: that solution stands, with
         // the time and work of both solves.
-        let mut stats = std::mem::take(&mut sol.stats);
-        cold_start::count_start_in(&ipm.stats, &mut stats);
         ipm.message = format!(
             "{}{}the interior-point solution: the SQP started from it ended with {:?}",
             ipm.message,
             if ipm.message.is_empty() { "" } else { "; " },
             sol.status
         );
-        ipm.stats = stats;
+        ipm.stats = std::mem::take(&mut sol.stats);
         Ok(ipm)
     }
 

@@ -96,13 +96,8 @@ impl Predictor {
         if !self.ready {
             return None;
         }
-        let mut accurate = false;
-        for sweeps in [0, 1] {
-            accurate = self.try_correction(kkt, p, w, terms, x0, sweeps)?;
-            if accurate {
-                break;
-            }
-        }
+        let accurate = self.try_correction(kkt, p, w, terms, x0, 0)?
+            || self.try_correction(kkt, p, w, terms, x0, 1)?;
         accurate.then(|| self.rhs.split_at(p.x.len()))
     }
 

@@ -396,9 +396,10 @@ fn sqrt_(a: f64) -> f64 {
 impl Function {
     /// This function as the text of a self-contained Rust module: `no_std`, no allocation,
     /// no dependency (the math functions are the C library's, which Rust's `std` calls
-    /// too, and square roots correctly rounded as `f64::sqrt`, so the results equal the tape's bit for bit on the same platform, but for the
-    /// sign and payload of NaNs, which rustc need not keep). It defines the constants
-    /// `INPUT_SIZES`, `OUTPUT_SIZES` and `WORK_SIZE` and
+    /// too, and square roots correctly rounded as `f64::sqrt`, so the results equal the
+    /// tape's bit for bit on the same platform, but for the sign and payload of NaNs,
+    /// which rustc need not keep). It defines the constants `INPUT_SIZES`, `OUTPUT_SIZES`
+    /// and `WORK_SIZE` and
     /// `pub fn eval(inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) -> Result<(), &'static str>`
     /// (wrong counts or lengths are an `Err` naming the argument). Include it with
     /// `include!` from a build script's output (docs/dsl.md has the recipe).
