@@ -244,6 +244,19 @@ def regulator():
     return ocp
 
 
+def test_a_transcription_compiled_to_native_code_takes_the_tapes_iterates():
+    # The JIT computes every value as the tape does (symx/tests/jit.rs): the same
+    # iterates bit for bit, so equality without a tolerance.
+    method = s.Method.multiple_shooting("rk4", 4)
+    tape, jit = van_der_pol().transcribe(method, 20), van_der_pol().transcribe(method, 20)
+    jit.compile(evaluator="jit")
+    a, b = tape.solve(), jit.solve()
+    assert a.iterations == b.iterations and a.objective == b.objective
+    assert np.array_equal(a.value(tape.states), b.value(jit.states))
+    with pytest.raises(s.OptionError, match="unknown evaluator"):
+        tape.compile(evaluator="gcc")
+
+
 def test_mpc_closed_loop_with_the_simulator_and_a_python_plant():
     ocp = regulator()
     tr = ocp.transcribe(s.Method.multiple_shooting("rk4", 1), 10)
