@@ -229,7 +229,7 @@ fn instantiate_on(g: &mut Graph, f: &Function, inputs: Vec<u32>) -> Vec<u32> {
     for (i, &v) in f.template.iter().enumerate() {
         reg[f.template_start + i] = g.constant(v);
     }
-    for ins in &f.tape {
+    for ins in f.tape.instructions() {
         let (a, b, c) = (ins.a as usize, ins.b as usize, ins.c as usize);
         let v = match ins.op {
             Op::Call => {

@@ -5,6 +5,7 @@ use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::function::{next_uid, Function, Instr};
 use crate::graph::{Graph, Node};
+use crate::interpret::Tape;
 use crate::op::Op;
 use crate::table::Table;
 use rustc_hash::FxHashMap;
@@ -234,6 +235,11 @@ pub(crate) fn compile(
     let call_scratch = work_size as usize;
     let scratch = ext.calls.iter().map(|c| c.function.work_size).max();
     let work_size = call_scratch + scratch.map_or(0, |s| s.max(1));
+    let output_ranges = output_offsets
+        .iter()
+        .zip(&output_sizes)
+        .map(|(&at, &n)| at..at + n);
+    let tape = Tape::new(tape, &ext.calls, work_size, output_ranges);
     Ok(Function {
         name: "f".into(),
         input_names: (0..inputs.len()).map(|k| format!("i{k}")).collect(),

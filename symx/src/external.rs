@@ -24,6 +24,7 @@
 //! [`Function::to_rust`]): both refuse with an error naming the function.
 use crate::error::SymxError;
 use crate::function::{next_uid, Function};
+use crate::interpret::Tape;
 use crate::sparsity::{entries, Sparsity};
 use std::sync::{Arc, OnceLock};
 
@@ -144,7 +145,7 @@ impl Function {
             input_used: vec![true; input_sizes.len()],
             input_sizes,
             output_sizes,
-            tape: Vec::new(),
+            tape: Tape::default(),
             template: Vec::new(),
             template_start: n_in + n_out,
             work_size: n_in + n_out,

@@ -29,8 +29,9 @@ use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::external::External;
 use crate::graph;
+use crate::interpret::{self, Tape};
 use crate::native::{self, Evaluator, NativeCode};
-use crate::op::{self, Op};
+use crate::op::Op;
 use crate::sparsity::{pattern_from_entries, Sparsity};
 use crate::table::Table;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -77,7 +78,8 @@ pub struct Function {
     pub(crate) input_used: Vec<bool>,
     /// Register of entry 0 of each output.
     pub(crate) output_offsets: Vec<usize>,
-    pub(crate) tape: Vec<Instr>,
+    /// The instructions, with the interpreter's program running them.
+    pub(crate) tape: Tape,
     /// Values of registers `template_start..template_start + template.len()`: the constants
     /// followed by the output slots (constant entries hold their value, others 0).
     pub(crate) template: Vec<f64>,
@@ -487,78 +489,7 @@ impl Function {
             w.add(self.template_start),
             self.template.len(),
         );
-        for ins in &self.tape {
-            let a = *w.add(ins.a as usize);
-            let b = *w.add(ins.b as usize);
-            let v = match ins.op {
-                Op::Add => a + b,
-                Op::Sub => a - b,
-                Op::Mul => a * b,
-                Op::Div => a / b,
-                Op::Neg => -a,
-                Op::Sq => a * a,
-                Op::Sym => a,
-                Op::Sqrt => a.sqrt(),
-                Op::Exp => a.exp(),
-                Op::Log => a.ln(),
-                Op::Sin => a.sin(),
-                Op::Cos => a.cos(),
-                Op::Tan => a.tan(),
-                Op::Asin => a.asin(),
-                Op::Acos => a.acos(),
-                Op::Atan => a.atan(),
-                Op::Sinh => a.sinh(),
-                Op::Cosh => a.cosh(),
-                Op::Tanh => a.tanh(),
-                Op::Abs => a.abs(),
-                Op::Sign => op::sign(a),
-                Op::Not => f64::from(a == 0.0),
-                Op::Pow => op::pow(a, b),
-                Op::Atan2 => a.atan2(b),
-                Op::Min => a.min(b),
-                Op::Max => a.max(b),
-                Op::Lt => f64::from(a < b),
-                Op::Le => f64::from(a <= b),
-                Op::Eq => f64::from(a == b),
-                Op::Ne => f64::from(a != b),
-                Op::And => f64::from(a != 0.0 && b != 0.0),
-                Op::Or => f64::from(a != 0.0 || b != 0.0),
-                Op::StrongMul => op::strong_mul(a, b),
-                Op::Floor => a.floor(),
-                Op::Ceil => a.ceil(),
-                Op::Erf => libm::erf(a),
-                Op::Asinh => a.asinh(),
-                Op::Acosh => a.acosh(),
-                Op::Atanh => a.atanh(),
-                Op::Log1p => a.ln_1p(),
-                Op::Expm1 => a.exp_m1(),
-                Op::Fmod => a % b,
-                Op::Hypot => a.hypot(b),
-                Op::Interpolant => self.tables.get_unchecked(ins.c as usize).eval(&[a]),
-                Op::Interpolant2 => self.tables.get_unchecked(ins.c as usize).eval(&[a, b]),
-                Op::InterpolantN => {
-                    self.tables
-                        .get_unchecked(ins.c as usize)
-                        .eval(std::slice::from_raw_parts(
-                            w.add(ins.a as usize),
-                            ins.b as usize,
-                        ))
-                }
-                Op::IfElse => {
-                    if a != 0.0 {
-                        b
-                    } else {
-                        *w.add(ins.c as usize)
-                    }
-                }
-                Op::Call => {
-                    self.exec_call(self.calls.get_unchecked(ins.d as usize), w);
-                    continue;
-                }
-                Op::Const | Op::CallOutput => std::hint::unreachable_unchecked(),
-            };
-            *w.add(ins.d as usize) = v;
-        }
+        interpret::run(self, w);
     }
 
     /// Runs one call: arguments into the scratch block, the callee's tape there, its
@@ -567,7 +498,7 @@ impl Function {
     /// # Safety
     /// As [`Function::exec`]; the registers of `call` were bounded at compilation.
     #[inline(never)]
-    unsafe fn exec_call(&self, call: &CallInstr, w: *mut f64) {
+    pub(crate) unsafe fn exec_call(&self, call: &CallInstr, w: *mut f64) {
         let f = &*call.function;
         let s = w.add(self.call_scratch);
         let mut p = 0;
@@ -655,7 +586,7 @@ impl Function {
 
     /// Propagates dependence bit masks along the tape (`bits` has `work_size` entries).
     fn propagate_bits(&self, bits: &mut [u64]) {
-        for ins in &self.tape {
+        for ins in self.tape.instructions() {
             match ins.op {
                 Op::Call => {
                     let call = &self.calls[ins.d as usize];

@@ -23,6 +23,7 @@ use crate::error::SymxError;
 use crate::expr::Expr;
 use crate::function::{next_uid, Function, Instr};
 use crate::graph;
+use crate::interpret::Tape;
 use crate::op::Op;
 use crate::table::{linear_fit, not_a_knot_fit, Fit1, Table};
 use std::sync::{Arc, OnceLock};
@@ -378,13 +379,18 @@ impl Function {
             input_offsets: vec![0],
             input_used: vec![true],
             output_offsets: vec![n],
-            tape: vec![Instr {
-                op: Op::InterpolantN,
-                d: n as u32,
-                a: 0,
-                b: n as u32,
-                c: 0,
-            }],
+            tape: Tape::new(
+                vec![Instr {
+                    op: Op::InterpolantN,
+                    d: n as u32,
+                    a: 0,
+                    b: n as u32,
+                    c: 0,
+                }],
+                &[],
+                n + 1,
+                std::iter::once(n..n + 1),
+            ),
             template: vec![0.0],
             template_start: n,
             work_size: n + 1,
@@ -400,7 +406,7 @@ impl Function {
 
     /// The table of a lookup function ([`Function::lookup`]).
     pub(crate) fn lookup_table(&self) -> Option<&Arc<Table>> {
-        match self.tape.as_slice() {
+        match &self.tape[..] {
             [Instr {
                 op: Op::InterpolantN,
                 ..

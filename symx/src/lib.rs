@@ -32,6 +32,7 @@ mod external;
 mod function;
 mod graph;
 mod interpolant;
+mod interpret;
 mod linalg;
 mod map;
 mod matrix;

@@ -29,6 +29,7 @@
 //! ([`FunctionFileError::Version`]); [`FUNCTION_FILE_VERSION`] is the version written.
 use crate::call::CallInstr;
 use crate::function::{next_uid, Function, Instr};
+use crate::interpret::Tape;
 use crate::op::Op;
 use crate::table::Table;
 use serde::{Deserialize, Serialize};
@@ -177,7 +178,11 @@ fn to_data(f: &Function, list: &[&Function]) -> FunctionData {
         input_offsets: f.input_offsets.clone(),
         output_offsets: f.output_offsets.clone(),
         input_used: f.input_used.clone(),
-        tape: f.tape.iter().map(|i| (i.op, i.d, i.a, i.b, i.c)).collect(),
+        tape: f
+            .tape
+            .instructions()
+            .map(|i| (i.op, i.d, i.a, i.b, i.c))
+            .collect(),
         template_start: f.template_start,
         constants: f.template.iter().map(|&v| Number::new(v)).collect(),
         tables: f.tables.iter().map(|t| t.as_ref().clone()).collect(),
@@ -264,6 +269,25 @@ fn from_data(d: FunctionData, loaded: &[Arc<Function>]) -> Result<Function, Func
         .iter()
         .map(Number::value)
         .collect::<Result<Vec<f64>, _>>()?;
+    let calls: Vec<CallInstr> = d
+        .calls
+        .into_iter()
+        .map(|c| CallInstr {
+            function: loaded[c.function].clone(),
+            args: c.args,
+            out: c.out,
+        })
+        .collect();
+    let instrs = d
+        .tape
+        .into_iter()
+        .map(|(op, d, a, b, c)| Instr { op, d, a, b, c });
+    let outputs = d
+        .output_offsets
+        .iter()
+        .zip(&d.output_sizes)
+        .map(|(&at, &n)| at..at + n);
+    let tape = Tape::new(instrs.collect(), &calls, d.work_size, outputs);
     Ok(Function {
         name: d.name,
         input_names: d.input_names,
@@ -274,24 +298,12 @@ fn from_data(d: FunctionData, loaded: &[Arc<Function>]) -> Result<Function, Func
         input_offsets: d.input_offsets,
         input_used: d.input_used,
         output_offsets: d.output_offsets,
-        tape: d
-            .tape
-            .into_iter()
-            .map(|(op, d, a, b, c)| Instr { op, d, a, b, c })
-            .collect(),
+        tape,
         template,
         template_start: d.template_start,
         work_size: d.work_size,
         tables: d.tables.into_iter().map(Arc::new).collect(),
-        calls: d
-            .calls
-            .into_iter()
-            .map(|c| CallInstr {
-                function: loaded[c.function].clone(),
-                args: c.args,
-                out: c.out,
-            })
-            .collect(),
+        calls,
         call_scratch: d.call_scratch,
         dependencies: OnceLock::new(),
         jacobians: Arc::new(Mutex::new(Default::default())),

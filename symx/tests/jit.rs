@@ -557,3 +557,31 @@ fn outputs_read_back_match_the_tape() {
         }
     }
 }
+
+/// Two operations in a row, the first's result read only by the second (`(x ∘ y) • z`,
+/// `z • (x ∘ y)`, `−(x ∘ y)`), which the tape's interpreter runs as one fused step: on
+/// every triple of special operands, NaNs of different signs and payloads in every
+/// position, the same bits as the JIT (which runs the two instructions).
+#[test]
+fn fused_pairs_match_the_jit_on_special_values() {
+    let special = special_with_nan_payloads();
+    let (x, y, z) = (Expr::sym("x"), Expr::sym("y"), Expr::sym("z"));
+    for first in pairable_binary() {
+        let t = first(x, y);
+        let mut pairs: Vec<Expr> = vec![-t];
+        for second in pairable_binary() {
+            pairs.push(second(t, z));
+            pairs.push(second(z, t));
+        }
+        for e in pairs {
+            let f = Function::new(&[&[x, y, z]], &[&[e]]).unwrap();
+            for &a in &special {
+                for &b in &special {
+                    for &c in &special {
+                        same_bits(&f, &[&[a, b, c]]);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -500,7 +500,7 @@ fn homes(f: &Function, output_of: &[Option<(u32, u32)>]) -> (Vec<bool>, Vec<bool
         (ins.a as usize..(ins.a + ins.b) as usize).for_each(|r| in_output[r] = false);
     }
     let mut store = stores(f);
-    for (s, ins) in store.iter_mut().zip(&f.tape) {
+    for (s, ins) in store.iter_mut().zip(f.tape.iter()) {
         if ins.op != Op::Call && in_output[ins.d as usize] {
             *s = false;
         }

@@ -66,7 +66,7 @@ pub(super) fn places(f: &Function) -> Vec<Place> {
 /// destination, or an output of a call).
 pub(super) fn written(f: &Function) -> Vec<bool> {
     let mut written = vec![false; f.work_size];
-    for ins in &f.tape {
+    for ins in f.tape.iter() {
         if ins.op == Op::Call {
             let call = &f.calls[ins.d as usize];
             let n: usize = call.function.output_sizes.iter().sum();
@@ -95,7 +95,7 @@ pub(super) fn constant_outputs(f: &Function) -> Vec<(usize, usize, f64)> {
 /// an argument of a call).
 pub(super) fn read(f: &Function) -> Vec<bool> {
     let mut read = vec![false; f.work_size];
-    for ins in &f.tape {
+    for ins in f.tape.iter() {
         operands(f, ins, |r| read[r as usize] = true);
     }
     read

@@ -1,0 +1,663 @@
+//! The tape's interpreter: the program it runs, built from a [`Function`]'s tape, and the
+//! loop that runs it.
+//!
+//! An interpreter's cost is mostly its dispatch (one indirect jump per instruction) and
+//! the round trip of every result through the work vector, not the arithmetic. The
+//! program is the tape with adjacent pairs fused into one step where the first
+//! instruction's result is a temporary read only by the next one: `w[d] = (w[a] ∘ w[b]) •
+//! w[c]` or `w[c] • (w[a] ∘ w[b])` for `∘` one of `+ − ×` and `•` one of `+ − × ÷`.
+//! Derivative tapes are mostly such chains (a Hessian's `a·b + c`,
+//! `a·b − c`, `(a·b)·k`): 35 % of the steps of the cart-pole MPC's Lagrangian Hessian go.
+//!
+//! A fused step computes the two operations in the same order with the same roundings
+//! (Rust never contracts `a·b + c` into a fused multiply-add), so its values are the
+//! tape's bit for bit, NaN payloads included (x86 returns the first operand's NaN); only
+//! the write of the temporary, which nothing reads, is skipped. The compiler is free to
+//! swap the operands of a commutative operation, which changes which of two NaNs comes
+//! out: additions and multiplications are written out on x86-64 ([`add`], [`mul`]), and
+//! `−(w[a] ∘ w[b])` is not fused (the negation may move into the product).
+//! `tests/jit.rs` compares every pair with the JIT on NaN payloads.
+//!
+//! The instructions are stored only as this program ([`Tape`]); the native code
+//! generators, the dependency analysis and serialization read them back exactly.
+use crate::call::CallInstr;
+use crate::function::{Function, Instr};
+use crate::op::{self, Op};
+use std::sync::OnceLock;
+
+/// How a step computes its value (the tape's operations, then the fused pairs).
+///
+/// `XY` is `(w[a] X w[b]) Y w[c]`, `XYRev` is `w[c] Y (w[a] X w[b])`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub(crate) enum Code {
+    Sym,
+    Neg,
+    Sq,
+    Sqrt,
+    Exp,
+    Log,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Sinh,
+    Cosh,
+    Tanh,
+    Abs,
+    Sign,
+    Not,
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+    Atan2,
+    Min,
+    Max,
+    Lt,
+    Le,
+    Eq,
+    Ne,
+    And,
+    Or,
+    StrongMul,
+    IfElse,
+    Floor,
+    Ceil,
+    Erf,
+    Asinh,
+    Acosh,
+    Atanh,
+    Log1p,
+    Expm1,
+    Fmod,
+    Hypot,
+    Interpolant,
+    Interpolant2,
+    InterpolantN,
+    Call,
+    AddAdd,
+    AddSub,
+    AddMul,
+    AddDiv,
+    SubAdd,
+    SubSub,
+    SubMul,
+    SubDiv,
+    MulAdd,
+    MulSub,
+    MulMul,
+    MulDiv,
+    AddAddRev,
+    AddSubRev,
+    AddMulRev,
+    AddDivRev,
+    SubAddRev,
+    SubSubRev,
+    SubMulRev,
+    SubDivRev,
+    MulAddRev,
+    MulSubRev,
+    MulMulRev,
+    MulDivRev,
+}
+
+impl Code {
+    /// The step running one tape instruction of operation `op` as it is.
+    fn plain(op: Op) -> Code {
+        match op {
+            Op::Sym => Code::Sym,
+            Op::Neg => Code::Neg,
+            Op::Sq => Code::Sq,
+            Op::Sqrt => Code::Sqrt,
+            Op::Exp => Code::Exp,
+            Op::Log => Code::Log,
+            Op::Sin => Code::Sin,
+            Op::Cos => Code::Cos,
+            Op::Tan => Code::Tan,
+            Op::Asin => Code::Asin,
+            Op::Acos => Code::Acos,
+            Op::Atan => Code::Atan,
+            Op::Sinh => Code::Sinh,
+            Op::Cosh => Code::Cosh,
+            Op::Tanh => Code::Tanh,
+            Op::Abs => Code::Abs,
+            Op::Sign => Code::Sign,
+            Op::Not => Code::Not,
+            Op::Add => Code::Add,
+            Op::Sub => Code::Sub,
+            Op::Mul => Code::Mul,
+            Op::Div => Code::Div,
+            Op::Pow => Code::Pow,
+            Op::Atan2 => Code::Atan2,
+            Op::Min => Code::Min,
+            Op::Max => Code::Max,
+            Op::Lt => Code::Lt,
+            Op::Le => Code::Le,
+            Op::Eq => Code::Eq,
+            Op::Ne => Code::Ne,
+            Op::And => Code::And,
+            Op::Or => Code::Or,
+            Op::StrongMul => Code::StrongMul,
+            Op::IfElse => Code::IfElse,
+            Op::Floor => Code::Floor,
+            Op::Ceil => Code::Ceil,
+            Op::Erf => Code::Erf,
+            Op::Asinh => Code::Asinh,
+            Op::Acosh => Code::Acosh,
+            Op::Atanh => Code::Atanh,
+            Op::Log1p => Code::Log1p,
+            Op::Expm1 => Code::Expm1,
+            Op::Fmod => Code::Fmod,
+            Op::Hypot => Code::Hypot,
+            Op::Interpolant => Code::Interpolant,
+            Op::Interpolant2 => Code::Interpolant2,
+            Op::InterpolantN => Code::InterpolantN,
+            Op::Call => Code::Call,
+            // Constants live in the template, call outputs in their call's block.
+            Op::Const | Op::CallOutput => unreachable!("{op:?} is never a tape instruction"),
+        }
+    }
+
+    /// Whether this code runs two instructions.
+    fn is_fused(self) -> bool {
+        self as u8 >= Code::AddAdd as u8
+    }
+
+    /// The step computing `second(first(w[a], w[b]), w[c])` (`rev`: `second(w[c], …)`),
+    /// or `None` if that pair has no step.
+    fn fused(first: Op, second: Op, rev: bool) -> Option<Code> {
+        use Code::*;
+        const TABLE: [[[Code; 4]; 3]; 2] = [
+            [
+                [AddAdd, AddSub, AddMul, AddDiv],
+                [SubAdd, SubSub, SubMul, SubDiv],
+                [MulAdd, MulSub, MulMul, MulDiv],
+            ],
+            [
+                [AddAddRev, AddSubRev, AddMulRev, AddDivRev],
+                [SubAddRev, SubSubRev, SubMulRev, SubDivRev],
+                [MulAddRev, MulSubRev, MulMulRev, MulDivRev],
+            ],
+        ];
+        let i = [Op::Add, Op::Sub, Op::Mul]
+            .iter()
+            .position(|&o| o == first)?;
+        let j = [Op::Add, Op::Sub, Op::Mul, Op::Div]
+            .iter()
+            .position(|&o| o == second)?;
+        Some(TABLE[usize::from(rev)][i][j])
+    }
+}
+
+/// One step of the program: `w[d] = code(w[a], w[b], w[c])`, registers (and table or
+/// call indices) as in the tape's [`Instr`]. A fused pair also records what the tape's two
+/// instructions were: the first (operation `first`) wrote `w[t]`, the second (`second`)
+/// read it on the left (or on the right, `rev`) of its other operand `w[c]`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Step {
+    code: Code,
+    first: Op,
+    second: Op,
+    rev: bool,
+    d: u32,
+    a: u32,
+    b: u32,
+    c: u32,
+    t: u32,
+}
+
+/// A function's instructions, kept as the program that runs them ([`Tape::new`]).
+///
+/// Iterating gives the instructions back exactly as compiled, without allocating; the
+/// native code generators, which index them, dereference the tape to a slice made on
+/// first use (so only a function compiled to native code keeps both).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Tape {
+    steps: Vec<Step>,
+    len: usize,
+    instrs: OnceLock<Vec<Instr>>,
+}
+
+impl Tape {
+    /// The tape of `instrs`, whose `calls` are the function's, in a work vector of
+    /// `work_size` registers of which `outputs` (ranges) are read after the last step.
+    pub(crate) fn new(
+        instrs: Vec<Instr>,
+        calls: &[CallInstr],
+        work_size: usize,
+        outputs: impl Iterator<Item = std::ops::Range<usize>>,
+    ) -> Tape {
+        let dead = dead_after_next(&instrs, calls, work_size, outputs);
+        let mut steps = Vec::with_capacity(instrs.len());
+        let mut i = 0;
+        while i < instrs.len() {
+            let ins = instrs[i];
+            match instrs
+                .get(i + 1)
+                .filter(|_| dead[i])
+                .and_then(|&n| fuse(ins, n))
+            {
+                Some(step) => {
+                    steps.push(step);
+                    i += 2;
+                }
+                None => {
+                    steps.push(Step {
+                        code: Code::plain(ins.op),
+                        first: ins.op,
+                        second: ins.op,
+                        rev: false,
+                        d: ins.d,
+                        a: ins.a,
+                        b: ins.b,
+                        c: ins.c,
+                        t: ins.d,
+                    });
+                    i += 1;
+                }
+            }
+        }
+        steps.shrink_to_fit();
+        Tape {
+            steps,
+            len: instrs.len(),
+            instrs: OnceLock::new(),
+        }
+    }
+
+    /// Number of instructions.
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// The instructions, exactly as compiled.
+    pub(crate) fn instructions(&self) -> impl Iterator<Item = Instr> + '_ {
+        self.steps.iter().flat_map(|s| {
+            let (instrs, n) = s.instrs();
+            instrs.into_iter().take(n)
+        })
+    }
+}
+
+impl std::ops::Deref for Tape {
+    type Target = [Instr];
+    fn deref(&self) -> &[Instr] {
+        self.instrs.get_or_init(|| self.instructions().collect())
+    }
+}
+
+impl Step {
+    /// The one or two instructions this step runs (the first `n` of the array).
+    fn instrs(&self) -> ([Instr; 2], usize) {
+        let op = self.first;
+        let (d, a, b, c) = (self.d, self.a, self.b, self.c);
+        if !self.code.is_fused() {
+            return ([Instr { op, d, a, b, c }; 2], 1);
+        }
+        let (t, o) = (self.t, self.c);
+        let first = Instr {
+            op,
+            d: t,
+            a,
+            b,
+            c: a,
+        };
+        let (a, b, c) = if self.rev { (o, t, o) } else { (t, o, t) };
+        let op = self.second;
+        ([first, Instr { op, d, a, b, c }], 2)
+    }
+}
+
+/// The fused step running `first` then `second`, which reads `first`'s result exactly
+/// once, or `None` if that pair has no code. Only pairs laid out as compilation lays them
+/// out (a binary operation's `c` is its `a`) are fused, so that [`Tape::instructions`]
+/// gives them back exactly.
+fn fuse(first: Instr, second: Instr) -> Option<Step> {
+    let t = first.d;
+    if first.c != first.a || second.c != second.a {
+        return None;
+    }
+    let (rev, other) = match (second.a == t, second.b == t) {
+        (true, false) => (false, second.b),
+        (false, true) => (true, second.a),
+        _ => return None,
+    };
+    Some(Step {
+        code: Code::fused(first.op, second.op, rev)?,
+        first: first.op,
+        second: second.op,
+        rev,
+        d: second.d,
+        a: first.a,
+        b: first.b,
+        c: other,
+        t,
+    })
+}
+
+/// For each instruction `i`: whether the value it writes is dead after instruction `i + 1`
+/// (overwritten there, or not read later before being written again, and not an output), computed by
+/// one backward pass over the tape. Irregular writes (a call's outputs) are ignored, which
+/// only ever keeps a register live.
+fn dead_after_next(
+    tape: &[Instr],
+    calls: &[CallInstr],
+    work_size: usize,
+    outputs: impl Iterator<Item = std::ops::Range<usize>>,
+) -> Vec<bool> {
+    let mut live = vec![false; work_size];
+    for r in outputs {
+        for slot in live.iter_mut().take(r.end).skip(r.start) {
+            *slot = true;
+        }
+    }
+    let mut dead = vec![false; tape.len()];
+    for (i, ins) in tape.iter().enumerate().rev() {
+        if i > 0 && tape[i - 1].op != Op::Call {
+            // The value instruction `i − 1` wrote is dead after `i` if `i` overwrites it
+            // or nothing later reads the register before it is written again.
+            let t = tape[i - 1].d as usize;
+            let overwritten = ins.op != Op::Call && ins.d as usize == t;
+            dead[i - 1] = overwritten || !live[t];
+        }
+        match ins.op {
+            Op::Call => {
+                for &r in &calls[ins.d as usize].args {
+                    live[r as usize] = true;
+                }
+            }
+            Op::InterpolantN => {
+                live[ins.d as usize] = false;
+                for slot in &mut live[ins.a as usize..(ins.a + ins.b) as usize] {
+                    *slot = true;
+                }
+            }
+            op => {
+                live[ins.d as usize] = false;
+                let read: &[u32] = match op.arity() {
+                    3 => &[ins.a, ins.b, ins.c],
+                    2 => &[ins.a, ins.b],
+                    _ => &[ins.a],
+                };
+                for &r in read {
+                    live[r as usize] = true;
+                }
+            }
+        }
+    }
+    dead
+}
+
+/// `a + b` computed with `a` as the first operand, so that of two NaNs `a`'s is returned
+/// (as x86 does for the first operand and the JIT's code does): the compiler may swap a
+/// commutative operation's operands, which changes which NaN comes out; on x86-64 the
+/// instruction is written out to prevent that.
+#[inline(always)]
+fn add(a: f64, b: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let mut v = a;
+        // SAFETY: one SSE2 addition of two registers (SSE2 is part of x86-64).
+        unsafe {
+            std::arch::asm!("addsd {v}, {b}", v = inout(xmm_reg) v, b = in(xmm_reg) b,
+                options(pure, nomem, nostack, preserves_flags));
+        }
+        v
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        a + b
+    }
+}
+
+/// `a · b` with `a` as the first operand (see [`add`]).
+#[inline(always)]
+fn mul(a: f64, b: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let mut v = a;
+        // SAFETY: one SSE2 multiplication of two registers.
+        unsafe {
+            std::arch::asm!("mulsd {v}, {b}", v = inout(xmm_reg) v, b = in(xmm_reg) b,
+                options(pure, nomem, nostack, preserves_flags));
+        }
+        v
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        a * b
+    }
+}
+
+/// Runs `f`'s program on a work vector whose input and template registers are filled.
+///
+/// # Safety
+/// `w` must point to at least `f.work_size` numbers.
+#[inline(always)]
+pub(crate) unsafe fn run(f: &Function, w: *mut f64) {
+    let r = |k: u32| *w.add(k as usize);
+    for s in &f.tape.steps {
+        let (a, b) = (r(s.a), r(s.b));
+        let v = match s.code {
+            Code::Add => add(a, b),
+            Code::Sub => a - b,
+            Code::Mul => mul(a, b),
+            Code::Div => a / b,
+            Code::Neg => -a,
+            Code::Sq => a * a,
+            Code::Sym => a,
+            Code::AddAdd => add(add(a, b), r(s.c)),
+            Code::AddSub => add(a, b) - r(s.c),
+            Code::AddMul => mul(add(a, b), r(s.c)),
+            Code::AddDiv => add(a, b) / r(s.c),
+            Code::SubAdd => add(a - b, r(s.c)),
+            Code::SubSub => a - b - r(s.c),
+            Code::SubMul => mul(a - b, r(s.c)),
+            Code::SubDiv => (a - b) / r(s.c),
+            Code::MulAdd => add(mul(a, b), r(s.c)),
+            Code::MulSub => mul(a, b) - r(s.c),
+            Code::MulMul => mul(mul(a, b), r(s.c)),
+            Code::MulDiv => mul(a, b) / r(s.c),
+            Code::AddAddRev => add(r(s.c), add(a, b)),
+            Code::AddSubRev => r(s.c) - add(a, b),
+            Code::AddMulRev => mul(r(s.c), add(a, b)),
+            Code::AddDivRev => r(s.c) / add(a, b),
+            Code::SubAddRev => add(r(s.c), a - b),
+            Code::SubSubRev => r(s.c) - (a - b),
+            Code::SubMulRev => mul(r(s.c), a - b),
+            Code::SubDivRev => r(s.c) / (a - b),
+            Code::MulAddRev => add(r(s.c), mul(a, b)),
+            Code::MulSubRev => r(s.c) - mul(a, b),
+            Code::MulMulRev => mul(r(s.c), mul(a, b)),
+            Code::MulDivRev => r(s.c) / mul(a, b),
+            Code::Sqrt => a.sqrt(),
+            Code::Exp => a.exp(),
+            Code::Log => a.ln(),
+            Code::Sin => a.sin(),
+            Code::Cos => a.cos(),
+            Code::Tan => a.tan(),
+            Code::Asin => a.asin(),
+            Code::Acos => a.acos(),
+            Code::Atan => a.atan(),
+            Code::Sinh => a.sinh(),
+            Code::Cosh => a.cosh(),
+            Code::Tanh => a.tanh(),
+            Code::Abs => a.abs(),
+            Code::Sign => op::sign(a),
+            Code::Not => f64::from(a == 0.0),
+            Code::Pow => op::pow(a, b),
+            Code::Atan2 => a.atan2(b),
+            Code::Min => a.min(b),
+            Code::Max => a.max(b),
+            Code::Lt => f64::from(a < b),
+            Code::Le => f64::from(a <= b),
+            Code::Eq => f64::from(a == b),
+            Code::Ne => f64::from(a != b),
+            Code::And => f64::from(a != 0.0 && b != 0.0),
+            Code::Or => f64::from(a != 0.0 || b != 0.0),
+            Code::StrongMul => op::strong_mul(a, b),
+            Code::Floor => a.floor(),
+            Code::Ceil => a.ceil(),
+            Code::Erf => libm::erf(a),
+            Code::Asinh => a.asinh(),
+            Code::Acosh => a.acosh(),
+            Code::Atanh => a.atanh(),
+            Code::Log1p => a.ln_1p(),
+            Code::Expm1 => a.exp_m1(),
+            Code::Fmod => a % b,
+            Code::Hypot => a.hypot(b),
+            Code::Interpolant => f.tables.get_unchecked(s.c as usize).eval(&[a]),
+            Code::Interpolant2 => f.tables.get_unchecked(s.c as usize).eval(&[a, b]),
+            Code::InterpolantN => {
+                f.tables
+                    .get_unchecked(s.c as usize)
+                    .eval(std::slice::from_raw_parts(
+                        w.add(s.a as usize),
+                        s.b as usize,
+                    ))
+            }
+            Code::IfElse => {
+                if a != 0.0 {
+                    b
+                } else {
+                    r(s.c)
+                }
+            }
+            Code::Call => {
+                f.exec_call(f.calls.get_unchecked(s.d as usize), w);
+                continue;
+            }
+        };
+        *w.add(s.d as usize) = v;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{hessian, Expr, Matrix};
+
+    fn ins(op: Op, d: u32, a: u32, b: u32) -> Instr {
+        let c = a;
+        Instr { op, d, a, b, c }
+    }
+
+    fn fused_steps(tape: &Tape) -> usize {
+        tape.steps.iter().filter(|s| s.code.is_fused()).count()
+    }
+
+    fn same(a: &[Instr], b: &[Instr]) -> bool {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| (x.op, x.d, x.a, x.b, x.c) == (y.op, y.d, y.a, y.b, y.c))
+    }
+
+    /// Registers 0–2 inputs, 3 the output, 4–5 temporaries.
+    fn tape_of(instrs: &[Instr]) -> Tape {
+        Tape::new(instrs.to_vec(), &[], 6, std::iter::once(3..4))
+    }
+
+    #[test]
+    fn a_temporary_read_once_fuses_and_comes_back_exactly() {
+        // w4 = w0·w1; w3 = w2 − w4 (the temporary on the right: `rev`).
+        let instrs = [ins(Op::Mul, 4, 0, 1), ins(Op::Sub, 3, 2, 4)];
+        let tape = tape_of(&instrs);
+        assert_eq!(tape.steps.len(), 1);
+        assert_eq!(tape.steps[0].code, Code::MulSubRev);
+        assert!(same(&tape.instructions().collect::<Vec<_>>(), &instrs));
+    }
+
+    #[test]
+    fn a_temporary_read_again_later_is_kept() {
+        // w4 = w0 + w1; w5 = w4 · w2; w3 = w5 − w4: w4 is read after the pair.
+        let instrs = [
+            ins(Op::Add, 4, 0, 1),
+            ins(Op::Mul, 5, 4, 2),
+            ins(Op::Sub, 3, 5, 4),
+        ];
+        let tape = tape_of(&instrs);
+        // Only the second and third fuse (w5 is dead after the third).
+        assert_eq!(tape.steps.len(), 2);
+        assert_eq!(tape.steps[1].code, Code::MulSub);
+        assert!(same(&tape.instructions().collect::<Vec<_>>(), &instrs));
+    }
+
+    #[test]
+    fn a_temporary_overwritten_by_its_reader_fuses() {
+        // w4 = w0 · w4; w4 = w1 + w4 (registers reused in place), then w3 = w4.
+        let instrs = [
+            ins(Op::Mul, 4, 0, 4),
+            ins(Op::Add, 4, 1, 4),
+            ins(Op::Sym, 3, 4, 4),
+        ];
+        let tape = tape_of(&instrs);
+        assert_eq!(tape.steps[0].code, Code::MulAddRev);
+        assert_eq!(tape.steps.len(), 2);
+        assert!(same(&tape.instructions().collect::<Vec<_>>(), &instrs));
+    }
+
+    #[test]
+    fn an_output_or_a_twice_read_result_is_not_skipped() {
+        // w3 (an output) = w0 · w1, then w4 = w3 + w2: the output must be written.
+        let output_first = [ins(Op::Mul, 3, 0, 1), ins(Op::Add, 4, 3, 2)];
+        assert_eq!(fused_steps(&tape_of(&output_first)), 0);
+        // w4 = w0 · w1; w3 = w4 · w4 reads it twice.
+        let twice = [ins(Op::Mul, 4, 0, 1), ins(Op::Mul, 3, 4, 4)];
+        assert_eq!(fused_steps(&tape_of(&twice)), 0);
+        // w4 = w0 · w1; w3 = −w4: a negation is not fused.
+        let negated = [ins(Op::Mul, 4, 0, 1), ins(Op::Neg, 3, 4, 4)];
+        assert_eq!(fused_steps(&tape_of(&negated)), 0);
+    }
+
+    #[test]
+    fn outputs_that_are_also_operands_evaluate_right() {
+        let (x, y, z) = (Expr::sym("x"), Expr::sym("y"), Expr::sym("z"));
+        let p = x * y;
+        let f = Function::new(&[&[x, y, z]], &[&[p, p + z, (x + y) * z - y]]).unwrap();
+        let out = f.call(&[&[2.0, 3.0, 5.0]]).unwrap();
+        assert_eq!(out[0], [6.0, 11.0, 22.0]);
+    }
+
+    /// One explicit RK4 step of a damped pendulum with a control, `[θ, ω, u] ↦ [θ⁺, ω⁺]`.
+    fn rk4_pendulum(x: &Matrix) -> [Expr; 2] {
+        let rhs = |th: Expr, om: Expr| [om, x[2] - 9.81 * th.sin() - 0.2 * om];
+        let h = 0.05;
+        let k1 = rhs(x[0], x[1]);
+        let k2 = rhs(x[0] + h / 2.0 * k1[0], x[1] + h / 2.0 * k1[1]);
+        let k3 = rhs(x[0] + h / 2.0 * k2[0], x[1] + h / 2.0 * k2[1]);
+        let k4 = rhs(x[0] + h * k3[0], x[1] + h * k3[1]);
+        [0, 1].map(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+    }
+
+    #[test]
+    fn a_hessian_runs_in_far_fewer_steps_than_instructions() {
+        // The Lagrangian Hessian of one multiple-shooting interval, as an OCP has.
+        let x = Matrix::sym_vec("x", 3);
+        let l = Matrix::sym_vec("l", 2);
+        let next = rk4_pendulum(&x);
+        let f = l[0] * next[0] + l[1] * next[1] + x[0].sq() + 0.1 * x[2].sq();
+        let h = hessian(f, &x).unwrap();
+        let fun = Function::new(&[&x, &l], &[h.values()]).unwrap();
+        let (steps, instrs) = (fun.tape.steps.len(), fun.tape.len());
+        assert!(
+            steps * 4 < instrs * 3,
+            "{steps} steps for {instrs} instructions"
+        );
+        let back: Vec<Instr> = fun.tape.instructions().collect();
+        assert_eq!(back.len(), instrs);
+        // The instructions rebuilt into a tape give the same program and instructions.
+        let outputs = fun
+            .output_offsets
+            .iter()
+            .zip(&fun.output_sizes)
+            .map(|(&at, &n)| at..at + n);
+        let again = Tape::new(back.clone(), &fun.calls, fun.work_size, outputs);
+        assert!(same(&again.instructions().collect::<Vec<_>>(), &back));
+        assert_eq!(again.steps.len(), steps);
+    }
+}
