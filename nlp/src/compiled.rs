@@ -31,6 +31,10 @@ pub struct Compiled {
     grad_fn: Arc<Function>,
     g_fn: Arc<Function>,
     jac_fn: Arc<Function>,
+    /// f and g in one tape, ∇f and J in one tape: a pair shares its common subexpressions
+    /// (the dynamics of an OCP's constraints are also in its objective's quadrature).
+    f_g_fn: Arc<Function>,
+    grad_jac_fn: Arc<Function>,
     hess_fn: Arc<Function>,
     jac_sparsity: Sparsity,
     hess_sparsity: Sparsity,
@@ -84,6 +88,8 @@ impl Compiled {
         let grad_fn = Function::new(&[x, p], &[&grad])?;
         let g_fn = Function::new(&[x, p], &[g])?;
         let jac_fn = Function::new(&[x, p], &[jac.values()])?;
+        let f_g_fn = Function::new(&[x, p], &[&[f], g])?;
+        let grad_jac_fn = Function::new(&[x, p], &[&grad, jac.values()])?;
         let hess_fn = Function::new(&[x, p, &[sigma], &lambda], &[hess.values()])?;
         let mut affine_cones = Vec::new();
         let mut entries = Vec::new();
@@ -106,12 +112,20 @@ impl Compiled {
                 jacobian_sparsity: cj.sparsity().clone(),
             }))
         };
-        let work_size = [&f_fn, &grad_fn, &g_fn, &jac_fn, &hess_fn]
-            .into_iter()
-            .chain(cone_fns.iter().flat_map(|c| [&c.entries, &c.jacobian]))
-            .map(|f| f.work_size())
-            .max()
-            .unwrap_or(0);
+        let work_size = [
+            &f_fn,
+            &grad_fn,
+            &g_fn,
+            &jac_fn,
+            &f_g_fn,
+            &grad_jac_fn,
+            &hess_fn,
+        ]
+        .into_iter()
+        .chain(cone_fns.iter().flat_map(|c| [&c.entries, &c.jacobian]))
+        .map(|f| f.work_size())
+        .max()
+        .unwrap_or(0);
         Ok(Compiled {
             n: x.len(),
             m: g.len(),
@@ -126,6 +140,8 @@ impl Compiled {
             grad_fn: Arc::new(grad_fn),
             g_fn: Arc::new(g_fn),
             jac_fn: Arc::new(jac_fn),
+            f_g_fn: Arc::new(f_g_fn),
+            grad_jac_fn: Arc::new(grad_jac_fn),
             hess_fn: Arc::new(hess_fn),
             jac_sparsity: jac.sparsity().clone(),
             hess_sparsity: hess.sparsity().clone(),
@@ -166,6 +182,8 @@ impl Compiled {
         self.grad_fn = convert(&self.grad_fn)?;
         self.g_fn = convert(&self.g_fn)?;
         self.jac_fn = convert(&self.jac_fn)?;
+        self.f_g_fn = convert(&self.f_g_fn)?;
+        self.grad_jac_fn = convert(&self.grad_jac_fn)?;
         self.hess_fn = convert(&self.hess_fn)?;
         if let Some(c) = &self.cone_fns {
             self.cone_fns = Some(Arc::new(ConeEvaluators {
@@ -304,9 +322,13 @@ impl Compiled {
     }
 
     fn eval(f: &Function, inputs: &[&[f64]], out: &mut [f64], work: &mut [f64]) {
+        Compiled::eval_into(f, inputs, &mut [out], work);
+    }
+
+    fn eval_into(f: &Function, inputs: &[&[f64]], outputs: &mut [&mut [f64]], work: &mut [f64]) {
         // Sizes are fixed at compilation and the solver passes vectors of those sizes; a
         // mismatch is a broken invariant of the caller.
-        if let Err(e) = f.eval(inputs, &mut [out], work) {
+        if let Err(e) = f.eval(inputs, outputs, work) {
             panic!("compiled problem evaluated with wrong sizes: {e}");
         }
     }
@@ -376,6 +398,24 @@ impl NumericNlp for Compiled {
     }
     fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]) {
         Compiled::eval(&self.jac_fn, &[x, &self.params], values, &mut self.work);
+    }
+    fn evaluates_together(&self) -> bool {
+        true
+    }
+    fn eval_f_g(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        let mut f = [0.0];
+        let outputs = &mut [&mut f[..], g];
+        Compiled::eval_into(&self.f_g_fn, &[x, &self.params], outputs, &mut self.work);
+        f[0]
+    }
+    fn eval_grad_f_jac_g(&mut self, x: &[f64], grad: &mut [f64], jac: &mut [f64]) {
+        let outputs = &mut [grad, jac];
+        Compiled::eval_into(
+            &self.grad_jac_fn,
+            &[x, &self.params],
+            outputs,
+            &mut self.work,
+        );
     }
     fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]) {
         Compiled::eval(

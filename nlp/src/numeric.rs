@@ -36,6 +36,27 @@ pub trait NumericNlp {
     fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]);
     /// Values of `obj_factor·∇²f(x) + Σ λ_i ∇²g_i(x)`, lower triangle, in `hess_l_sparsity` order.
     fn eval_hess_l(&mut self, x: &[f64], obj_factor: f64, lambda: &[f64], values: &mut [f64]);
+    /// Whether [`NumericNlp::eval_f_g`] and [`NumericNlp::eval_grad_f_jac_g`] cost less
+    /// than their two evaluations apart (default: no). Solvers then ask for the two values
+    /// of a pair together whenever they need one of them at a new point (they need both
+    /// at almost every point); a [`Compiled`](crate::Compiled) problem says yes.
+    fn evaluates_together(&self) -> bool {
+        false
+    }
+    /// f(x), and g(x) into `g`, in one evaluation (default: [`NumericNlp::eval_f`] then
+    /// [`NumericNlp::eval_g`]); the values must be those of the two apart.
+    fn eval_f_g(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        let f = self.eval_f(x);
+        self.eval_g(x, g);
+        f
+    }
+    /// ∇f(x) into `grad` and the Jacobian's values into `jac`, in one evaluation (default:
+    /// [`NumericNlp::eval_grad_f`] then [`NumericNlp::eval_jac_g`]); the values must be
+    /// those of the two apart.
+    fn eval_grad_f_jac_g(&mut self, x: &[f64], grad: &mut [f64], jac: &mut [f64]) {
+        self.eval_grad_f(x, grad);
+        self.eval_jac_g(x, jac);
+    }
     /// Name of variable `i` for messages (default `x[i]`).
     fn variable_name(&self, i: usize) -> String {
         format!("x[{i}]")

@@ -89,6 +89,15 @@ impl PointValues {
         }
     }
 
+    /// The vectors of ∇f and J at `x`, to be written by one evaluation and both marked
+    /// known (as [`PointValues::store`]).
+    pub(crate) fn store_grad_jac(&mut self, x: &[f64]) -> (&mut [f64], &mut [f64]) {
+        self.move_to(x);
+        self.known[Value::Grad.index()] = true;
+        self.known[Value::Jac.index()] = true;
+        (&mut self.grad, &mut self.jac)
+    }
+
     /// f at the point (meaningful when [`PointValues::has`] says so).
     pub(crate) fn f(&self) -> f64 {
         self.f

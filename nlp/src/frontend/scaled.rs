@@ -202,14 +202,29 @@ impl<'a> ScaledNlp<'a> {
     }
 
     /// Makes `value` known at `x` ([`ScaledNlp::values`]): evaluated (unscaled, counted
-    /// and timed) unless it was evaluated at this point (same bits) already.
+    /// and timed) unless it was evaluated at this point (same bits) already. When the
+    /// problem [evaluates pairs together](NumericNlp::evaluates_together), f and g (∇f and
+    /// J) are evaluated, stored and counted together.
     pub fn evaluate(&mut self, value: Value, x: &[f64]) {
         if self.values.has(value, x) {
             return;
         }
         let t = Instant::now();
         let (u, c) = (&mut *self.user, &mut self.counters);
+        let together = u.evaluates_together();
         match value {
+            Value::F | Value::G if together => {
+                let f = u.eval_f_g(x, self.values.store(Value::G, x));
+                self.values.store_f(x, f);
+                c.f += 1;
+                c.g += 1;
+            }
+            Value::Grad | Value::Jac if together => {
+                let (grad, jac) = self.values.store_grad_jac(x);
+                u.eval_grad_f_jac_g(x, grad, jac);
+                c.grad_f += 1;
+                c.jac_g += 1;
+            }
             Value::F => {
                 let f = u.eval_f(x);
                 self.values.store_f(x, f);
@@ -428,10 +443,11 @@ mod tests {
         sc.f(&[2.0, 4.0]);
         sc.g(&x, &mut v);
         assert_eq!(v, [12.0, 203.0 * 0.01]);
+        // A compiled problem evaluates f and g together: each evaluation counts both.
         let c = &sc.counters;
         assert_eq!(
             (c.f, c.grad_f, c.g, c.jac_g),
-            (2, 1, 2, 1),
+            (3, 1, 3, 1),
             "another point between"
         );
         // λ_user = λ̃·s_g/s_f and back; z_user = z/s_f and back.

@@ -556,10 +556,8 @@ impl Rti {
     /// f, ∇f, g, J and ∇²L at the linearisation point.
     fn linearise(&mut self) -> Result<(), RtiError> {
         let (c, it) = (&mut self.compiled, &mut self.it);
-        it.f = c.eval_f(&it.x);
-        c.eval_grad_f(&it.x, &mut it.grad);
-        c.eval_g(&it.x, &mut it.g);
-        c.eval_jac_g(&it.x, &mut it.jv);
+        it.f = c.eval_f_g(&it.x, &mut it.g);
+        c.eval_grad_f_jac_g(&it.x, &mut it.grad, &mut it.jv);
         c.eval_hess_l(&it.x, 1.0, &it.mult.lambda, &mut self.curv.hv);
         let finite = |v: &[f64]| v.iter().all(|a| a.is_finite());
         if !it.f.is_finite() || !finite(&it.grad) || !finite(&it.g) {
