@@ -19,7 +19,7 @@
 //! * only the operations themselves remain on the tape: one byte of opcode and register
 //!   numbers, dispatched by a single `match`, with two operations in a row fused into one
 //!   step where the first's result is a temporary only the second reads (see
-//!   `interpret.rs`: a third to a half fewer steps on derivative tapes).
+//!   `interpret.rs`: about a third fewer steps on a Lagrangian Hessian).
 //!
 //! A call of another compiled function (a `Call` node, see [`Function::apply`]) is one
 //! instruction: it gathers the argument registers into a scratch block at the end of the

@@ -6,8 +6,8 @@
 //! program is the tape with adjacent pairs fused into one step where the first
 //! instruction's result is a temporary read only by the next one: `w[d] = (w[a] ∘ w[b]) •
 //! w[c]` or `w[c] • (w[a] ∘ w[b])` for `∘` one of `+ − ×` and `•` one of `+ − × ÷`.
-//! Derivative tapes are mostly such chains (a Hessian's `a·b + c`,
-//! `a·b − c`, `(a·b)·k`): 35 % of the steps of the cart-pole MPC's Lagrangian Hessian go.
+//! Derivative tapes are full of such chains (a Hessian's `a·b + c`, `a·b − c`, `(a·b)·k`):
+//! the Lagrangian Hessian of one RK4 interval runs its 142 instructions in 93 steps.
 //!
 //! A fused step computes the two operations in the same order with the same roundings
 //! (Rust never contracts `a·b + c` into a fused multiply-add), so its values are the
