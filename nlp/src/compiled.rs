@@ -27,15 +27,15 @@ pub struct Compiled {
     /// only), which [`NumericNlp::check_ready`] reports before a solve.
     params: Vec<f64>,
     parameter_index: ParameterIndex,
-    f_fn: Arc<Function>,
-    grad_fn: Arc<Function>,
-    g_fn: Arc<Function>,
-    jac_fn: Arc<Function>,
     /// f and g in one tape, ∇f and J in one tape: a pair shares its common subexpressions
-    /// (the dynamics of an OCP's constraints are also in its objective's quadrature).
+    /// (the dynamics of an OCP's constraints are also in its objective's quadrature), and
+    /// the solvers need both values of a pair at almost every point. One value alone is
+    /// evaluated with its pair, the other written to a spare vector.
     f_g_fn: Arc<Function>,
     grad_jac_fn: Arc<Function>,
     hess_fn: Arc<Function>,
+    /// Where a single value's evaluation writes the other value of its pair.
+    spare: Spare,
     jac_sparsity: Sparsity,
     hess_sparsity: Sparsity,
     work: Vec<f64>,
@@ -63,6 +63,14 @@ pub struct CompileOptions {
     pub evaluator: Evaluator,
 }
 
+/// Vectors for the value of a pair nobody asked for (see `Compiled::f_g_fn`).
+#[derive(Clone)]
+struct Spare {
+    g: Vec<f64>,
+    grad: Vec<f64>,
+    jac: Vec<f64>,
+}
+
 /// Evaluators of the affine cones' stacked entries `[t; v]` and of their Jacobian.
 struct ConeEvaluators {
     entries: Function,
@@ -84,10 +92,6 @@ impl Compiled {
         let sigma = Expr::sym("obj_factor");
         let lambda = Matrix::sym_vec("lambda", g.len());
         let hess = symx::lagrangian_hessian(f, g, x, sigma, &lambda)?;
-        let f_fn = Function::new(&[x, p], &[&[f]])?;
-        let grad_fn = Function::new(&[x, p], &[&grad])?;
-        let g_fn = Function::new(&[x, p], &[g])?;
-        let jac_fn = Function::new(&[x, p], &[jac.values()])?;
         let f_g_fn = Function::new(&[x, p], &[&[f], g])?;
         let grad_jac_fn = Function::new(&[x, p], &[&grad, jac.values()])?;
         let hess_fn = Function::new(&[x, p, &[sigma], &lambda], &[hess.values()])?;
@@ -112,20 +116,12 @@ impl Compiled {
                 jacobian_sparsity: cj.sparsity().clone(),
             }))
         };
-        let work_size = [
-            &f_fn,
-            &grad_fn,
-            &g_fn,
-            &jac_fn,
-            &f_g_fn,
-            &grad_jac_fn,
-            &hess_fn,
-        ]
-        .into_iter()
-        .chain(cone_fns.iter().flat_map(|c| [&c.entries, &c.jacobian]))
-        .map(|f| f.work_size())
-        .max()
-        .unwrap_or(0);
+        let work_size = [&f_g_fn, &grad_jac_fn, &hess_fn]
+            .into_iter()
+            .chain(cone_fns.iter().flat_map(|c| [&c.entries, &c.jacobian]))
+            .map(|f| f.work_size())
+            .max()
+            .unwrap_or(0);
         Ok(Compiled {
             n: x.len(),
             m: g.len(),
@@ -136,13 +132,14 @@ impl Compiled {
             x0: parts.initial.to_vec(),
             params,
             parameter_index: parts.parameter_index.clone(),
-            f_fn: Arc::new(f_fn),
-            grad_fn: Arc::new(grad_fn),
-            g_fn: Arc::new(g_fn),
-            jac_fn: Arc::new(jac_fn),
             f_g_fn: Arc::new(f_g_fn),
             grad_jac_fn: Arc::new(grad_jac_fn),
             hess_fn: Arc::new(hess_fn),
+            spare: Spare {
+                g: vec![0.0; g.len()],
+                grad: vec![0.0; x.len()],
+                jac: vec![0.0; jac.values().len()],
+            },
             jac_sparsity: jac.sparsity().clone(),
             hess_sparsity: hess.sparsity().clone(),
             work: vec![0.0; work_size],
@@ -178,10 +175,6 @@ impl Compiled {
             return Ok(self);
         }
         let convert = |f: &Function| f.with_evaluator(evaluator).map(Arc::new);
-        self.f_fn = convert(&self.f_fn)?;
-        self.grad_fn = convert(&self.grad_fn)?;
-        self.g_fn = convert(&self.g_fn)?;
-        self.jac_fn = convert(&self.jac_fn)?;
         self.f_g_fn = convert(&self.f_g_fn)?;
         self.grad_jac_fn = convert(&self.grad_jac_fn)?;
         self.hess_fn = convert(&self.hess_fn)?;
@@ -386,18 +379,23 @@ impl NumericNlp for Compiled {
         &self.hess_sparsity
     }
     fn eval_f(&mut self, x: &[f64]) -> f64 {
-        let mut out = [0.0];
-        Compiled::eval(&self.f_fn, &[x, &self.params], &mut out, &mut self.work);
-        out[0]
+        let mut g = std::mem::take(&mut self.spare.g);
+        let f = self.eval_f_g(x, &mut g);
+        self.spare.g = g;
+        f
     }
     fn eval_grad_f(&mut self, x: &[f64], grad: &mut [f64]) {
-        Compiled::eval(&self.grad_fn, &[x, &self.params], grad, &mut self.work);
+        let mut jac = std::mem::take(&mut self.spare.jac);
+        self.eval_grad_f_jac_g(x, grad, &mut jac);
+        self.spare.jac = jac;
     }
     fn eval_g(&mut self, x: &[f64], g: &mut [f64]) {
-        Compiled::eval(&self.g_fn, &[x, &self.params], g, &mut self.work);
+        self.eval_f_g(x, g);
     }
     fn eval_jac_g(&mut self, x: &[f64], values: &mut [f64]) {
-        Compiled::eval(&self.jac_fn, &[x, &self.params], values, &mut self.work);
+        let mut grad = std::mem::take(&mut self.spare.grad);
+        self.eval_grad_f_jac_g(x, &mut grad, values);
+        self.spare.grad = grad;
     }
     fn evaluates_together(&self) -> bool {
         true
