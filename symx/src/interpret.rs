@@ -162,47 +162,54 @@ impl Code {
         }
     }
 
-    /// Whether this code runs two instructions.
-    fn is_fused(self) -> bool {
-        self as u8 >= Code::AddAdd as u8
-    }
-
     /// The step computing `second(first(w[a], w[b]), w[c])` (`rev`: `second(w[c], …)`),
     /// or `None` if that pair has no step.
     fn fused(first: Op, second: Op, rev: bool) -> Option<Code> {
-        use Code::*;
-        const TABLE: [[[Code; 4]; 3]; 2] = [
-            [
-                [AddAdd, AddSub, AddMul, AddDiv],
-                [SubAdd, SubSub, SubMul, SubDiv],
-                [MulAdd, MulSub, MulMul, MulDiv],
-            ],
-            [
-                [AddAddRev, AddSubRev, AddMulRev, AddDivRev],
-                [SubAddRev, SubSubRev, SubMulRev, SubDivRev],
-                [MulAddRev, MulSubRev, MulMulRev, MulDivRev],
-            ],
-        ];
-        let i = [Op::Add, Op::Sub, Op::Mul]
-            .iter()
-            .position(|&o| o == first)?;
-        let j = [Op::Add, Op::Sub, Op::Mul, Op::Div]
-            .iter()
-            .position(|&o| o == second)?;
-        Some(TABLE[usize::from(rev)][i][j])
+        let i = FIRST.iter().position(|&o| o == first)?;
+        let j = SECOND.iter().position(|&o| o == second)?;
+        Some(FUSED[usize::from(rev)][i][j])
+    }
+
+    /// The `(first, second, rev)` a fused code runs ([`Code::fused`] inverted).
+    fn pair(self) -> Option<(Op, Op, bool)> {
+        (0..2).find_map(|rev| {
+            (0..FIRST.len()).find_map(|i| {
+                (0..SECOND.len())
+                    .find(|&j| FUSED[rev][i][j] == self)
+                    .map(|j| (FIRST[i], SECOND[j], rev == 1))
+            })
+        })
     }
 }
 
+/// The first operations a fused step can run, the second ones, and the code of each pair
+/// (`FUSED[rev][first][second]`).
+const FIRST: [Op; 3] = [Op::Add, Op::Sub, Op::Mul];
+const SECOND: [Op; 4] = [Op::Add, Op::Sub, Op::Mul, Op::Div];
+const FUSED: [[[Code; 4]; 3]; 2] = {
+    use Code::*;
+    [
+        [
+            [AddAdd, AddSub, AddMul, AddDiv],
+            [SubAdd, SubSub, SubMul, SubDiv],
+            [MulAdd, MulSub, MulMul, MulDiv],
+        ],
+        [
+            [AddAddRev, AddSubRev, AddMulRev, AddDivRev],
+            [SubAddRev, SubSubRev, SubMulRev, SubDivRev],
+            [MulAddRev, MulSubRev, MulMulRev, MulDivRev],
+        ],
+    ]
+};
+
 /// One step of the program: `w[d] = code(w[a], w[b], w[c])`, registers (and table or
-/// call indices) as in the tape's [`Instr`]. A fused pair also records what the tape's two
-/// instructions were: the first (operation `first`) wrote `w[t]`, the second (`second`)
-/// read it on the left (or on the right, `rev`) of its other operand `w[c]`.
+/// call indices) as in the tape's [`Instr`]; `op` is the instruction's operation (the code
+/// of a fused pair says both). A fused pair also records the register `t` its first
+/// instruction wrote, which its second read beside its other operand `w[c]`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Step {
     code: Code,
-    first: Op,
-    second: Op,
-    rev: bool,
+    op: Op,
     d: u32,
     a: u32,
     b: u32,
@@ -248,9 +255,7 @@ impl Tape {
                 None => {
                     steps.push(Step {
                         code: Code::plain(ins.op),
-                        first: ins.op,
-                        second: ins.op,
-                        rev: false,
+                        op: ins.op,
                         d: ins.d,
                         a: ins.a,
                         b: ins.b,
@@ -293,11 +298,11 @@ impl std::ops::Deref for Tape {
 impl Step {
     /// The one or two instructions this step runs (the first `n` of the array).
     fn instrs(&self) -> ([Instr; 2], usize) {
-        let op = self.first;
         let (d, a, b, c) = (self.d, self.a, self.b, self.c);
-        if !self.code.is_fused() {
+        let Some((op, second, rev)) = self.code.pair() else {
+            let op = self.op;
             return ([Instr { op, d, a, b, c }; 2], 1);
-        }
+        };
         let (t, o) = (self.t, self.c);
         let first = Instr {
             op,
@@ -306,8 +311,8 @@ impl Step {
             b,
             c: a,
         };
-        let (a, b, c) = if self.rev { (o, t, o) } else { (t, o, t) };
-        let op = self.second;
+        let (a, b, c) = if rev { (o, t, o) } else { (t, o, t) };
+        let op = second;
         ([first, Instr { op, d, a, b, c }], 2)
     }
 }
@@ -328,9 +333,7 @@ fn fuse(first: Instr, second: Instr) -> Option<Step> {
     };
     Some(Step {
         code: Code::fused(first.op, second.op, rev)?,
-        first: first.op,
-        second: second.op,
-        rev,
+        op: first.op,
         d: second.d,
         a: first.a,
         b: first.b,
@@ -547,7 +550,10 @@ mod tests {
     }
 
     fn fused_steps(tape: &Tape) -> usize {
-        tape.steps.iter().filter(|s| s.code.is_fused()).count()
+        tape.steps
+            .iter()
+            .filter(|s| s.code.pair().is_some())
+            .count()
     }
 
     fn same(a: &[Instr], b: &[Instr]) -> bool {
