@@ -30,7 +30,8 @@ use crate::crossing_search::{self, Searched};
 use crate::gait;
 use crate::scenario::Scenario;
 use crate::solve::{
-    objective_without_10, search_from, solve_scheduled, PlanningError, Settings, Solved, Stop,
+    guess_with_optimal_stances, objective_without_10, search_from, solve_scheduled, PlanningError,
+    Settings, Solved, Stop,
 };
 use crate::terrain::Terrain;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -182,17 +183,19 @@ fn crawl_thread(
     race: &Race,
 ) -> (Result<Solved, PlanningError>, ByCrawl) {
     let schedule = gait::crawl_schedule(s.n_step);
-    let guess = gait::crawl(s);
     let name = "free gait: crawl schedule";
-    let solved = solve_scheduled(
-        s,
-        terrain,
-        &schedule,
-        &guess,
-        settings,
-        name,
-        Stop::default(),
-    );
+    let solved =
+        guess_with_optimal_stances(s, terrain, settings, gait::crawl_plan(s)).and_then(|guess| {
+            solve_scheduled(
+                s,
+                terrain,
+                &schedule,
+                &guess,
+                settings,
+                name,
+                Stop::default(),
+            )
+        });
     let verdict = solved.as_ref().ok().and_then(|r| r.run.verdict());
     let (Some(start), Ok(crawl)) = (race.crawl_finished(verdict), &solved) else {
         return (solved, None);
@@ -218,17 +221,19 @@ fn pair_thread(
 ) -> (Result<Solved, PlanningError>, ByPair) {
     let schedule = gait::pair_schedule(s.n_step);
     let footholds = gait::footholds_for_schedule(s, &schedule);
-    let guess = gait::plan_for_footholds(s, &footholds).to_flat();
     let name = "free gait: biped-pair schedule";
-    let solved = solve_scheduled(
-        s,
-        terrain,
-        &schedule,
-        &guess,
-        candidate,
-        name,
-        Stop::default(),
-    );
+    let plan = gait::plan_for_footholds(s, &footholds);
+    let solved = guess_with_optimal_stances(s, terrain, candidate, plan).and_then(|guess| {
+        solve_scheduled(
+            s,
+            terrain,
+            &schedule,
+            &guess,
+            candidate,
+            name,
+            Stop::default(),
+        )
+    });
     let Ok(pair) = &solved else {
         race.pair_finished(None, Vec::new());
         return (solved, (None, None));

@@ -124,6 +124,26 @@ impl StanceSolver {
     }
 }
 
+impl StanceSolver {
+    /// Replaces the CoMs and forces of every stance of `plan` but the first (the start)
+    /// by the least-cost ones for that stance's feet ([`StanceSolver::solve`], from the
+    /// stance's own): with the feet fixed, the problem separates by stance, so the
+    /// footholds of a heuristic guess get CoMs and forces that satisfy (2), (4) and (11)
+    /// at a local minimum of their terms of (1). A stance whose solve fails keeps its
+    /// own. Returns how many stances were replaced.
+    pub fn optimise_stances(&mut self, s: &Scenario, plan: &mut Plan) -> usize {
+        let mut replaced = 0;
+        for k in 1..plan.stances.len() {
+            let stance = plan.stances[k];
+            if let Some((better, _)) = self.solve(s, &stance.feet, &stance) {
+                plan.stances[k] = better;
+                replaced += 1;
+            }
+        }
+        replaced
+    }
+}
+
 /// The terms of cost (1) of one stance.
 pub fn stance_cost(s: &Scenario, st: &Stance) -> f64 {
     Plan { stances: vec![*st] }.cost(s)
