@@ -2,7 +2,8 @@
 //! and the verdict ([`decide`]: solved, or why not, as a [`PlanStatus`]).
 //!
 //! - `crawl` gait: one solve of the scheduled problem (order BR, FR, BL, FL), from the
-//!   crawl-gait heuristic.
+//!   crawl-gait heuristic's footholds with each stance's least-cost CoMs and forces
+//!   (`guess_with_optimal_stances`), then the crossing search.
 //! - `free` gait: the optimiser picks which foot moves at each transition, (10). Every
 //!   solve is of a scheduled problem (non-moving feet share variables), so (10) holds
 //!   exactly in every candidate, and the plan is the best of:
