@@ -14,10 +14,16 @@
 //!   schedule search from its result if the pair plan is by then known to be the better;
 //! - the crawl thread, once its plan is solved and the pair plan is known to be the
 //!   better, runs the schedule search from the crawl plan and the reference (the other
-//!   chain of `solve::chains`).
+//!   chain of `solve::chains`); when the pair solve is still running, it starts the
+//!   schedule search from the crawl plan *speculatively* (needed when the pair plan wins)
+//!   and the reference after it if the pair plan has won by then. Without this, a crawl
+//!   solve ending first left its thread idle until the pair thread's whole chain had run
+//!   (since the crawl and pair solves start from the least-cost stances, 101 and 87
+//!   iterations, either may end first: one default run in three took 1.03 s instead of
+//!   0.77 s).
 //!
 //! [`Race`] keeps the two verdicts: as soon as both are known and the crawl plan is the
-//! better one, the speculative search is cancelled (its solves stop at their next
+//! better one, the speculative searches are cancelled (their solves stop at their next
 //! iteration) and discarded, and everything then runs after the first phase as before.
 //! Whatever was not started early runs there too.
 //!
@@ -69,15 +75,26 @@ struct Shared {
 
 impl Race {
     /// Records the crawl solve's verdict; cancels the speculation if the pair solve has
-    /// ended and lost. Returns the pair plan (flat) when the pair solve has ended and
-    /// its plan is the better one: the crawl thread's chain may start.
-    pub(crate) fn crawl_finished(&self, crawl: Verdict) -> Option<Vec<f64>> {
+    /// ended and lost. Says what the crawl thread may start.
+    pub(crate) fn crawl_finished(&self, crawl: Verdict) -> AfterCrawl {
         let mut v = self.lock();
         v.crawl = Some(crawl);
-        let pair = v.pair?;
-        self.settle(pair, crawl)
-            .then(|| v.pair_plan.clone())
-            .flatten()
+        let Some(pair) = v.pair else {
+            return AfterCrawl::PairPending;
+        };
+        match v.pair_plan.clone() {
+            Some(plan) if self.settle(pair, crawl) => AfterCrawl::PairBetter(plan),
+            _ => AfterCrawl::Nothing,
+        }
+    }
+
+    /// The pair plan (flat) if both solves have ended and it is the better one.
+    pub(crate) fn pair_plan_if_better(&self) -> Option<Vec<f64>> {
+        let v = self.lock();
+        match (v.pair, v.crawl) {
+            (Some(p), Some(c)) if pair_better(p, c) => v.pair_plan.clone(),
+            _ => None,
+        }
     }
 
     /// Records the pair solve's verdict and plan; whether the speculative crossing
@@ -120,6 +137,19 @@ impl Race {
     }
 }
 
+/// What the crawl thread may start once its solve has ended ([`Race::crawl_finished`]).
+#[derive(Debug, PartialEq)]
+pub(crate) enum AfterCrawl {
+    /// The pair plan is known to be the better one: its plan (flat), the reference's
+    /// start.
+    PairBetter(Vec<f64>),
+    /// The pair solve is still running: the crawl thread speculates that its plan will
+    /// be the better one.
+    PairPending,
+    /// The crawl plan is the better one, or the pair solve failed: nothing.
+    Nothing,
+}
+
 /// The later work done early, all of it for the case that the pair plan is the better
 /// one (empty otherwise): what `solve::chains` then does not run again.
 #[derive(Default)]
@@ -128,14 +158,19 @@ pub(crate) struct Early {
     pub(crate) crossed: Option<Searched>,
     /// The schedule search from the crossing search's result.
     pub(crate) from_better: Option<Vec<Solved>>,
-    /// The schedule search from the crawl plan and the reference without (10).
-    pub(crate) from_worse_and_reference: Option<(Vec<Solved>, Option<f64>)>,
+    /// The schedule search from the crawl plan.
+    pub(crate) from_worse: Option<Vec<Solved>>,
+    /// The reference without (10).
+    pub(crate) reference: Option<Option<f64>>,
 }
 
-type ByCrawl = Option<(
-    Result<Vec<Solved>, PlanningError>,
-    Result<Option<f64>, PlanningError>,
-)>;
+/// The crawl thread's early work: the schedule search from the crawl plan, the
+/// reference without (10).
+#[derive(Default)]
+struct ByCrawl {
+    searched: Option<Result<Vec<Solved>, PlanningError>>,
+    reference: Option<Result<Option<f64>, PlanningError>>,
+}
 type ByPair = (
     Option<Result<Searched, PlanningError>>,
     Option<Result<Vec<Solved>, PlanningError>>,
@@ -161,20 +196,19 @@ pub(crate) fn first_phase(
         return Ok((crawl, pair, Early::default()));
     }
     let (crossed, from_better) = by_pair;
-    let from_worse_and_reference = match by_crawl {
-        Some((searched, reference)) => Some((searched?, reference?)),
-        None => None,
-    };
     let early = Early {
         crossed: crossed.transpose()?,
         from_better: from_better.transpose()?,
-        from_worse_and_reference,
+        from_worse: by_crawl.searched.transpose()?,
+        reference: by_crawl.reference.transpose()?,
     };
     Ok((crawl, pair, early))
 }
 
 /// The crawl schedule's solve, then (pair plan known better) the schedule search from
-/// the crawl plan ‖ the reference from the pair plan.
+/// the crawl plan ‖ the reference from the pair plan, or (pair solve still running) the
+/// speculative schedule search from the crawl plan, then the reference if the pair plan
+/// has won by then.
 fn crawl_thread(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
@@ -197,17 +231,38 @@ fn crawl_thread(
             )
         });
     let verdict = solved.as_ref().ok().and_then(|r| r.run.verdict());
-    let (Some(start), Ok(crawl)) = (race.crawl_finished(verdict), &solved) else {
-        return (solved, None);
+    let next = race.crawl_finished(verdict);
+    let Ok(crawl) = &solved else {
+        return (solved, ByCrawl::default());
     };
     if !crawl.run.solution.status.is_success() {
-        return (solved, None);
+        return (solved, ByCrawl::default());
     }
-    let more = rayon::join(
-        || search_from(s, terrain, candidate, &crawl.run, "crawl"),
-        || objective_without_10(s, terrain, &start, candidate),
-    );
-    (solved, Some(more))
+    let by_crawl = match next {
+        AfterCrawl::PairBetter(start) => {
+            let (searched, reference) = rayon::join(
+                || search_from(s, terrain, candidate, &crawl.run, "crawl", None),
+                || objective_without_10(s, terrain, &start, candidate),
+            );
+            ByCrawl {
+                searched: Some(searched),
+                reference: Some(reference),
+            }
+        }
+        AfterCrawl::PairPending => {
+            let cancel = Some(&race.cancel);
+            let searched = search_from(s, terrain, candidate, &crawl.run, "crawl", cancel);
+            let reference = race
+                .pair_plan_if_better()
+                .map(|start| objective_without_10(s, terrain, &start, candidate));
+            ByCrawl {
+                searched: Some(searched),
+                reference,
+            }
+        }
+        AfterCrawl::Nothing => ByCrawl::default(),
+    };
+    (solved, by_crawl)
 }
 
 /// The pair schedule's solve, then the speculative crossing search from its plan, then
@@ -245,7 +300,7 @@ fn pair_thread(
     let from_better = match &crossed {
         Ok(c) if !race.cancelled() && race.pair_known_better() => {
             let from = c.best_run().unwrap_or(&pair.run);
-            Some(search_from(s, terrain, candidate, from, "biped-pair"))
+            Some(search_from(s, terrain, candidate, from, "biped-pair", None))
         }
         _ => None,
     };
@@ -254,7 +309,7 @@ fn pair_thread(
 
 #[cfg(test)]
 mod tests {
-    use super::{pair_better, Race};
+    use super::{pair_better, AfterCrawl, Race};
 
     #[test]
     fn pair_better_follows_the_rule_of_beats() {
@@ -276,28 +331,34 @@ mod tests {
         let r = Race::default();
         assert!(r.pair_finished(Some(1.0), plan()));
         assert!(!r.pair_known_better());
-        assert_eq!(r.crawl_finished(Some(2.0)), Some(plan()));
+        assert_eq!(r.crawl_finished(Some(2.0)), AfterCrawl::PairBetter(plan()));
         assert!(!r.cancelled());
         assert!(r.pair_known_better());
         // Pair first, then a better crawl plan: cancelled, the crawl thread stops.
         let r = Race::default();
         assert!(r.pair_finished(Some(2.0), plan()));
-        assert_eq!(r.crawl_finished(Some(1.0)), None);
+        assert_eq!(r.crawl_finished(Some(1.0)), AfterCrawl::Nothing);
         assert!(r.cancelled());
         assert!(!r.pair_known_better());
-        // Crawl first and better: the speculation does not start.
+        // Crawl first and better: both speculations start (the pair one does not, the
+        // crawl thread's is cancelled once the pair plan loses).
         let r = Race::default();
-        assert_eq!(r.crawl_finished(Some(1.0)), None);
+        assert_eq!(r.crawl_finished(Some(1.0)), AfterCrawl::PairPending);
+        assert_eq!(r.pair_plan_if_better(), None);
         assert!(!r.pair_finished(Some(2.0), plan()));
-        // Crawl first and worse: it starts (the crawl thread has ended: nothing more).
+        assert!(r.cancelled());
+        assert_eq!(r.pair_plan_if_better(), None);
+        // Crawl first and worse: the crawl thread speculates, the pair thread's search
+        // starts, nothing is cancelled and the reference may then start from the pair plan.
         let r = Race::default();
-        assert_eq!(r.crawl_finished(Some(3.0)), None);
+        assert_eq!(r.crawl_finished(Some(3.0)), AfterCrawl::PairPending);
         assert!(r.pair_finished(Some(2.0), plan()));
         assert!(!r.cancelled());
         assert!(r.pair_known_better());
+        assert_eq!(r.pair_plan_if_better(), Some(plan()));
         // The pair solve failed: nothing starts.
         let r = Race::default();
         assert!(!r.pair_finished(None, Vec::new()));
-        assert_eq!(r.crawl_finished(Some(1.0)), None);
+        assert_eq!(r.crawl_finished(Some(1.0)), AfterCrawl::Nothing);
     }
 }

@@ -204,12 +204,6 @@ pub(crate) struct Stop<'a> {
 }
 
 impl Stop<'_> {
-    /// Stop on a stall only.
-    pub(crate) const STALL: Stop<'static> = Stop {
-        on_stall: true,
-        cancel: None,
-    };
-
     /// Whether the flag [`Stop::cancel`] is set.
     pub(crate) fn cancelled(&self) -> bool {
         self.cancel.is_some_and(|c| c.load(Ordering::SeqCst))
@@ -581,7 +575,7 @@ pub fn plan_warm(
         return finish(s, settings, last, None, phases, started);
     }
     let mut best = last;
-    for solved in search_from(s, terrain, &settings.candidate(), &best, "re-plan")? {
+    for solved in search_from(s, terrain, &settings.candidate(), &best, "re-plan", None)? {
         let next = record(solved, settings, &mut phases);
         if next.beats(&best) {
             best = next;
@@ -815,7 +809,8 @@ fn chains(
     let Early {
         crossed,
         from_better,
-        from_worse_and_reference,
+        from_worse,
+        reference,
     } = early;
     let (better_chain, other_chain) = rayon::join(
         || -> Result<_, PlanningError> {
@@ -827,18 +822,21 @@ fn chains(
                 Some(searched) => searched,
                 None => {
                     let from = crossed.best_run().unwrap_or(better);
-                    search_from(s, terrain, candidate, from, better_label)?
+                    search_from(s, terrain, candidate, from, better_label, None)?
                 }
             };
             Ok((crossed, searched))
         },
         || -> Result<_, PlanningError> {
-            if let Some(done) = from_worse_and_reference {
-                return Ok(done);
-            }
             let (from_worse, reference) = rayon::join(
-                || search_from(s, terrain, candidate, worse, worse_label),
-                || objective_without_10(s, terrain, reference_start, candidate),
+                || match from_worse {
+                    Some(done) => Ok(done),
+                    None => search_from(s, terrain, candidate, worse, worse_label, None),
+                },
+                || match reference {
+                    Some(done) => Ok(done),
+                    None => objective_without_10(s, terrain, reference_start, candidate),
+                },
             );
             Ok((from_worse?, reference?))
         },
@@ -861,13 +859,16 @@ fn pair_run_or(crawl: Run, pair: Run) -> Run {
 /// round's proposal satisfies every equation of its schedule with a lower cost; its
 /// re-solve frees every variable. Stops when no proposal improves, a re-solve does not
 /// beat the plan it started from, or after [`SEARCH_ROUNDS`] rounds. Nothing when
-/// `from` failed.
+/// `from` failed. Once `cancel` is set (a speculative search, [`crate::early_start`])
+/// its re-solve stops and no further round starts: the result is then incomplete and
+/// must be discarded.
 pub(crate) fn search_from(
     s: &Scenario,
     terrain: &(dyn Terrain + Sync),
     candidate: &Settings,
     from: &Run,
     label: &str,
+    cancel: Option<&AtomicBool>,
 ) -> Result<Vec<Solved>, PlanningError> {
     let mut out: Vec<Solved> = Vec::new();
     if !from.solution.status.is_success() {
@@ -876,7 +877,14 @@ pub(crate) fn search_from(
     let search_settings = candidate.warm();
     let mut stance_solver = stance_solver(s, terrain, candidate)?;
     let mut best = from;
+    let stop = Stop {
+        on_stall: true,
+        cancel,
+    };
     for round in 1..=SEARCH_ROUNDS {
+        if stop.cancelled() {
+            break;
+        }
         let Some(proposal) =
             schedule_search::propose(s, &mut stance_solver, &best.plan, &best.schedule)
         else {
@@ -894,7 +902,7 @@ pub(crate) fn search_from(
                 if proposal.changed == 1 { "" } else { "s" },
                 proposal.evaluated
             ),
-            Stop::STALL,
+            stop,
         )?;
         let improved = next.run.beats(best);
         out.push(next);
