@@ -130,12 +130,22 @@ impl StanceSolver {
     /// stance's own): with the feet fixed, the problem separates by stance, so the
     /// footholds of a heuristic guess get CoMs and forces that satisfy (2), (4) and (11)
     /// at a local minimum of their terms of (1). A stance whose solve fails keeps its
-    /// own. Returns how many stances were replaced.
+    /// own. A stance equal to the one before it as it was (a robot standing at its goal)
+    /// is the same problem from the same start: it takes that stance's result without a
+    /// solve. Returns how many stances were replaced.
     pub fn optimise_stances(&mut self, s: &Scenario, plan: &mut Plan) -> usize {
         let mut replaced = 0;
+        let mut previous: Option<(Stance, Option<Stance>)> = None;
         for k in 1..plan.stances.len() {
             let stance = plan.stances[k];
-            if let Some((better, _)) = self.solve(s, &stance.feet, &stance) {
+            let result = match previous {
+                Some((before, result)) if before == stance => result,
+                _ => self
+                    .solve(s, &stance.feet, &stance)
+                    .map(|(better, _)| better),
+            };
+            previous = Some((stance, result));
+            if let Some(better) = result {
                 plan.stances[k] = better;
                 replaced += 1;
             }
