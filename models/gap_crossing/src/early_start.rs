@@ -340,8 +340,9 @@ mod tests {
         assert_eq!(r.crawl_finished(Some(1.0)), AfterCrawl::Nothing);
         assert!(r.cancelled());
         assert!(!r.pair_known_better());
-        // Crawl first and better: both speculations start (the pair one does not, the
-        // crawl thread's is cancelled once the pair plan loses).
+        // Crawl first and better: the crawl thread speculates, the pair thread's
+        // speculation does not start, and the crawl thread's is cancelled when the pair
+        // plan loses.
         let r = Race::default();
         assert_eq!(r.crawl_finished(Some(1.0)), AfterCrawl::PairPending);
         assert_eq!(r.pair_plan_if_better(), None);

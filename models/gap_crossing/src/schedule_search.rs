@@ -122,9 +122,7 @@ impl StanceSolver {
         };
         Some((stance, stance_cost(s, &stance)))
     }
-}
 
-impl StanceSolver {
     /// Replaces the CoMs and forces of every stance of `plan` but the first (the start)
     /// by the least-cost ones for that stance's feet ([`StanceSolver::solve`], from the
     /// stance's own): with the feet fixed, the problem separates by stance, so the
