@@ -58,6 +58,9 @@ pub struct StanceSolver {
     /// The last successful solve: its multipliers warm-start the next one
     /// ([`StanceSolver::solve`]).
     last: Option<Solution>,
+    /// Where a warm solve writes its result (swapped with `last`, so that a solve
+    /// allocates nothing after the first).
+    next: Option<Solution>,
 }
 
 impl StanceSolver {
@@ -89,6 +92,7 @@ impl StanceSolver {
             solver: settings.solver(),
             settings,
             last: None,
+            next: None,
         })
     }
 
@@ -116,18 +120,27 @@ impl StanceSolver {
             x0.extend_from_slice(&f);
         }
         self.compiled.set_initial_point(&x0).ok()?;
-        let warm = self.last.take().and_then(|mut previous| {
-            previous.x.copy_from_slice(&x0);
-            self.solver.solve_warm(&mut self.compiled, &previous).ok()
-        });
-        let sol = match warm {
-            Some(sol) if sol.status.is_success() => sol,
-            _ => self.solver.solve(&mut self.compiled).ok()?,
+        let warm = match self.last.as_mut() {
+            Some(previous) => {
+                previous.x.copy_from_slice(&x0);
+                let next = self.next.get_or_insert_with(|| previous.clone());
+                self.solver
+                    .solve_warm_into(&mut self.compiled, previous, next)
+                    .is_ok()
+                    && next.status.is_success()
+            }
+            None => false,
         };
+        if warm {
+            std::mem::swap(&mut self.last, &mut self.next);
+        } else {
+            self.last = Some(self.solver.solve(&mut self.compiled).ok()?);
+        }
+        let sol = self.last.as_ref().expect("just solved");
         if !sol.status.is_success() {
+            self.last = None;
             return None;
         }
-        self.last = Some(sol.clone());
         let x = self
             .problem
             .evaluate(self.problem.variables(), &sol.x)
