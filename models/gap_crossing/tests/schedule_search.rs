@@ -223,8 +223,8 @@ fn stance_solver_reproduces_a_solved_stance() {
 /// With the feet held at the specification's crawl footholds, the least-cost CoMs and
 /// forces of every stance (`StanceSolver::optimise_stances`, the starting guess of the
 /// crawl and biped-pair solves) make a plan that passes the independent checker, with the
-/// cost the specification gives for exactly this problem: "about 1.985e5" (shared spec,
-/// "The start configuration…"; our docs/gap-crossing.md, "Design choices").
+/// cost the specification gives for exactly this problem: "about 1.985e5" (quoted in
+/// docs/gap-crossing.md, "Free gait strategy").
 #[test]
 fn optimal_stances_on_the_crawl_footholds_cost_what_the_spec_says() {
     let s = Scenario::default();
