@@ -36,8 +36,7 @@ use crate::crossing_search::{self, Searched};
 use crate::gait;
 use crate::scenario::Scenario;
 use crate::solve::{
-    guess_with_optimal_stances, objective_without_10, search_from, solve_scheduled, PlanningError,
-    Settings, Solved, Stop,
+    objective_without_10, search_from, solve_from_footholds, PlanningError, Settings, Solved,
 };
 use crate::terrain::Terrain;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -218,18 +217,7 @@ fn crawl_thread(
 ) -> (Result<Solved, PlanningError>, ByCrawl) {
     let schedule = gait::crawl_schedule(s.n_step);
     let name = "free gait: crawl schedule";
-    let solved =
-        guess_with_optimal_stances(s, terrain, settings, gait::crawl_plan(s)).and_then(|guess| {
-            solve_scheduled(
-                s,
-                terrain,
-                &schedule,
-                &guess,
-                settings,
-                name,
-                Stop::default(),
-            )
-        });
+    let solved = solve_from_footholds(s, terrain, &schedule, gait::crawl_plan(s), settings, name);
     let verdict = solved.as_ref().ok().and_then(|r| r.run.verdict());
     let next = race.crawl_finished(verdict);
     let Ok(crawl) = &solved else {
@@ -278,17 +266,7 @@ fn pair_thread(
     let footholds = gait::footholds_for_schedule(s, &schedule);
     let name = "free gait: biped-pair schedule";
     let plan = gait::plan_for_footholds(s, &footholds);
-    let solved = guess_with_optimal_stances(s, terrain, candidate, plan).and_then(|guess| {
-        solve_scheduled(
-            s,
-            terrain,
-            &schedule,
-            &guess,
-            candidate,
-            name,
-            Stop::default(),
-        )
-    });
+    let solved = solve_from_footholds(s, terrain, &schedule, plan, candidate, name);
     let Ok(pair) = &solved else {
         race.pair_finished(None, Vec::new());
         return (solved, (None, None));

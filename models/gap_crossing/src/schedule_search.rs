@@ -111,18 +111,17 @@ impl StanceSolver {
     /// solved again from `start` alone if that fails. On the default scenario this takes
     /// the stance solves from 24.4 to 13.4 iterations on average, same plans.
     pub fn solve(&mut self, s: &Scenario, feet: &Feet, start: &Stance) -> Option<(Stance, f64)> {
-        let p: Vec<f64> = feet.to_array().iter().flatten().copied().collect();
-        self.compiled.set_value(STANCE_FEET, &p).ok()?;
-        let mut x0 = Vec::with_capacity(18);
-        x0.extend_from_slice(&start.com.b);
-        x0.extend_from_slice(&start.com.f);
-        for f in start.forces.to_array() {
-            x0.extend_from_slice(&f);
-        }
-        self.compiled.set_initial_point(&x0).ok()?;
+        let p = feet.to_array();
+        self.compiled
+            .set_value(STANCE_FEET, p.as_flattened())
+            .ok()?;
+        let [f0, f1, f2, f3] = start.forces.to_array();
+        let x0 = [start.com.b, start.com.f, f0, f1, f2, f3];
+        let x0 = x0.as_flattened();
+        self.compiled.set_initial_point(x0).ok()?;
         let warm = match self.last.as_mut() {
             Some(previous) => {
-                previous.x.copy_from_slice(&x0);
+                previous.x.copy_from_slice(x0);
                 let next = self.next.get_or_insert_with(|| previous.clone());
                 self.solver
                     .solve_warm_into(&mut self.compiled, previous, next)
