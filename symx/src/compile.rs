@@ -98,6 +98,24 @@ fn order(g: &Graph, outputs: &[&[Expr]], loc: &mut Locals) -> Result<Order, Symx
     Ok(o)
 }
 
+/// Reorders the depth-first `steps` so that equal operations run back to back
+/// ([`crate::schedule::group`]).
+fn regroup(outputs: &[&[Expr]], loc: &Locals, steps: &mut Vec<u32>, step_nodes: &mut Vec<Node>) {
+    let mut position = vec![u32::MAX; loc.register.len()];
+    for (s, &id) in steps.iter().enumerate() {
+        position[loc.local(id)] = s as u32;
+    }
+    let step_of = |id: u32| {
+        let p = position[loc.local(id)];
+        (p != u32::MAX).then_some(p as usize)
+    };
+    let output_steps = outputs
+        .iter()
+        .flat_map(|y| y.iter())
+        .filter_map(|e| step_of(e.id));
+    crate::schedule::group(steps, step_nodes, step_of, output_steps);
+}
+
 /// Tables and called functions referenced by a tape, each listed once.
 #[derive(Default)]
 struct Externals {
@@ -145,11 +163,12 @@ pub(crate) fn compile(
     }
     let mut input_used = vec![false; inputs.len()];
     let Order {
-        steps,
-        step_nodes,
+        mut steps,
+        mut step_nodes,
         const_ids,
         constants,
     } = order(g, outputs, &mut loc)?;
+    regroup(outputs, &loc, &mut steps, &mut step_nodes);
 
     // Constants, then output slots.
     let template_start = next;

@@ -1,9 +1,12 @@
 //! [`Function`]: expressions compiled to a flat instruction tape.
 //!
 //! Compilation orders the needed nodes depth-first from each output (so values are
-//! consumed soon after they are produced), gives each node a register, and frees a
-//! register after its last use so that later nodes reuse it (liveness-based allocation, as
-//! CasADi's SX virtual machine does). Common subexpressions are already single nodes of
+//! consumed soon after they are produced), regroups that order window by window so that
+//! equal operations run back to back (`schedule.rs`: the interpreter's dispatch then
+//! predicts its jumps; about 2× faster on a Lagrangian Hessian; native code is generated
+//! from the depth-first order), gives each node a register, and frees a register after
+//! its last use so that later nodes reuse it (liveness-based allocation, as CasADi's SX
+//! virtual machine does). Common subexpressions are already single nodes of
 //! the graph, so each is evaluated once. The compiled function owns no graph handles: it is
 //! `Send + Sync`, and evaluation writes only into the caller's work vector.
 //!
@@ -248,9 +251,53 @@ impl Function {
             return Ok(self.clone());
         }
         self.refuse_external("jit")?;
-        let code = native::compile(self)?;
+        let source = self.for_native();
+        let code = native::compile(&source)?;
         Ok(Function {
             native: Some(Arc::new(code)),
+            ..self.clone()
+        })
+    }
+
+    /// This function as native code is generated from it: its tape in depth-first order
+    /// ([`crate::schedule::depth_first`]), and so are its callees'; itself when nothing
+    /// changes. The work size stays: a tape whose depth-first order needs more registers
+    /// than its grouped order (it happens on small functions: 110 against 107 on one
+    /// corpus Hessian) keeps the grouped order, so that a work vector sized for a
+    /// function fits its native form too.
+    pub(crate) fn for_native(&self) -> std::borrow::Cow<'_, Function> {
+        use std::borrow::Cow;
+        if !self.calls.is_empty() {
+            // Calls are never regrouped (`schedule::group`): only the callees change.
+            let calls = self
+                .calls
+                .iter()
+                .map(|c| crate::call::CallInstr {
+                    function: Arc::new(c.function.for_native().into_owned()),
+                    args: c.args.clone(),
+                    out: c.out,
+                })
+                .collect();
+            return Cow::Owned(Function {
+                calls,
+                ..self.clone()
+            });
+        }
+        let Some((instrs, work_size)) = crate::schedule::depth_first(self)
+            .filter(|&(_, work_size)| work_size <= self.work_size)
+        else {
+            return Cow::Borrowed(self);
+        };
+        let outputs = self
+            .output_offsets
+            .iter()
+            .zip(&self.output_sizes)
+            .map(|(&at, &n)| at..at + n);
+        // Without calls, the callees' scratch block after the temporaries is empty.
+        Cow::Owned(Function {
+            tape: Tape::new(instrs, &[], work_size, outputs),
+            work_size,
+            call_scratch: work_size,
             ..self.clone()
         })
     }

@@ -18,6 +18,9 @@
 //! `−(w[a] ∘ w[b])` is not fused (the negation may move into the product).
 //! `tests/jit.rs` compares every pair with the JIT on NaN payloads.
 //!
+//! The dispatch's jump is predicted when equal steps follow each other: compilation
+//! orders the tape so that they do (`schedule.rs`), with the pairs to fuse kept adjacent.
+//!
 //! The instructions are stored only as this program ([`Tape`]); the native code
 //! generators, the dependency analysis and serialization read them back exactly.
 use crate::call::CallInstr;
@@ -107,7 +110,7 @@ pub(crate) enum Code {
 
 impl Code {
     /// The step running one tape instruction of operation `op` as it is.
-    fn plain(op: Op) -> Code {
+    pub(crate) fn plain(op: Op) -> Code {
         match op {
             Op::Sym => Code::Sym,
             Op::Neg => Code::Neg,
@@ -164,7 +167,7 @@ impl Code {
 
     /// The step computing `second(first(w[a], w[b]), w[c])` (`rev`: `second(w[c], …)`),
     /// or `None` if that pair has no step.
-    fn fused(first: Op, second: Op, rev: bool) -> Option<Code> {
+    pub(crate) fn fused(first: Op, second: Op, rev: bool) -> Option<Code> {
         let i = FIRST.iter().position(|&o| o == first)?;
         let j = SECOND.iter().position(|&o| o == second)?;
         Some(FUSED[usize::from(rev)][i][j])
@@ -274,6 +277,12 @@ impl Tape {
         }
     }
 
+    /// The steps, in the order they run.
+    #[cfg(test)]
+    pub(crate) fn steps(&self) -> &[Step] {
+        &self.steps
+    }
+
     /// Number of instructions.
     pub(crate) fn len(&self) -> usize {
         self.len
@@ -296,6 +305,12 @@ impl std::ops::Deref for Tape {
 }
 
 impl Step {
+    /// How this step computes its value.
+    #[cfg(test)]
+    pub(crate) fn code(&self) -> Code {
+        self.code
+    }
+
     /// The one or two instructions this step runs (the first `n` of the array).
     fn instrs(&self) -> ([Instr; 2], usize) {
         let (d, a, b, c) = (self.d, self.a, self.b, self.c);

@@ -38,6 +38,7 @@ mod map;
 mod matrix;
 mod native;
 mod op;
+mod schedule;
 mod serialize;
 mod simplify;
 pub mod sparsity;

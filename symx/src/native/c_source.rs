@@ -382,7 +382,8 @@ impl Function {
             out: String::new(),
             names: FxHashMap::default(),
         };
-        let main = w.function(self, true)?;
+        let native = self.for_native();
+        let main = w.function(&native, true)?;
         let mut o = String::new();
         writeln!(
             o,
@@ -420,7 +421,7 @@ impl Function {
             writeln!(bind, "  y[{k}] = res[{k}];").unwrap();
         }
         let zeros = self.input_sizes.iter().copied().max().unwrap_or(0).max(1);
-        let work = Registers::of(self, true).work;
+        let work = Registers::of(&native, true).work;
         write!(
             o,
             r#"

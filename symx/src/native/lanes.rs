@@ -260,7 +260,11 @@ mod tests {
         let x: Vec<Expr> = (0..4).map(|k| Expr::sym(&format!("x{k}"))).collect();
         // Four independent `x·x + x`, to neighbouring outputs: pairs.
         let outs: Vec<Expr> = x.iter().map(|&v| v * v + v).collect();
-        let f = Function::new(&[&x], &[&outs]).unwrap();
+        // (Native code is generated from the depth-first order, `Function::for_native`.)
+        let f = Function::new(&[&x], &[&outs])
+            .unwrap()
+            .for_native()
+            .into_owned();
         let s = all_steps(&f);
         assert!(s.iter().any(|s| matches!(s, Step::Pair { .. })), "{s:?}");
         // A chain: each element depends on the previous one, nothing pairs.
@@ -270,7 +274,10 @@ mod tests {
             acc = acc * v + 1.0;
             chain.push(acc);
         }
-        let g = Function::new(&[&x], &[&chain]).unwrap();
+        let g = Function::new(&[&x], &[&chain])
+            .unwrap()
+            .for_native()
+            .into_owned();
         let s = all_steps(&g);
         assert!(s.iter().all(|s| matches!(s, Step::Single(_))), "{s:?}");
     }

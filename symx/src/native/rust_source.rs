@@ -430,7 +430,8 @@ impl Function {
             out: String::new(),
             names: FxHashMap::default(),
         };
-        let main = w.function(self)?;
+        let native = self.for_native();
+        let main = w.function(&native)?;
         let mut o = String::new();
         let list = |v: &[usize]| {
             v.iter()
@@ -465,7 +466,7 @@ impl Function {
         writeln!(
             o,
             "/// Length of the work vector (the temporaries only).\npub const WORK_SIZE: usize = {};",
-            packed_work_need(self)
+            packed_work_need(&native)
         )
         .unwrap();
         writeln!(

@@ -1,0 +1,383 @@
+//! The order in which the tape runs its steps: the depth-first order of `compile`,
+//! regrouped window by window so that steps of the same kind run back to back.
+//!
+//! The interpreter (`interpret::run`) dispatches every step through one indirect jump.
+//! In depth-first order consecutive steps are rarely of the same kind (on the gap model's
+//! Lagrangian Hessian a kind changes every 1.4 steps), so that jump is mispredicted most
+//! of the time: the same tape with every step's code made equal ran in half the time.
+//! [`group`] reorders the steps so that equal kinds follow each other, without changing
+//! what any step computes (every value is bit-identical: each operation gets the same
+//! operands; only the order of independent steps changes).
+//!
+//! - **Kinds** are the interpreter's codes: a plain operation, or a *pair* — an
+//!   `Add`/`Sub`/`Mul` read once, by an `Add`/`Sub`/`Mul`/`Div` — that `interpret::Tape`
+//!   fuses into one step when the two are adjacent. Pairs are chosen here (each step in at
+//!   most one) and kept adjacent, so they fuse wherever the order puts them.
+//! - **Windows.** The steps are taken [`WINDOW`] units at a time in depth-first order
+//!   (a unit is a step or a pair, placed where its last step was); within a window a list
+//!   scheduler emits ready units, staying with the kind it emitted last while one is ready,
+//!   else switching to the kind with the most ready units. Every operand of a unit is
+//!   computed earlier in depth-first order, hence in its window or an earlier one, so the
+//!   order is valid; the window bounds how much longer values stay live than in
+//!   depth-first order (registers are allocated afterwards, on the new order).
+//! - A tape with calls is left in depth-first order (so that calling functions, whose
+//!   native code is generated from that order, need no reordering across calls).
+use crate::function::{Function, Instr};
+use crate::graph::Node;
+use crate::interpret::Code;
+use crate::op::Op;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Units (steps or fused pairs) regrouped together; larger windows make longer runs of
+/// one kind and keep values live longer.
+pub(crate) const WINDOW: usize = 8192;
+
+/// No step.
+const NONE: u32 = u32::MAX;
+
+/// Reorders `steps` (node ids in depth-first post-order) and `step_nodes` (their nodes)
+/// as described in the module docs. `step_of_operand(id)` gives the position in `steps`
+/// of the step computing node `id` (`None` for inputs and constants); `output_steps`
+/// lists the positions of steps whose value is an output of the function (read after
+/// the last step, so never fused away).
+pub(crate) fn group(
+    steps: &mut Vec<u32>,
+    step_nodes: &mut Vec<Node>,
+    step_of_operand: impl Fn(u32) -> Option<usize>,
+    output_steps: impl Iterator<Item = usize>,
+) {
+    let n = steps.len();
+    let calls = step_nodes
+        .iter()
+        .any(|node| matches!(node.op, Op::Call | Op::CallOutput));
+    if n < 3 || calls {
+        return;
+    }
+    let operands = |s: usize| -> &[u32] { step_nodes[s].operands() };
+    // How often each step's value is read (outputs count as a read).
+    let mut reads = vec![0u32; n];
+    for s in 0..n {
+        for &a in operands(s) {
+            if let Some(t) = step_of_operand(a) {
+                reads[t] += 1;
+            }
+        }
+    }
+    for t in output_steps {
+        reads[t] += 1;
+    }
+    // Pairs: `first[q]` is the step fused before q.
+    let mut first = vec![NONE; n];
+    let mut in_pair = vec![false; n];
+    for q in 0..n {
+        let node = &step_nodes[q];
+        if !matches!(node.op, Op::Add | Op::Sub | Op::Mul | Op::Div) {
+            continue;
+        }
+        let [a, b] = [node.operands()[0], node.operands()[1]];
+        if a == b {
+            continue;
+        }
+        for x in [a, b] {
+            let Some(p) = step_of_operand(x) else {
+                continue;
+            };
+            if reads[p] == 1
+                && !in_pair[p]
+                && matches!(step_nodes[p].op, Op::Add | Op::Sub | Op::Mul)
+            {
+                first[q] = p as u32;
+                in_pair[p] = true;
+                in_pair[q] = true;
+                break;
+            }
+        }
+    }
+    let is_first = |s: usize| in_pair[s] && first[s] == NONE;
+    // Units in the order of their last step, and the interpreter's code of each.
+    let kind = |q: usize| -> u32 {
+        let node = &step_nodes[q];
+        let code = match first[q] {
+            NONE => Some(Code::plain(node.op)),
+            p => {
+                let rev = node.operands()[1] == steps[p as usize];
+                Code::fused(step_nodes[p as usize].op, node.op, rev)
+            }
+        };
+        code.expect("pairs are of fusable operations") as u32
+    };
+    let units: Vec<u32> = (0..n).filter(|&s| !is_first(s)).map(|s| s as u32).collect();
+    // Unit of each step (by its last step's position in `units`).
+    let mut unit_of = vec![NONE; n];
+    for (u, &q) in units.iter().enumerate() {
+        unit_of[q as usize] = u as u32;
+        if first[q as usize] != NONE {
+            unit_of[first[q as usize] as usize] = u as u32;
+        }
+    }
+    let kinds: Vec<u32> = units.iter().map(|&q| kind(q as usize)).collect();
+    let n_kinds = kinds.iter().max().map_or(0, |&k| k as usize + 1);
+
+    let mut order: Vec<u32> = Vec::with_capacity(n);
+    let emit = |u: usize, order: &mut Vec<u32>| {
+        let q = units[u] as usize;
+        if first[q] != NONE {
+            order.push(first[q]);
+        }
+        order.push(q as u32);
+    };
+    let mut pending = vec![0u32; units.len()];
+    let mut children: Vec<Vec<u32>> = vec![Vec::new(); WINDOW];
+    let mut ready: Vec<BinaryHeap<Reverse<u32>>> = vec![BinaryHeap::new(); n_kinds];
+    let mut start = 0;
+    while start < units.len() {
+        let end = (start + WINDOW).min(units.len());
+        // Dependencies inside the window.
+        for c in children.iter_mut().take(end - start) {
+            c.clear();
+        }
+        for u in start..end {
+            let q = units[u] as usize;
+            let members = [first[q], q as u32];
+            for &m in members.iter().filter(|&&m| m != NONE) {
+                for &a in operands(m as usize) {
+                    let Some(t) = step_of_operand(a) else {
+                        continue;
+                    };
+                    let v = unit_of[t] as usize;
+                    if v >= start && v != u {
+                        pending[u] += 1;
+                        children[v - start].push(u as u32);
+                    }
+                }
+            }
+            if pending[u] == 0 {
+                ready[kinds[u] as usize].push(Reverse(u as u32));
+            }
+        }
+        // List scheduling: stay with the last kind while it has ready units, else take
+        // the kind with the most.
+        let mut current = kinds[start] as usize;
+        for _ in start..end {
+            if ready[current].is_empty() {
+                current = (0..n_kinds)
+                    .max_by_key(|&k| (ready[k].len(), Reverse(k)))
+                    .expect("a window has kinds");
+            }
+            let Reverse(u) = ready[current].pop().expect("a ready unit");
+            let u = u as usize;
+            emit(u, &mut order);
+            for &c in &children[u - start] {
+                let c = c as usize;
+                pending[c] -= 1;
+                if pending[c] == 0 {
+                    ready[kinds[c] as usize].push(Reverse(c as u32));
+                }
+            }
+        }
+        start = end;
+    }
+    debug_assert_eq!(order.len(), n);
+    let new_steps: Vec<u32> = order.iter().map(|&s| steps[s as usize]).collect();
+    let new_nodes: Vec<Node> = order.iter().map(|&s| step_nodes[s as usize]).collect();
+    *steps = new_steps;
+    *step_nodes = new_nodes;
+}
+
+/// The instructions of `f`'s tape back in depth-first order from the outputs (the order
+/// `compile` produces before [`group`]), with the temporaries renamed as `compile`
+/// allocates them, and the work size they need. Native code wants this order: a chain of
+/// dependent operations, not a run of equal ones, is what SIMD lanes (`native::lanes`)
+/// pair and what a compiler keeps in machine registers (the JIT ran the gap model's
+/// Hessian 1.6× slower in grouped order). `None` for a tape with calls or lookup
+/// functions (never grouped), or one whose instructions are not all reached from the
+/// outputs.
+pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
+    let tape: &[Instr] = &f.tape;
+    if tape
+        .iter()
+        .any(|i| matches!(i.op, Op::Call | Op::InterpolantN))
+    {
+        return None;
+    }
+    let n = tape.len();
+    let temp_start = (f.template_start + f.template.len()) as u32;
+    // Registers each instruction reads (as `interpret::dead_after_next` counts them).
+    let reads = |ins: &Instr| -> ([u32; 3], usize) {
+        let k = match ins.op.arity() {
+            3 => 3,
+            2 => 2,
+            _ => 1,
+        };
+        ([ins.a, ins.b, ins.c], k)
+    };
+    // The instruction whose value each operand reads (NONE: an input or a constant).
+    let mut writer = vec![NONE; f.work_size];
+    let mut source = vec![[NONE; 3]; n];
+    for (i, ins) in tape.iter().enumerate() {
+        let (regs, k) = reads(ins);
+        for m in 0..k {
+            source[i][m] = writer[regs[m] as usize];
+        }
+        writer[ins.d as usize] = i as u32;
+    }
+    // Copies of computed values into output slots run last, as `compile` emits them.
+    let is_copy = |i: usize| tape[i].op == Op::Sym;
+    let mut visited = vec![false; n];
+    let mut order: Vec<u32> = Vec::with_capacity(n);
+    let mut stack: Vec<(u32, usize)> = Vec::new();
+    let outputs = f
+        .output_offsets
+        .iter()
+        .zip(&f.output_sizes)
+        .flat_map(|(&at, &len)| at..at + len);
+    for slot in outputs {
+        let w = writer[slot];
+        if w == NONE {
+            continue;
+        }
+        let root = if is_copy(w as usize) {
+            source[w as usize][0]
+        } else {
+            w
+        };
+        if root == NONE || visited[root as usize] {
+            continue;
+        }
+        stack.push((root, 0));
+        visited[root as usize] = true;
+        while let Some(&mut (i, ref mut next)) = stack.last_mut() {
+            let (_, k) = reads(&tape[i as usize]);
+            if *next < k {
+                let s = source[i as usize][*next];
+                *next += 1;
+                if s != NONE && !visited[s as usize] && !is_copy(s as usize) {
+                    visited[s as usize] = true;
+                    stack.push((s, 0));
+                }
+            } else {
+                order.push(i);
+                stack.pop();
+            }
+        }
+    }
+    order.extend((0..n as u32).filter(|&i| is_copy(i as usize)));
+    if order.len() != n {
+        return None;
+    }
+    // Registers: outputs' slots, inputs and constants stay; temporaries are allocated in
+    // the new order, each freed after its last reader (before the reader's result takes
+    // one, as in `compile`).
+    let mut last_read = vec![0usize; n];
+    for (p, &i) in order.iter().enumerate() {
+        let (_, k) = reads(&tape[i as usize]);
+        for &s in &source[i as usize][..k] {
+            if s != NONE {
+                last_read[s as usize] = p;
+            }
+        }
+    }
+    let mut register = vec![NONE; n];
+    let mut free: Vec<u32> = Vec::new();
+    let mut work = temp_start;
+    let mut out = Vec::with_capacity(n);
+    for (p, &i) in order.iter().enumerate() {
+        let ins = tape[i as usize];
+        let (regs, k) = reads(&ins);
+        let mut new = regs;
+        for m in 0..k {
+            let s = source[i as usize][m];
+            if s != NONE {
+                new[m] = register[s as usize];
+                if last_read[s as usize] == p && new[m] >= temp_start && !new[..m].contains(&new[m])
+                {
+                    free.push(new[m]);
+                }
+            }
+        }
+        let d = if ins.d < temp_start {
+            ins.d
+        } else {
+            free.pop().unwrap_or_else(|| {
+                work += 1;
+                work - 1
+            })
+        };
+        register[i as usize] = d;
+        let (a, b, c) = match ins.op {
+            Op::Interpolant | Op::Interpolant2 if k < 3 => {
+                (new[0], if k == 2 { new[1] } else { new[0] }, ins.c)
+            }
+            _ => match k {
+                3 => (new[0], new[1], new[2]),
+                2 => (new[0], new[1], new[0]),
+                _ => (new[0], new[0], new[0]),
+            },
+        };
+        out.push(Instr {
+            op: ins.op,
+            d,
+            a,
+            b,
+            c,
+        });
+    }
+    Some((out, work as usize))
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::interpret::Code;
+    use crate::{Expr, Function};
+
+    fn codes(f: &Function) -> Vec<Code> {
+        f.tape.steps().iter().map(|s| s.code()).collect()
+    }
+
+    fn bits(f: &Function, x: &[f64]) -> Vec<u64> {
+        let out = f.call(&[x]).unwrap();
+        out.iter().flatten().map(|v| v.to_bits()).collect()
+    }
+
+    /// Two independent `sin(a) + b`: depth-first they alternate (Sin, Add, Sin, Add); the
+    /// tape runs both sines, then both sums, and the native order is depth-first again,
+    /// with the same values bit for bit.
+    #[test]
+    fn equal_operations_run_back_to_back_and_native_code_gets_depth_first() {
+        let x: Vec<Expr> = (0..4).map(|k| Expr::sym(&format!("x{k}"))).collect();
+        let outs = [x[0].sin() + x[1], x[2].sin() + x[3]];
+        let f = Function::new(&[&x], &[&outs]).unwrap();
+        assert_eq!(codes(&f), [Code::Sin, Code::Sin, Code::Add, Code::Add]);
+        let native = f.for_native();
+        assert_eq!(codes(&native), [Code::Sin, Code::Add, Code::Sin, Code::Add]);
+        let at = [0.3, -1.2, 2.5, 1e-3];
+        assert_eq!(bits(&f, &at), bits(&native, &at));
+        // The reference values, computed directly.
+        assert_eq!(
+            bits(&f, &at),
+            [
+                (0.3f64.sin() - 1.2).to_bits(),
+                (2.5f64.sin() + 1e-3).to_bits()
+            ]
+        );
+    }
+
+    /// A product read once by a sum is fused with it wherever the regrouping puts them:
+    /// four independent `a·b + c` are four fused steps (one kind, one run).
+    #[test]
+    fn fusable_pairs_stay_adjacent() {
+        let x: Vec<Expr> = (0..6).map(|k| Expr::sym(&format!("x{k}"))).collect();
+        let outs: Vec<Expr> = (0..4).map(|k| x[k] * x[k + 1] + x[k + 2]).collect();
+        let f = Function::new(&[&x], &[&outs]).unwrap();
+        let c = codes(&f);
+        assert_eq!(c.len(), 4, "{c:?}");
+        assert!(matches!(c[0], Code::MulAdd | Code::MulAddRev), "{c:?}");
+        assert!(c.iter().all(|&k| k == c[0]), "{c:?}");
+        let at: [f64; 6] = [1.5, -2.0, 0.25, 3.0, -0.5, 7.0];
+        let want: Vec<u64> = (0..4)
+            .map(|k| (at[k] * at[k + 1] + at[k + 2]).to_bits())
+            .collect();
+        assert_eq!(bits(&f, &at), want);
+    }
+}
