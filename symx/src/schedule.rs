@@ -37,7 +37,7 @@ use std::collections::BinaryHeap;
 /// instructions) windows of 256, 1 024, 4 096, 8 192 and 32 768 units ran in 183, 153,
 /// 109, 96 and 69 µs (medians of 5 processes; the depth-first tape 165–191 µs in the same
 /// program) with 10 517 … 17 040 registers (depth-first: 10 457).
-pub(crate) const WINDOW: usize = 32_768;
+const WINDOW: usize = 32_768;
 
 /// The depth-first order is kept when a model of the dispatch's branch predictor
 /// ([`predicted_misses`]) mispredicts fewer than one step in this many. Derivative tapes
