@@ -7,9 +7,9 @@
 //! Lagrangian Hessian ran 1.2–2.4× faster; native code is generated from the depth-first
 //! order), gives each node a register, and frees a register after its last use so that
 //! later nodes reuse it (liveness-based allocation, as CasADi's SX virtual machine does).
-//! Common subexpressions are already single nodes of
-//! the graph, so each is evaluated once. The compiled function owns no graph handles: it is
-//! `Send + Sync`, and evaluation writes only into the caller's work vector.
+//! Common subexpressions are already single nodes of the graph, so each is evaluated once.
+//! The compiled function owns no graph handles: it is `Send + Sync`, and evaluation writes
+//! only into the caller's work vector.
 //!
 //! The work vector is laid out as
 //! `[inputs | constants | outputs | temporaries]`:
