@@ -257,12 +257,7 @@ fn instantiate_on(g: &mut Graph, f: &Function, inputs: Vec<u32>) -> Vec<u32> {
         };
         reg[ins.d as usize] = v;
     }
-    f.output_sizes
-        .iter()
-        .zip(&f.output_offsets)
-        .flat_map(|(&n, &at)| at..at + n)
-        .map(|r| reg[r])
-        .collect()
+    f.output_ranges().flatten().map(|r| reg[r]).collect()
 }
 
 /// The Jacobian function of `f` with respect to the input entries where `wrt` is true

@@ -57,6 +57,21 @@ pub(crate) struct Instr {
     pub c: u32,
 }
 
+impl Instr {
+    /// The registers the instruction reads by value, in operand order: `a`, `b` for a
+    /// binary operation, `a`, `b`, `c` for `if_else`, `a` otherwise (a copy included).
+    /// Not for [`Op::Call`] (its arguments are in its call) or [`Op::InterpolantN`] (it
+    /// reads a range).
+    pub(crate) fn value_operands(&self) -> impl Iterator<Item = u32> {
+        let n = match self.op.arity() {
+            3 => 3,
+            2 => 2,
+            _ => 1,
+        };
+        [self.a, self.b, self.c].into_iter().take(n)
+    }
+}
+
 /// A compiled function from vectors of numbers to vectors of numbers.
 ///
 /// ```
@@ -260,6 +275,14 @@ impl Function {
         })
     }
 
+    /// The registers of each output, in output order.
+    pub(crate) fn output_ranges(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        self.output_offsets
+            .iter()
+            .zip(&self.output_sizes)
+            .map(|(&at, &n)| at..at + n)
+    }
+
     /// This function as native code is generated from it: its tape in depth-first order
     /// ([`crate::schedule::depth_first`]), and so are its callees'; itself when nothing
     /// changes. The work size stays: a tape whose depth-first order needs more registers
@@ -270,33 +293,42 @@ impl Function {
         use std::borrow::Cow;
         if !self.calls.is_empty() {
             // Calls are never regrouped (`schedule::group`): only the callees change.
-            let calls = self
+            let mut changed = false;
+            let calls: Vec<CallInstr> = self
                 .calls
                 .iter()
-                .map(|c| crate::call::CallInstr {
-                    function: Arc::new(c.function.for_native().into_owned()),
-                    args: c.args.clone(),
-                    out: c.out,
+                .map(|c| {
+                    let function = match c.function.for_native() {
+                        Cow::Borrowed(_) => c.function.clone(),
+                        Cow::Owned(f) => {
+                            changed = true;
+                            Arc::new(f)
+                        }
+                    };
+                    CallInstr {
+                        function,
+                        args: c.args.clone(),
+                        out: c.out,
+                    }
                 })
                 .collect();
-            return Cow::Owned(Function {
-                calls,
-                ..self.clone()
-            });
+            return if changed {
+                Cow::Owned(Function {
+                    calls,
+                    ..self.clone()
+                })
+            } else {
+                Cow::Borrowed(self)
+            };
         }
         let Some((instrs, work_size)) = crate::schedule::depth_first(self)
             .filter(|&(_, work_size)| work_size <= self.work_size)
         else {
             return Cow::Borrowed(self);
         };
-        let outputs = self
-            .output_offsets
-            .iter()
-            .zip(&self.output_sizes)
-            .map(|(&at, &n)| at..at + n);
         // Without calls, the callees' scratch block after the temporaries is empty.
         Cow::Owned(Function {
-            tape: Tape::new(instrs, &[], work_size, outputs),
+            tape: Tape::new(instrs, &[], work_size, self.output_ranges()),
             work_size,
             call_scratch: work_size,
             ..self.clone()

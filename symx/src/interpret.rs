@@ -394,14 +394,9 @@ fn dead_after_next(
                     *slot = true;
                 }
             }
-            op => {
+            _ => {
                 live[ins.d as usize] = false;
-                let read: &[u32] = match op.arity() {
-                    3 => &[ins.a, ins.b, ins.c],
-                    2 => &[ins.a, ins.b],
-                    _ => &[ins.a],
-                };
-                for &r in read {
+                for r in ins.value_operands() {
                     live[r as usize] = true;
                 }
             }
@@ -672,12 +667,7 @@ mod tests {
         let back: Vec<Instr> = fun.tape.instructions().collect();
         assert_eq!(back.len(), instrs);
         // The instructions rebuilt into a tape give the same program and instructions.
-        let outputs = fun
-            .output_offsets
-            .iter()
-            .zip(&fun.output_sizes)
-            .map(|(&at, &n)| at..at + n);
-        let again = Tape::new(back.clone(), &fun.calls, fun.work_size, outputs);
+        let again = Tape::new(back.clone(), &fun.calls, fun.work_size, fun.output_ranges());
         assert!(same(&again.instructions().collect::<Vec<_>>(), &back));
         assert_eq!(again.steps.len(), steps);
     }

@@ -146,7 +146,7 @@ pub(crate) fn group(
         order.push(q as u32);
     };
     let mut pending = vec![0u32; units.len()];
-    let mut children: Vec<Vec<u32>> = vec![Vec::new(); WINDOW];
+    let mut children: Vec<Vec<u32>> = vec![Vec::new(); WINDOW.min(units.len())];
     let mut ready: Vec<BinaryHeap<Reverse<u32>>> = vec![BinaryHeap::new(); n_kinds];
     let mut start = 0;
     while start < units.len() {
@@ -221,22 +221,14 @@ pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
     }
     let n = tape.len();
     let temp_start = (f.template_start + f.template.len()) as u32;
-    // Registers each instruction reads (as `interpret::dead_after_next` counts them).
-    let reads = |ins: &Instr| -> ([u32; 3], usize) {
-        let k = match ins.op.arity() {
-            3 => 3,
-            2 => 2,
-            _ => 1,
-        };
-        ([ins.a, ins.b, ins.c], k)
-    };
     // The instruction whose value each operand reads (NONE: an input or a constant).
     let mut writer = vec![NONE; f.work_size];
     let mut source = vec![[NONE; 3]; n];
+    let mut arity = vec![0usize; n];
     for (i, ins) in tape.iter().enumerate() {
-        let (regs, k) = reads(ins);
-        for m in 0..k {
-            source[i][m] = writer[regs[m] as usize];
+        for (m, r) in ins.value_operands().enumerate() {
+            source[i][m] = writer[r as usize];
+            arity[i] = m + 1;
         }
         writer[ins.d as usize] = i as u32;
     }
@@ -245,12 +237,7 @@ pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
     let mut visited = vec![false; n];
     let mut order: Vec<u32> = Vec::with_capacity(n);
     let mut stack: Vec<(u32, usize)> = Vec::new();
-    let outputs = f
-        .output_offsets
-        .iter()
-        .zip(&f.output_sizes)
-        .flat_map(|(&at, &len)| at..at + len);
-    for slot in outputs {
+    for slot in f.output_ranges().flatten() {
         let w = writer[slot];
         if w == NONE {
             continue;
@@ -266,8 +253,7 @@ pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
         stack.push((root, 0));
         visited[root as usize] = true;
         while let Some(&mut (i, ref mut next)) = stack.last_mut() {
-            let (_, k) = reads(&tape[i as usize]);
-            if *next < k {
+            if *next < arity[i as usize] {
                 let s = source[i as usize][*next];
                 *next += 1;
                 if s != NONE && !visited[s as usize] && !is_copy(s as usize) {
@@ -289,8 +275,7 @@ pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
     // one, as in `compile`).
     let mut last_read = vec![0usize; n];
     for (p, &i) in order.iter().enumerate() {
-        let (_, k) = reads(&tape[i as usize]);
-        for &s in &source[i as usize][..k] {
+        for &s in &source[i as usize][..arity[i as usize]] {
             if s != NONE {
                 last_read[s as usize] = p;
             }
@@ -302,8 +287,8 @@ pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
     let mut out = Vec::with_capacity(n);
     for (p, &i) in order.iter().enumerate() {
         let ins = tape[i as usize];
-        let (regs, k) = reads(&ins);
-        let mut new = regs;
+        let k = arity[i as usize];
+        let mut new = [ins.a, ins.b, ins.c];
         for m in 0..k {
             let s = source[i as usize][m];
             if s != NONE {
@@ -323,15 +308,13 @@ pub(crate) fn depth_first(f: &Function) -> Option<(Vec<Instr>, usize)> {
             })
         };
         register[i as usize] = d;
-        let (a, b, c) = match ins.op {
-            Op::Interpolant | Op::Interpolant2 if k < 3 => {
-                (new[0], if k == 2 { new[1] } else { new[0] }, ins.c)
-            }
-            _ => match k {
-                3 => (new[0], new[1], new[2]),
-                2 => (new[0], new[1], new[0]),
-                _ => (new[0], new[0], new[0]),
-            },
+        // Compile's layout: a unary operation's `b` is its `a`; `c` is `a` too, except
+        // for `if_else` and the lookups (whose `c` is a table index).
+        let (a, b) = (new[0], if k >= 2 { new[1] } else { new[0] });
+        let c = match ins.op {
+            Op::Interpolant | Op::Interpolant2 => ins.c,
+            _ if k == 3 => new[2],
+            _ => new[0],
         };
         out.push(Instr {
             op: ins.op,

@@ -430,16 +430,7 @@ fn reads(f: &Function, ins: &Instr, mut visit: impl FnMut(u32)) {
         Op::Call => f.calls[ins.d as usize].args.iter().for_each(|&r| visit(r)),
         // Read through a pointer: handled by the caller.
         Op::InterpolantN => {}
-        Op::IfElse => {
-            visit(ins.a);
-            visit(ins.b);
-            visit(ins.c);
-        }
-        op if op.arity() == 2 => {
-            visit(ins.a);
-            visit(ins.b);
-        }
-        _ => visit(ins.a),
+        _ => ins.value_operands().for_each(visit),
     }
 }
 
