@@ -72,14 +72,31 @@ pub(crate) fn group(
     if predicted_misses(step_nodes.iter().map(|node| node.op)) * MISS_RATIO < n {
         return;
     }
-    let operands = |s: usize| -> &[u32] { step_nodes[s].operands() };
+    // The step computing each operand of each step (`NONE`: an input or a constant),
+    // looked up once.
+    let operand_steps: Vec<[u32; 3]> = step_nodes
+        .iter()
+        .map(|node| {
+            let mut at = [NONE; 3];
+            for (slot, &a) in at.iter_mut().zip(node.operands()) {
+                if let Some(t) = step_of_operand(a) {
+                    *slot = t as u32;
+                }
+            }
+            at
+        })
+        .collect();
+    let operand_steps_of = |s: usize| {
+        operand_steps[s]
+            .iter()
+            .filter(|&&t| t != NONE)
+            .map(|&t| t as usize)
+    };
     // How often each step's value is read (outputs count as a read).
     let mut reads = vec![0u32; n];
     for s in 0..n {
-        for &a in operands(s) {
-            if let Some(t) = step_of_operand(a) {
-                reads[t] += 1;
-            }
+        for t in operand_steps_of(s) {
+            reads[t] += 1;
         }
     }
     for t in output_steps {
@@ -93,14 +110,11 @@ pub(crate) fn group(
         if !matches!(node.op, Op::Add | Op::Sub | Op::Mul | Op::Div) {
             continue;
         }
-        let [a, b] = [node.operands()[0], node.operands()[1]];
-        if a == b {
+        if node.operands()[0] == node.operands()[1] {
             continue;
         }
-        for x in [a, b] {
-            let Some(p) = step_of_operand(x) else {
-                continue;
-            };
+        for p in operand_steps[q][..2].iter().filter(|&&p| p != NONE) {
+            let p = *p as usize;
             if reads[p] == 1
                 && !in_pair[p]
                 && matches!(step_nodes[p].op, Op::Add | Op::Sub | Op::Mul)
@@ -119,7 +133,7 @@ pub(crate) fn group(
         let code = match first[q] {
             NONE => Some(Code::plain(node.op)),
             p => {
-                let rev = node.operands()[1] == steps[p as usize];
+                let rev = operand_steps[q][1] == p;
                 Code::fused(step_nodes[p as usize].op, node.op, rev)
             }
         };
@@ -136,40 +150,46 @@ pub(crate) fn group(
     }
     let kinds: Vec<u32> = units.iter().map(|&q| kind(q as usize)).collect();
     let n_kinds = kinds.iter().max().map_or(0, |&k| k as usize + 1);
+    let n_units = units.len();
 
-    let mut order: Vec<u32> = Vec::with_capacity(n);
-    let emit = |u: usize, order: &mut Vec<u32>| {
-        let q = units[u] as usize;
-        if first[q] != NONE {
-            order.push(first[q]);
-        }
-        order.push(q as u32);
-    };
-    let mut pending = vec![0u32; units.len()];
-    let mut children: Vec<Vec<u32>> = vec![Vec::new(); WINDOW.min(units.len())];
-    let mut ready: Vec<BinaryHeap<Reverse<u32>>> = vec![BinaryHeap::new(); n_kinds];
-    let mut start = 0;
-    while start < units.len() {
-        let end = (start + WINDOW).min(units.len());
-        // Dependencies inside the window.
-        for c in children.iter_mut().take(end - start) {
-            c.clear();
-        }
-        for u in start..end {
-            let q = units[u] as usize;
-            let members = [first[q], q as u32];
-            for &m in members.iter().filter(|&&m| m != NONE) {
-                for &a in operands(m as usize) {
-                    let Some(t) = step_of_operand(a) else {
-                        continue;
-                    };
-                    let v = unit_of[t] as usize;
-                    if v >= start && v != u {
-                        pending[u] += 1;
-                        children[v - start].push(u as u32);
-                    }
+    // Dependencies inside each window: `pending[u]` operands of u computed by other
+    // units of its window, and the units reading each unit (`children`, compressed rows
+    // in the order the units read them).
+    let window_start = |u: usize| u - u % WINDOW;
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(n);
+    for (u, &q) in units.iter().enumerate() {
+        let q = q as usize;
+        for m in [first[q], q as u32].into_iter().filter(|&m| m != NONE) {
+            for t in operand_steps_of(m as usize) {
+                let v = unit_of[t] as usize;
+                if v >= window_start(u) && v != u {
+                    edges.push((v as u32, u as u32));
                 }
             }
+        }
+    }
+    let mut pending = vec![0u32; n_units];
+    let mut child_ptr = vec![0u32; n_units + 1];
+    for &(v, u) in &edges {
+        pending[u as usize] += 1;
+        child_ptr[v as usize + 1] += 1;
+    }
+    for v in 0..n_units {
+        child_ptr[v + 1] += child_ptr[v];
+    }
+    let mut children = vec![0u32; edges.len()];
+    let mut fill: Vec<u32> = child_ptr[..n_units].to_vec();
+    for &(v, u) in &edges {
+        children[fill[v as usize] as usize] = u;
+        fill[v as usize] += 1;
+    }
+
+    let mut order: Vec<u32> = Vec::with_capacity(n);
+    let mut ready: Vec<BinaryHeap<Reverse<u32>>> = vec![BinaryHeap::new(); n_kinds];
+    let mut start = 0;
+    while start < n_units {
+        let end = (start + WINDOW).min(n_units);
+        for u in start..end {
             if pending[u] == 0 {
                 ready[kinds[u] as usize].push(Reverse(u as u32));
             }
@@ -185,8 +205,12 @@ pub(crate) fn group(
             }
             let Reverse(u) = ready[current].pop().expect("a ready unit");
             let u = u as usize;
-            emit(u, &mut order);
-            for &c in &children[u - start] {
+            let q = units[u] as usize;
+            if first[q] != NONE {
+                order.push(first[q]);
+            }
+            order.push(q as u32);
+            for &c in &children[child_ptr[u] as usize..child_ptr[u + 1] as usize] {
                 let c = c as usize;
                 pending[c] -= 1;
                 if pending[c] == 0 {
