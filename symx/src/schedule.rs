@@ -30,7 +30,6 @@ use crate::graph::Node;
 use crate::interpret::Code;
 use crate::op::Op;
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// Units (steps or fused pairs) regrouped together; larger windows make longer runs of
 /// one kind and keep values live longer. On the gap model's Lagrangian Hessian (45 681
@@ -155,56 +154,57 @@ pub(crate) fn group(
     // Dependencies inside each window: `pending[u]` operands of u computed by other
     // units of its window, and the units reading each unit (`children`, compressed rows
     // in the order the units read them).
-    let window_start = |u: usize| u - u % WINDOW;
-    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(n);
-    for (u, &q) in units.iter().enumerate() {
-        let q = q as usize;
-        for m in [first[q], q as u32].into_iter().filter(|&m| m != NONE) {
-            for t in operand_steps_of(m as usize) {
-                let v = unit_of[t] as usize;
-                if v >= window_start(u) && v != u {
-                    edges.push((v as u32, u as u32));
+    // Calls `edge(v, u)` for every operand of unit u computed by another unit v of its
+    // window, in the order u reads them.
+    let each_edge = |edge: &mut dyn FnMut(usize, usize)| {
+        for (u, &q) in units.iter().enumerate() {
+            let q = q as usize;
+            for m in [first[q], q as u32].into_iter().filter(|&m| m != NONE) {
+                for t in operand_steps_of(m as usize) {
+                    let v = unit_of[t] as usize;
+                    if v >= u - u % WINDOW && v != u {
+                        edge(v, u);
+                    }
                 }
             }
         }
-    }
+    };
     let mut pending = vec![0u32; n_units];
     let mut child_ptr = vec![0u32; n_units + 1];
-    for &(v, u) in &edges {
-        pending[u as usize] += 1;
-        child_ptr[v as usize + 1] += 1;
-    }
+    each_edge(&mut |v, u| {
+        pending[u] += 1;
+        child_ptr[v + 1] += 1;
+    });
     for v in 0..n_units {
         child_ptr[v + 1] += child_ptr[v];
     }
-    let mut children = vec![0u32; edges.len()];
+    let mut children = vec![0u32; child_ptr[n_units] as usize];
     let mut fill: Vec<u32> = child_ptr[..n_units].to_vec();
-    for &(v, u) in &edges {
-        children[fill[v as usize] as usize] = u;
-        fill[v as usize] += 1;
-    }
+    each_edge(&mut |v, u| {
+        children[fill[v] as usize] = u as u32;
+        fill[v] += 1;
+    });
 
     let mut order: Vec<u32> = Vec::with_capacity(n);
-    let mut ready: Vec<BinaryHeap<Reverse<u32>>> = vec![BinaryHeap::new(); n_kinds];
+    let mut ready = ReadySets::new(n_kinds, WINDOW.min(n_units));
     let mut start = 0;
     while start < n_units {
         let end = (start + WINDOW).min(n_units);
         for u in start..end {
             if pending[u] == 0 {
-                ready[kinds[u] as usize].push(Reverse(u as u32));
+                ready.insert(kinds[u] as usize, u - start);
             }
         }
         // List scheduling: stay with the last kind while it has ready units, else take
         // the kind with the most.
         let mut current = kinds[start] as usize;
         for _ in start..end {
-            if ready[current].is_empty() {
+            if ready.len(current) == 0 {
                 current = (0..n_kinds)
-                    .max_by_key(|&k| (ready[k].len(), Reverse(k)))
+                    .max_by_key(|&k| (ready.len(k), Reverse(k)))
                     .expect("a window has kinds");
             }
-            let Reverse(u) = ready[current].pop().expect("a ready unit");
-            let u = u as usize;
+            let u = start + ready.pop_lowest(current).expect("a ready unit");
             let q = units[u] as usize;
             if first[q] != NONE {
                 order.push(first[q]);
@@ -214,7 +214,7 @@ pub(crate) fn group(
                 let c = c as usize;
                 pending[c] -= 1;
                 if pending[c] == 0 {
-                    ready[kinds[c] as usize].push(Reverse(c as u32));
+                    ready.insert(kinds[c] as usize, c - start);
                 }
             }
         }
@@ -225,6 +225,63 @@ pub(crate) fn group(
     let new_nodes: Vec<Node> = order.iter().map(|&s| step_nodes[s as usize]).collect();
     *steps = new_steps;
     *step_nodes = new_nodes;
+}
+
+/// The ready units of a window by kind, each kind's as a set of offsets in the window
+/// from which the lowest is taken first: a bitset with one summary bit per word, so that
+/// taking the lowest scans at most `width / 4096` summary words (a binary heap per kind
+/// spent a third of [`group`]'s time in its sift-down).
+struct ReadySets {
+    /// Words of `bits` per kind (one bit per offset).
+    words: usize,
+    /// Words of `summary` per kind (one bit per word of `bits`, set when it is non-zero).
+    summary_words: usize,
+    bits: Vec<u64>,
+    summary: Vec<u64>,
+    len: Vec<usize>,
+}
+
+impl ReadySets {
+    /// Empty sets of `n_kinds` kinds over offsets `0..width`.
+    fn new(n_kinds: usize, width: usize) -> ReadySets {
+        let words = width.div_ceil(64);
+        let summary_words = words.div_ceil(64);
+        ReadySets {
+            words,
+            summary_words,
+            bits: vec![0; n_kinds * words],
+            summary: vec![0; n_kinds * summary_words],
+            len: vec![0; n_kinds],
+        }
+    }
+
+    /// Number of offsets in kind `k`'s set.
+    fn len(&self, k: usize) -> usize {
+        self.len[k]
+    }
+
+    /// Adds `offset` (not in the set) to kind `k`'s set.
+    fn insert(&mut self, k: usize, offset: usize) {
+        let w = offset / 64;
+        self.bits[k * self.words + w] |= 1 << (offset % 64);
+        self.summary[k * self.summary_words + w / 64] |= 1 << (w % 64);
+        self.len[k] += 1;
+    }
+
+    /// Removes and returns the lowest offset of kind `k`'s set.
+    fn pop_lowest(&mut self, k: usize) -> Option<usize> {
+        let summary = &mut self.summary[k * self.summary_words..(k + 1) * self.summary_words];
+        let (s, &sw) = summary.iter().enumerate().find(|(_, &sw)| sw != 0)?;
+        let w = s * 64 + sw.trailing_zeros() as usize;
+        let word = &mut self.bits[k * self.words + w];
+        let offset = w * 64 + word.trailing_zeros() as usize;
+        *word &= *word - 1;
+        if *word == 0 {
+            summary[s] &= !(1 << (w % 64));
+        }
+        self.len[k] -= 1;
+        Some(offset)
+    }
 }
 
 /// The instructions of `f`'s tape back in depth-first order from the outputs (the order
@@ -409,6 +466,35 @@ mod tests {
 
     /// A product read once by a sum is fused with it wherever the regrouping puts them:
     /// four independent `a·b + c` are four fused steps (one kind, one run).
+    /// The ready sets give each kind's offsets lowest first, as a sorted set does, across
+    /// summary words and interleaved with insertions.
+    #[test]
+    fn ready_sets_take_the_lowest_offset_first() {
+        use std::collections::BTreeSet;
+        let width = 10_000;
+        let mut sets = super::ReadySets::new(3, width);
+        let mut model = [BTreeSet::new(), BTreeSet::new(), BTreeSet::new()];
+        let mut x: usize = 12_345;
+        for round in 0..20_000 {
+            x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let k = (x >> 40) % 3;
+            let offset = (x >> 20) % width;
+            if round % 3 != 2 && !model[k].contains(&offset) {
+                sets.insert(k, offset);
+                model[k].insert(offset);
+            } else {
+                assert_eq!(sets.pop_lowest(k), model[k].pop_first());
+            }
+            assert_eq!(sets.len(k), model[k].len());
+        }
+        for k in 0..3 {
+            while let Some(lowest) = model[k].pop_first() {
+                assert_eq!(sets.pop_lowest(k), Some(lowest));
+            }
+            assert_eq!(sets.pop_lowest(k), None);
+        }
+    }
+
     #[test]
     fn fusable_pairs_stay_adjacent() {
         let x: Vec<Expr> = (0..6).map(|k| Expr::sym(&format!("x{k}"))).collect();
