@@ -487,8 +487,8 @@ mod tests {
             }
             assert_eq!(sets.len(k), model[k].len());
         }
-        for k in 0..3 {
-            while let Some(lowest) = model[k].pop_first() {
+        for (k, set) in model.iter_mut().enumerate() {
+            while let Some(lowest) = set.pop_first() {
                 assert_eq!(sets.pop_lowest(k), Some(lowest));
             }
             assert_eq!(sets.pop_lowest(k), None);
