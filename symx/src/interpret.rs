@@ -491,6 +491,91 @@ fn mul(a: f64, b: f64) -> f64 {
     }
 }
 
+/// The value of every step code but `Call`, as `Code => expression`, handed to `$then!`
+/// after the names it must bind: the step `$s` and its first operands `$a`, `$b` (`$r`
+/// reads a register, `$f` is the function, `$w` the work vector). The one list of what
+/// each code computes, for both loops of [`run`].
+macro_rules! step_values {
+    ($then:ident, $f:ident, $w:ident, $r:ident, $s:ident, $a:ident, $b:ident) => {
+        $then! { $s, $a, $b;
+            Add => add($a, $b),
+            Sub => $a - $b,
+            Mul => mul($a, $b),
+            Div => $a / $b,
+            Neg => -$a,
+            Sq => $a * $a,
+            Sym => $a,
+            AddAdd => add(add($a, $b), $r($s.c)),
+            AddSub => add($a, $b) - $r($s.c),
+            AddMul => mul(add($a, $b), $r($s.c)),
+            AddDiv => add($a, $b) / $r($s.c),
+            SubAdd => add($a - $b, $r($s.c)),
+            SubSub => $a - $b - $r($s.c),
+            SubMul => mul($a - $b, $r($s.c)),
+            SubDiv => ($a - $b) / $r($s.c),
+            MulAdd => add(mul($a, $b), $r($s.c)),
+            MulSub => mul($a, $b) - $r($s.c),
+            MulMul => mul(mul($a, $b), $r($s.c)),
+            MulDiv => mul($a, $b) / $r($s.c),
+            AddAddRev => add($r($s.c), add($a, $b)),
+            AddSubRev => $r($s.c) - add($a, $b),
+            AddMulRev => mul($r($s.c), add($a, $b)),
+            AddDivRev => $r($s.c) / add($a, $b),
+            SubAddRev => add($r($s.c), $a - $b),
+            SubSubRev => $r($s.c) - ($a - $b),
+            SubMulRev => mul($r($s.c), $a - $b),
+            SubDivRev => $r($s.c) / ($a - $b),
+            MulAddRev => add($r($s.c), mul($a, $b)),
+            MulSubRev => $r($s.c) - mul($a, $b),
+            MulMulRev => mul($r($s.c), mul($a, $b)),
+            MulDivRev => $r($s.c) / mul($a, $b),
+            Sqrt => $a.sqrt(),
+            Exp => $a.exp(),
+            Log => $a.ln(),
+            Sin => $a.sin(),
+            Cos => $a.cos(),
+            Tan => $a.tan(),
+            Asin => $a.asin(),
+            Acos => $a.acos(),
+            Atan => $a.atan(),
+            Sinh => $a.sinh(),
+            Cosh => $a.cosh(),
+            Tanh => $a.tanh(),
+            Abs => $a.abs(),
+            Sign => op::sign($a),
+            Not => f64::from($a == 0.0),
+            Pow => op::pow($a, $b),
+            Atan2 => $a.atan2($b),
+            Min => $a.min($b),
+            Max => $a.max($b),
+            Lt => f64::from($a < $b),
+            Le => f64::from($a <= $b),
+            Eq => f64::from($a == $b),
+            Ne => f64::from($a != $b),
+            And => f64::from($a != 0.0 && $b != 0.0),
+            Or => f64::from($a != 0.0 || $b != 0.0),
+            StrongMul => op::strong_mul($a, $b),
+            Floor => $a.floor(),
+            Ceil => $a.ceil(),
+            Erf => libm::erf($a),
+            Asinh => $a.asinh(),
+            Acosh => $a.acosh(),
+            Atanh => $a.atanh(),
+            Log1p => $a.ln_1p(),
+            Expm1 => $a.exp_m1(),
+            Fmod => $a % $b,
+            Hypot => $a.hypot($b),
+            Interpolant => $f.tables.get_unchecked($s.c as usize).eval(&[$a]),
+            Interpolant2 => $f.tables.get_unchecked($s.c as usize).eval(&[$a, $b]),
+            InterpolantN => $f
+                .tables
+                .get_unchecked($s.c as usize)
+                .eval(std::slice::from_raw_parts($w.add($s.a as usize), $s.b as usize)),
+            IfElse => if $a != 0.0 { $b } else { $r($s.c) },
+        }
+    };
+}
+
 /// Runs `f`'s program on a work vector whose input and template registers are filled:
 /// run by run of equal codes when the tape has long runs (each run in a loop of its own,
 /// so that the dispatch's indirect jump is taken once per run), else step by step.
@@ -519,109 +604,26 @@ unsafe fn run_runs(f: &Function, w: *mut f64) {
         let end = run.end as usize;
         let run_steps = steps.get_unchecked(start..end);
         start = end;
-        // `w[d] = value` for every step `s` of the run, with `a`, `b` its first operands.
-        macro_rules! each {
-            (|$s:ident, $a:ident, $b:ident| $value:expr) => {
-                for $s in run_steps {
-                    #[allow(unused_variables)]
-                    let ($a, $b) = (r($s.a), r($s.b));
-                    *w.add($s.d as usize) = $value;
+        // One loop per code: `w[d] = value` for every step of the run.
+        macro_rules! loop_per_code {
+            ($s:ident, $a:ident, $b:ident; $($code:ident => $value:expr,)*) => {
+                match run.code {
+                    $(Code::$code => {
+                        for $s in run_steps {
+                            #[allow(unused_variables)]
+                            let ($a, $b) = (r($s.a), r($s.b));
+                            *w.add($s.d as usize) = $value;
+                        }
+                    })*
+                    Code::Call => {
+                        for s in run_steps {
+                            f.exec_call(f.calls.get_unchecked(s.d as usize), w);
+                        }
+                    }
                 }
             };
         }
-        match run.code {
-            Code::Add => each!(|s, a, b| add(a, b)),
-            Code::Sub => each!(|s, a, b| a - b),
-            Code::Mul => each!(|s, a, b| mul(a, b)),
-            Code::Div => each!(|s, a, b| a / b),
-            Code::Neg => each!(|s, a, b| -a),
-            Code::Sq => each!(|s, a, b| a * a),
-            Code::Sym => each!(|s, a, b| a),
-            Code::AddAdd => each!(|s, a, b| add(add(a, b), r(s.c))),
-            Code::AddSub => each!(|s, a, b| add(a, b) - r(s.c)),
-            Code::AddMul => each!(|s, a, b| mul(add(a, b), r(s.c))),
-            Code::AddDiv => each!(|s, a, b| add(a, b) / r(s.c)),
-            Code::SubAdd => each!(|s, a, b| add(a - b, r(s.c))),
-            Code::SubSub => each!(|s, a, b| a - b - r(s.c)),
-            Code::SubMul => each!(|s, a, b| mul(a - b, r(s.c))),
-            Code::SubDiv => each!(|s, a, b| (a - b) / r(s.c)),
-            Code::MulAdd => each!(|s, a, b| add(mul(a, b), r(s.c))),
-            Code::MulSub => each!(|s, a, b| mul(a, b) - r(s.c)),
-            Code::MulMul => each!(|s, a, b| mul(mul(a, b), r(s.c))),
-            Code::MulDiv => each!(|s, a, b| mul(a, b) / r(s.c)),
-            Code::AddAddRev => each!(|s, a, b| add(r(s.c), add(a, b))),
-            Code::AddSubRev => each!(|s, a, b| r(s.c) - add(a, b)),
-            Code::AddMulRev => each!(|s, a, b| mul(r(s.c), add(a, b))),
-            Code::AddDivRev => each!(|s, a, b| r(s.c) / add(a, b)),
-            Code::SubAddRev => each!(|s, a, b| add(r(s.c), a - b)),
-            Code::SubSubRev => each!(|s, a, b| r(s.c) - (a - b)),
-            Code::SubMulRev => each!(|s, a, b| mul(r(s.c), a - b)),
-            Code::SubDivRev => each!(|s, a, b| r(s.c) / (a - b)),
-            Code::MulAddRev => each!(|s, a, b| add(r(s.c), mul(a, b))),
-            Code::MulSubRev => each!(|s, a, b| r(s.c) - mul(a, b)),
-            Code::MulMulRev => each!(|s, a, b| mul(r(s.c), mul(a, b))),
-            Code::MulDivRev => each!(|s, a, b| r(s.c) / mul(a, b)),
-            Code::Sqrt => each!(|s, a, b| a.sqrt()),
-            Code::Exp => each!(|s, a, b| a.exp()),
-            Code::Log => each!(|s, a, b| a.ln()),
-            Code::Sin => each!(|s, a, b| a.sin()),
-            Code::Cos => each!(|s, a, b| a.cos()),
-            Code::Tan => each!(|s, a, b| a.tan()),
-            Code::Asin => each!(|s, a, b| a.asin()),
-            Code::Acos => each!(|s, a, b| a.acos()),
-            Code::Atan => each!(|s, a, b| a.atan()),
-            Code::Sinh => each!(|s, a, b| a.sinh()),
-            Code::Cosh => each!(|s, a, b| a.cosh()),
-            Code::Tanh => each!(|s, a, b| a.tanh()),
-            Code::Abs => each!(|s, a, b| a.abs()),
-            Code::Sign => each!(|s, a, b| op::sign(a)),
-            Code::Not => each!(|s, a, b| f64::from(a == 0.0)),
-            Code::Pow => each!(|s, a, b| op::pow(a, b)),
-            Code::Atan2 => each!(|s, a, b| a.atan2(b)),
-            Code::Min => each!(|s, a, b| a.min(b)),
-            Code::Max => each!(|s, a, b| a.max(b)),
-            Code::Lt => each!(|s, a, b| f64::from(a < b)),
-            Code::Le => each!(|s, a, b| f64::from(a <= b)),
-            Code::Eq => each!(|s, a, b| f64::from(a == b)),
-            Code::Ne => each!(|s, a, b| f64::from(a != b)),
-            Code::And => each!(|s, a, b| f64::from(a != 0.0 && b != 0.0)),
-            Code::Or => each!(|s, a, b| f64::from(a != 0.0 || b != 0.0)),
-            Code::StrongMul => each!(|s, a, b| op::strong_mul(a, b)),
-            Code::Floor => each!(|s, a, b| a.floor()),
-            Code::Ceil => each!(|s, a, b| a.ceil()),
-            Code::Erf => each!(|s, a, b| libm::erf(a)),
-            Code::Asinh => each!(|s, a, b| a.asinh()),
-            Code::Acosh => each!(|s, a, b| a.acosh()),
-            Code::Atanh => each!(|s, a, b| a.atanh()),
-            Code::Log1p => each!(|s, a, b| a.ln_1p()),
-            Code::Expm1 => each!(|s, a, b| a.exp_m1()),
-            Code::Fmod => each!(|s, a, b| a % b),
-            Code::Hypot => each!(|s, a, b| a.hypot(b)),
-            Code::Interpolant => each!(|s, a, b| f.tables.get_unchecked(s.c as usize).eval(&[a])),
-            Code::Interpolant2 => {
-                each!(|s, a, b| f.tables.get_unchecked(s.c as usize).eval(&[a, b]))
-            }
-            Code::InterpolantN => each!(|s, a, b| {
-                f.tables
-                    .get_unchecked(s.c as usize)
-                    .eval(std::slice::from_raw_parts(
-                        w.add(s.a as usize),
-                        s.b as usize,
-                    ))
-            }),
-            Code::IfElse => each!(|s, a, b| {
-                if a != 0.0 {
-                    b
-                } else {
-                    r(s.c)
-                }
-            }),
-            Code::Call => {
-                for s in run_steps {
-                    f.exec_call(f.calls.get_unchecked(s.d as usize), w);
-                }
-            }
-        }
+        step_values!(loop_per_code, f, w, r, s, a, b);
     }
 }
 
@@ -633,98 +635,21 @@ unsafe fn run_runs(f: &Function, w: *mut f64) {
 unsafe fn run_steps(f: &Function, w: *mut f64) {
     let r = |k: u32| *w.add(k as usize);
     for s in &f.tape.steps {
-        let (a, b) = (r(s.a), r(s.b));
-        let v = match s.code {
-            Code::Add => add(a, b),
-            Code::Sub => a - b,
-            Code::Mul => mul(a, b),
-            Code::Div => a / b,
-            Code::Neg => -a,
-            Code::Sq => a * a,
-            Code::Sym => a,
-            Code::AddAdd => add(add(a, b), r(s.c)),
-            Code::AddSub => add(a, b) - r(s.c),
-            Code::AddMul => mul(add(a, b), r(s.c)),
-            Code::AddDiv => add(a, b) / r(s.c),
-            Code::SubAdd => add(a - b, r(s.c)),
-            Code::SubSub => a - b - r(s.c),
-            Code::SubMul => mul(a - b, r(s.c)),
-            Code::SubDiv => (a - b) / r(s.c),
-            Code::MulAdd => add(mul(a, b), r(s.c)),
-            Code::MulSub => mul(a, b) - r(s.c),
-            Code::MulMul => mul(mul(a, b), r(s.c)),
-            Code::MulDiv => mul(a, b) / r(s.c),
-            Code::AddAddRev => add(r(s.c), add(a, b)),
-            Code::AddSubRev => r(s.c) - add(a, b),
-            Code::AddMulRev => mul(r(s.c), add(a, b)),
-            Code::AddDivRev => r(s.c) / add(a, b),
-            Code::SubAddRev => add(r(s.c), a - b),
-            Code::SubSubRev => r(s.c) - (a - b),
-            Code::SubMulRev => mul(r(s.c), a - b),
-            Code::SubDivRev => r(s.c) / (a - b),
-            Code::MulAddRev => add(r(s.c), mul(a, b)),
-            Code::MulSubRev => r(s.c) - mul(a, b),
-            Code::MulMulRev => mul(r(s.c), mul(a, b)),
-            Code::MulDivRev => r(s.c) / mul(a, b),
-            Code::Sqrt => a.sqrt(),
-            Code::Exp => a.exp(),
-            Code::Log => a.ln(),
-            Code::Sin => a.sin(),
-            Code::Cos => a.cos(),
-            Code::Tan => a.tan(),
-            Code::Asin => a.asin(),
-            Code::Acos => a.acos(),
-            Code::Atan => a.atan(),
-            Code::Sinh => a.sinh(),
-            Code::Cosh => a.cosh(),
-            Code::Tanh => a.tanh(),
-            Code::Abs => a.abs(),
-            Code::Sign => op::sign(a),
-            Code::Not => f64::from(a == 0.0),
-            Code::Pow => op::pow(a, b),
-            Code::Atan2 => a.atan2(b),
-            Code::Min => a.min(b),
-            Code::Max => a.max(b),
-            Code::Lt => f64::from(a < b),
-            Code::Le => f64::from(a <= b),
-            Code::Eq => f64::from(a == b),
-            Code::Ne => f64::from(a != b),
-            Code::And => f64::from(a != 0.0 && b != 0.0),
-            Code::Or => f64::from(a != 0.0 || b != 0.0),
-            Code::StrongMul => op::strong_mul(a, b),
-            Code::Floor => a.floor(),
-            Code::Ceil => a.ceil(),
-            Code::Erf => libm::erf(a),
-            Code::Asinh => a.asinh(),
-            Code::Acosh => a.acosh(),
-            Code::Atanh => a.atanh(),
-            Code::Log1p => a.ln_1p(),
-            Code::Expm1 => a.exp_m1(),
-            Code::Fmod => a % b,
-            Code::Hypot => a.hypot(b),
-            Code::Interpolant => f.tables.get_unchecked(s.c as usize).eval(&[a]),
-            Code::Interpolant2 => f.tables.get_unchecked(s.c as usize).eval(&[a, b]),
-            Code::InterpolantN => {
-                f.tables
-                    .get_unchecked(s.c as usize)
-                    .eval(std::slice::from_raw_parts(
-                        w.add(s.a as usize),
-                        s.b as usize,
-                    ))
-            }
-            Code::IfElse => {
-                if a != 0.0 {
-                    b
-                } else {
-                    r(s.c)
+        // One dispatch per step: `w[d] = value`.
+        macro_rules! value_by_code {
+            ($s:ident, $a:ident, $b:ident; $($code:ident => $value:expr,)*) => {{
+                #[allow(unused_variables)]
+                let ($a, $b) = (r($s.a), r($s.b));
+                match $s.code {
+                    $(Code::$code => $value,)*
+                    Code::Call => {
+                        f.exec_call(f.calls.get_unchecked($s.d as usize), w);
+                        continue;
+                    }
                 }
-            }
-            Code::Call => {
-                f.exec_call(f.calls.get_unchecked(s.d as usize), w);
-                continue;
-            }
-        };
-        *w.add(s.d as usize) = v;
+            }};
+        }
+        *w.add(s.d as usize) = step_values!(value_by_code, f, w, r, s, a, b);
     }
 }
 
