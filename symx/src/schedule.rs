@@ -153,9 +153,8 @@ pub(crate) fn group(
 
     // Dependencies inside each window: `pending[u]` operands of u computed by other
     // units of its window, and the units reading each unit (`children`, compressed rows
-    // in the order the units read them).
-    // Calls `edge(v, u)` for every operand of unit u computed by another unit v of its
-    // window, in the order u reads them.
+    // in the order the units read them), counted then filled by `each_edge`, which calls
+    // `edge(v, u)` for every operand of unit u computed by another unit v of its window.
     let each_edge = |edge: &mut dyn FnMut(usize, usize)| {
         for (u, &q) in units.iter().enumerate() {
             let q = q as usize;
