@@ -107,6 +107,35 @@ fn value_rejects_symbols_of_other_problems_and_wrong_solutions() {
     ));
 }
 
+/// A symbol that is neither a variable nor a parameter is named with where it is
+/// used: in the objective, or in which constraint (the bulk compilation does not say).
+#[test]
+fn compile_names_the_expression_with_a_free_symbol() {
+    let (mut pb, x, _) = projection();
+    let stranger = Expr::sym("q");
+    pb.subject_to_named("tilt", (x[0] - stranger).le(2.0)).unwrap();
+    assert_eq!(
+        pb.compile().unwrap_err(),
+        BuildError::FreeSymbol {
+            location: "constraint 'tilt'".into(),
+            name: "q".into()
+        }
+    );
+    let (mut pb, x, _) = projection();
+    pb.minimize(x[0] * Expr::sym("r"));
+    pb.subject_to_named("tilt", (x[0] - Expr::sym("q")).le(2.0)).unwrap();
+    let err = pb.compile().unwrap_err();
+    assert_eq!(
+        err,
+        BuildError::FreeSymbol {
+            location: "the objective".into(),
+            name: "r".into()
+        },
+        "the objective is checked first"
+    );
+    assert!(err.to_string().contains("'r'"), "{err}");
+}
+
 // ---- parameters ----
 
 #[test]

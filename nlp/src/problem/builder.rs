@@ -583,7 +583,16 @@ impl Problem {
     pub fn compile(&self) -> Result<Compiled, BuildError> {
         let params = self.parameter_vector_or_unset();
         let f = self.objective();
-        // Name the culprit of a free symbol before the bulk compilation.
+        self.parts()
+            .and_then(|parts| Compiled::new(parts, f, params))
+            .map_err(|e| self.culprit(f).err().unwrap_or(e))
+    }
+
+    /// Why a compilation failed, when an expression fails on its own: the objective's
+    /// error, or a free symbol of the constraints named with its constraint. Run only
+    /// after a failure (each check compiles its expressions once more); `Ok` when every
+    /// expression compiles on its own.
+    fn culprit(&self, f: Expr) -> Result<(), BuildError> {
         self.function(&[f], "the objective")?;
         let written: Vec<Expr> = self.rows.iter().map(|r| r.expr).collect();
         if let Err(e @ BuildError::FreeSymbol { .. }) = self.function(&written, "constraints") {
@@ -593,7 +602,7 @@ impl Problem {
             }
             return Err(e);
         }
-        Compiled::new(self.parts()?, f, params)
+        Ok(())
     }
 
     /// As [`Problem::compile`], with options: e.g. native evaluators, so that every solver
