@@ -7,6 +7,9 @@
 //!   0), n_step 60, goals 3 m ahead (the default goals) — the problem that
 //!   `benches/reference/gap_crossing_casadi.py` solves with IPOPT; `solve` is the IPM call
 //!   only, `total` adds guess, build and compile (fresh thread);
+//! * `gap_crossing/crawl_gap60_build_compile`: guess, build and compile (`Problem::compile`:
+//!   derivatives and tapes) of the default scenario's crawl problem, n_step 60, in a fresh
+//!   expression arena: what each of the planner's solves pays before its first iteration;
 //! * `gap_crossing_scaling/crawl_gap/N`: crawl gait on the default gap, IPM call only, for
 //!   n_step in `GAP_CROSSING_SIZES` (comma-separated, default `30,60,120`; the larger sizes
 //!   240 and 480 are measured once by `examples/scaling.rs`).
@@ -95,6 +98,11 @@ fn bench(c: &mut Criterion) {
         g.bench_function("crawl_flat60_solve", |b| crawl_solve_only(b, &flat));
         g.bench_function("crawl_flat60_total", |b| {
             b.iter(|| assert!(crawl_total(&flat)))
+        });
+        g.bench_function("crawl_gap60_build_compile", |b| {
+            b.iter(|| {
+                symx::with_fresh_arena(|| black_box(crawl_model(&default).expect("model builds").1))
+            })
         });
         g.finish();
     }

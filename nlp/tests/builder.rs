@@ -113,7 +113,8 @@ fn value_rejects_symbols_of_other_problems_and_wrong_solutions() {
 fn compile_names_the_expression_with_a_free_symbol() {
     let (mut pb, x, _) = projection();
     let stranger = Expr::sym("q");
-    pb.subject_to_named("tilt", (x[0] - stranger).le(2.0)).unwrap();
+    pb.subject_to_named("tilt", (x[0] - stranger).le(2.0))
+        .unwrap();
     assert_eq!(
         pb.compile().unwrap_err(),
         BuildError::FreeSymbol {
@@ -123,7 +124,8 @@ fn compile_names_the_expression_with_a_free_symbol() {
     );
     let (mut pb, x, _) = projection();
     pb.minimize(x[0] * Expr::sym("r"));
-    pb.subject_to_named("tilt", (x[0] - Expr::sym("q")).le(2.0)).unwrap();
+    pb.subject_to_named("tilt", (x[0] - Expr::sym("q")).le(2.0))
+        .unwrap();
     let err = pb.compile().unwrap_err();
     assert_eq!(
         err,
