@@ -35,6 +35,7 @@
 //! - [`strict_json`]: JSON parsing that rejects duplicate keys.
 
 pub mod check;
+pub mod console;
 pub mod convergence;
 pub mod crossing;
 pub mod crossing_search;

@@ -18,6 +18,7 @@ use gap_crossing::scenario::{Gait, Scenario, ScenarioError};
 use gap_crossing::shard::{self, Shard, ShardError, ShardFile};
 use gap_crossing::solve::{self, Backend, PlanningError, Settings};
 use gap_crossing::sweep::{self, Grid, GridError, PointResult};
+use gap_crossing::{errln, outln};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -312,7 +313,7 @@ fn solve_or_clear(a: &SolveArgs) -> Result<ExitCode, CliError> {
         }
         let removed = output::remove_files(&a.out, &SOLVE_FILES);
         if !removed.is_empty() {
-            eprintln!(
+            errln!(
                 "removed the earlier results in {}: {}",
                 a.out.display(),
                 removed.join(", ")
@@ -370,7 +371,7 @@ fn report(outcome: &solve::Outcome, out: &Path) -> Result<ExitCode, CliError> {
     )?;
     if !outcome.status.is_solved() {
         let kind = outcome.status.kind();
-        eprintln!(
+        errln!(
             "error: no valid plan: status {kind} (exit code {}): {}",
             kind.exit_code(),
             outcome.status
@@ -378,9 +379,9 @@ fn report(outcome: &solve::Outcome, out: &Path) -> Result<ExitCode, CliError> {
         // A certificate decided before solving: the file holds the guess, whose
         // violations say nothing more.
         if !report.ok() && !kind.is_proved_impossible() {
-            eprintln!("checker: {report}");
+            errln!("checker: {report}");
         }
-        eprintln!(
+        errln!(
             "wrote {}/solution.json with status {kind} (not a valid plan) and its drawings",
             out.display()
         );
@@ -388,30 +389,33 @@ fn report(outcome: &solve::Outcome, out: &Path) -> Result<ExitCode, CliError> {
     }
 
     let moves = foot_moves(&file.plan());
-    println!();
+    outln!();
     for phase in &outcome.phases {
-        println!(
+        outln!(
             "  {:<42} {:?}, {} iterations, (10) residual {:.1e}",
-            phase.name, phase.status, phase.iterations, phase.complementarity
+            phase.name,
+            phase.status,
+            phase.iterations,
+            phase.complementarity
         );
     }
-    println!("status:     {} ({} gait)", file.solver.status, s.gait);
-    println!("objective:  {:.6e}", file.solver.objective);
+    outln!("status:     {} ({} gait)", file.solver.status, s.gait);
+    outln!("objective:  {:.6e}", file.solver.objective);
     if let Some(r) = file.solver.objective_without_10 {
-        println!(
+        outln!(
             "reference:  {r:.6e} without (10) (every foot free at every transition; what (10) costs: {:.1} %)",
             100.0 * (file.solver.objective - r) / file.solver.objective
         );
     }
-    println!(
+    outln!(
         "steps:      {} of {} transitions move a foot; moves per foot: {}",
         report.moves,
         s.n_step - 1,
         moves
     );
-    println!("time:       {:.3} s", file.solver.solve_seconds);
-    println!("checker:    {}", report.summary());
-    println!(
+    outln!("time:       {:.3} s", file.solver.solve_seconds);
+    outln!("checker:    {}", report.summary());
+    outln!(
         "wrote {}/{{solution.json, plan.svg, plan.html, convergence.svg, convergence.json}}",
         out.display()
     );
@@ -542,7 +546,7 @@ fn sweep(a: &SweepArgs) -> Result<ExitCode, CliError> {
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64();
     for e in save_errors.into_inner().unwrap_or_default() {
-        eprintln!("warning: {e}");
+        errln!("warning: {e}");
     }
 
     let files = write_sweep(&a.out, a.shard, &grid, &results, wall, threads)?;
@@ -560,7 +564,7 @@ fn announce_sweep(grid: &Grid, shard: Option<Shard>, threads: usize) -> usize {
     let of = shard.map_or(String::new(), |sh| {
         format!(" of shard {}/{}", sh.index, sh.count)
     });
-    eprintln!(
+    errln!(
         "sweep: {n} points{of} ({}) on {threads} threads",
         if axes.is_empty() {
             "no axes: the base scenario".to_string()
@@ -613,7 +617,7 @@ fn write_sweep(
 fn sweep_merge(a: &MergeArgs) -> Result<ExitCode, CliError> {
     let files = shard::find(&a.dirs)?;
     let merged = shard::merge(shard::read(&files)?)?;
-    eprintln!("sweep merge: {} shard files", files.len());
+    errln!("sweep merge: {} shard files", files.len());
     let written = sweep::write_outputs(
         &a.out,
         &merged.grid,
@@ -644,9 +648,13 @@ fn report_sweep(
     for (ax, w) in grid.axes.iter().zip(&widths) {
         head += &format!("  {:>w$}", ax.key);
     }
-    println!(
+    outln!(
         "{head}  {:<22} {:>6} {:>13} {:>6} {:>8}",
-        "status", "check", "objective", "iter", "time"
+        "status",
+        "check",
+        "objective",
+        "iter",
+        "time"
     );
     for r in results {
         let mut line = format!("{:>5}", r.index);
@@ -664,16 +672,17 @@ fn report_sweep(
         };
         let obj = r.objective.map(|o| format!("{o:.6e}")).unwrap_or_default();
         let it = r.iterations.map(|i| i.to_string()).unwrap_or_default();
-        println!(
+        outln!(
             "{line}  {:<22} {check:>6} {obj:>13} {it:>6} {:>7.2}s",
-            r.status, r.seconds
+            r.status,
+            r.seconds
         );
         if let Some(e) = &r.error {
-            println!("       {e}");
+            outln!("       {e}");
         }
     }
     let ok = results.iter().filter(|r| r.ok()).count();
-    println!(
+    outln!(
         "sweep: {ok} of {} points solved and checked, {:.1} s wall on {threads} threads",
         results.len(),
         wall
@@ -682,8 +691,8 @@ fn report_sweep(
         .into_iter()
         .map(|(k, n)| format!("{k} {n}"))
         .collect();
-    println!("outcomes: {}", by_status.join(", "));
-    println!(
+    outln!("outcomes: {}", by_status.join(", "));
+    outln!(
         "wrote {}",
         files
             .iter()
@@ -719,7 +728,7 @@ fn check_cmd(a: &CheckArgs) -> Result<ExitCode, CliError> {
             ..Options::default()
         },
     );
-    println!("{report}");
+    outln!("{report}");
     Ok(if report.ok() {
         ExitCode::SUCCESS
     } else {
@@ -777,7 +786,7 @@ fn render_cmd(a: &RenderArgs) -> Result<ExitCode, CliError> {
         files.push(("convergence.svg", svg.as_bytes()));
     }
     for p in output::write_all(&dir, &files)? {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -815,7 +824,7 @@ fn guess_cmd(a: &GuessArgs) -> Result<ExitCode, CliError> {
         ],
     )?;
     let (json, svg) = (&written[0], &written[1]);
-    println!(
+    outln!(
         "wrote {} and {} ({name} guess, cost {:.4e}); checker: {}",
         json.display(),
         svg.display(),
@@ -843,7 +852,7 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             ExitCode::from(2)
         }
     }

@@ -413,13 +413,13 @@ fn solve_scheduled_here(
 pub(crate) fn record(solved: Solved, settings: &Settings, phases: &mut Vec<Phase>) -> Run {
     let level = settings.print_level();
     if level > 0 {
-        println!("\n== {}", solved.name);
+        crate::outln!("\n== {}", solved.name);
     }
     if level >= 5 {
-        print!("{}", nlp::format_table(&solved.phase.records));
+        crate::out!("{}", nlp::format_table(&solved.phase.records));
     }
     if level >= 3 {
-        print!("{}", nlp::format_summary(&solved.run.solution));
+        crate::out!("{}", nlp::format_summary(&solved.run.solution));
     }
     phases.push(solved.phase);
     Run {

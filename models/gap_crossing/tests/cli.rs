@@ -2,6 +2,7 @@
 
 use gap_crossing::status::StatusKind;
 use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
 
 mod common;
 use common::run;
@@ -617,4 +618,49 @@ fn failed_solves_leave_no_stale_result() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("removed the earlier results"));
     assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 0);
+}
+
+/// Standard output closed before anything is printed (`gap-crossing | head -1` once
+/// `head` has exited): every write to it fails, yet the solve writes its files and exits
+/// with its status, without a panic (it used to exit 101 with no files written); `check`
+/// likewise.
+#[test]
+fn a_closed_standard_output_stops_nothing() {
+    let d = tmp("closed_stdout");
+    let out_dir = d.join("out");
+    let spawn = |args: &[&str]| {
+        let mut child = Command::new(common::BIN)
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("binary runs");
+        // The reader is gone before the first write: each write fails with EPIPE.
+        drop(child.stdout.take());
+        child.wait_with_output().expect("binary ends")
+    };
+    let out = spawn(&[
+        "solve",
+        "--gait",
+        "crawl",
+        "--set",
+        "n_step=12",
+        "--set",
+        "goal.B=[0.5, 0.5, 0.5]",
+        "--set",
+        "goal.F=[2.5, 0.5, 0.5]",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(
+        !text(&out.stderr).contains("panicked"),
+        "{}",
+        text(&out.stderr)
+    );
+    let sol = out_dir.join("solution.json");
+    assert!(sol.exists(), "solution.json missing");
+    let out = spawn(&["check", sol.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(out.stderr.is_empty(), "{}", text(&out.stderr));
 }
