@@ -124,6 +124,27 @@ fn selected(sel: &Selection) -> Result<Vec<(Instance, nlp::Problem)>, CorpusErro
     Ok(out)
 }
 
+/// `println!` for a stream of results that never panics: when standard output is
+/// closed (`corpus list | head`) the reader wants no more, so the command ends quietly
+/// (exit 0); any other failure to write ends it with the error (exit 2).
+macro_rules! emit {
+    ($($arg:tt)*) => {{
+        use std::io::Write;
+        if let Err(e) = writeln!(std::io::stdout().lock(), $($arg)*) {
+            stdout_failed(e);
+        }
+    }};
+}
+
+/// Ends the process after a failed write to standard output (see `emit!`).
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("corpus: standard output: {e}");
+    std::process::exit(2);
+}
+
 fn main() -> ExitCode {
     match real_main() {
         Ok(()) => ExitCode::SUCCESS,
@@ -144,7 +165,7 @@ fn real_main() -> Result<(), CorpusError> {
                     "n": pb.n_variables(), "m": pb.n_constraints(), "source": inst.family.source,
                     "reference": inst.reference().map(|r| r.value),
                 });
-                println!("{line}");
+                emit!("{line}");
             }
         }
         Command::Solve {
@@ -157,7 +178,7 @@ fn real_main() -> Result<(), CorpusError> {
                     "{}: {} in {} iterations, f = {:.10e}",
                     outcome.instance, outcome.status, outcome.iterations, outcome.objective
                 );
-                println!("{}", serde_json::to_string(&outcome).expect("serialisable"));
+                emit!("{}", serde_json::to_string(&outcome).expect("serialisable"));
             }
         }
         Command::Export {
@@ -181,7 +202,7 @@ fn real_main() -> Result<(), CorpusError> {
                 );
                 d.symnlp = Some(outcome);
             }
-            println!("{}", serde_json::to_string(&d).expect("serialisable"));
+            emit!("{}", serde_json::to_string(&d).expect("serialisable"));
         }
         Command::Diagnose {
             names,
@@ -197,7 +218,7 @@ fn real_main() -> Result<(), CorpusError> {
                 let sol = nlp::Ipm::new(options).solve(&mut compiled)?;
                 let d = corpus::diagnose::diagnose(&sol);
                 let line = serde_json::json!({"instance": name, "status": format!("{:?}", sol.status), "diagnosis": d});
-                println!("{line}");
+                emit!("{line}");
             }
         }
         Command::Trace {
@@ -255,8 +276,8 @@ fn real_main() -> Result<(), CorpusError> {
             for kind in ["Ocp", "Cute"] {
                 let part: Vec<_> = rows.iter().filter(|r| r.kind == kind).cloned().collect();
                 let (total, ours, theirs, same, lost, slow, gmean) = profile::summary(&part);
-                println!("\n**{kind}**: {total} instances; symnlp solves {ours}, IPOPT {theirs}; both to the same objective (1e-6): {same}; symnlp fails where IPOPT succeeds: {lost}; symnlp > 2x IPOPT's iterations: {slow}; geometric-mean iteration ratio (both solved): {gmean:.2}\n");
-                println!("{}", profile::table(&part));
+                emit!("\n**{kind}**: {total} instances; symnlp solves {ours}, IPOPT {theirs}; both to the same objective (1e-6): {same}; symnlp fails where IPOPT succeeds: {lost}; symnlp > 2x IPOPT's iterations: {slow}; geometric-mean iteration ratio (both solved): {gmean:.2}\n");
+                emit!("{}", profile::table(&part));
             }
         }
     }
@@ -290,7 +311,7 @@ fn trace(
     }
     let sol = nlp::Ipm::new(options).solve(&mut compiled)?;
     for r in &sol.stats.records {
-        println!("{}", serde_json::to_string(r).expect("serialisable"));
+        emit!("{}", serde_json::to_string(r).expect("serialisable"));
     }
     let mut line = serde_json::json!({"instance": name, "perturb": perturb,
         "status": format!("{:?}", sol.status), "iterations": sol.stats.iterations,
@@ -298,6 +319,6 @@ fn trace(
     if print_x {
         line["x"] = serde_json::json!(sol.x);
     }
-    println!("{line}");
+    emit!("{line}");
     Ok(())
 }
