@@ -4,6 +4,22 @@ use std::fmt::Write;
 
 use crate::solution::{BackendColumns, IterationRecord, Solution};
 
+/// Writes solver log text to standard output, best effort: when it is closed or fails
+/// (the program's output piped into `head`, a closed terminal) the text is dropped and
+/// the solve goes on; `print!` would panic mid-solve (use [`log_out!`](crate::log_out)).
+pub(crate) fn write_out(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let _ = std::io::stdout().lock().write_fmt(args);
+}
+
+/// `println!` for the solvers' logs that never panics ([`write_out`]).
+macro_rules! log_out {
+    ($($arg:tt)*) => {
+        $crate::log::write_out(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+pub(crate) use log_out;
+
 /// The header line of a table of rows with columns `backend`: IPOPT's layout, the fifth
 /// column the back end's own (`lg(mu)`: log10 μ of the interior point; `lg(ra)`: log10 ρ_a
 /// of the SQP, "-" when 0). `lg(rg)` is log10 of the Hessian regularisation, `alpha_du`

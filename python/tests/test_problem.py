@@ -229,3 +229,38 @@ def test_unpickled_problem_is_rebuilt_in_the_thread_that_uses_it():
     other = box["pb"]  # unpickled on thread t, used here
     assert other.solve().objective == want
     assert other.n_variables == 4
+
+
+CLOSED_STDOUT = '''
+import symnlp as s
+pb = s.Problem()
+x = pb.variable("x", 2)
+pb.minimize((1 - x[0]) ** 2 + 100 * (x[1] - x[0] ** 2) ** 2)
+pb.subject_to(x[0] ** 2 + x[1] ** 2 <= 1.5)
+pb.set_initial(x, [-1.2, 1.0])
+for solver in ("ipm", "sqp"):
+    sol = pb.solve(solver=solver, options={"print_level": 5})
+    assert sol.success, solver
+    open(OUT + "_" + solver, "w").write(repr(sol.objective))
+'''
+
+
+def test_a_closed_standard_output_does_not_stop_a_logging_solve(tmp_path):
+    """The solvers' log (print_level 5) written to a standard output whose reader is
+    gone (the program piped into ``head``): the log is dropped, the solves end normally.
+    The log used to be printed with Rust's ``println!``, which panics there."""
+    import subprocess
+    import sys
+
+    out = str(tmp_path / "objective")
+    child = subprocess.Popen(
+        [sys.executable, "-c", f"OUT = {out!r}\n" + CLOSED_STDOUT],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    child.stdout.close()  # before the first write: every write fails with EPIPE
+    _, err = child.communicate(timeout=120)
+    assert child.returncode == 0, err.decode()
+    for solver in ("ipm", "sqp"):
+        # Rosenbrock in the disc x² + y² ≤ 1.5 (README's example): a finite optimum.
+        assert float(open(out + "_" + solver).read()) < 1.0

@@ -49,9 +49,9 @@ pub(crate) fn conclude(
         (stats.total_seconds - stats.eval_seconds - stats.factor_seconds).max(0.0);
     sol.stats = stats;
     if print_level >= 3 {
-        print!("{}", crate::log::format_summary(sol));
+        crate::log::write_out(format_args!("{}", crate::log::format_summary(sol)));
         if !sol.message.is_empty() {
-            println!("{}", sol.message);
+            crate::log::log_out!("{}", sol.message);
         }
     }
 }

@@ -262,12 +262,13 @@ impl Sqp {
             o.print_level,
         );
         if o.print_level >= 3 {
-            println!(
+            crate::log::log_out!(
                 "Polished QP solutions: {} of {}",
-                s.work.n_polished, s.work.n_qp
+                s.work.n_polished,
+                s.work.n_qp
             );
             let [shape, eq, cycle, limit, penalty] = s.work.active_set_failures;
-            println!(
+            crate::log::log_out!(
                 "Active-set QPs: {} solved; handed to clarabel: shape {shape}, equality QP \
                  {eq}, cycle {cycle}, iteration limit {limit}, penalty {penalty}",
                 s.work.n_active_set
@@ -349,7 +350,7 @@ fn iterate(
 fn print_penalty_line(s: &SqpState<'_>, res: &qp::QpResult) {
     let max_abs = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     let e_sum: f64 = res.e.iter().map(|v| v.max(0.0)).sum();
-    println!(
+    crate::log::log_out!(
         "      rho {:.2e}  max|lambda| Hessian {:.2e}  QP {:.2e}  sum e {:.2e}",
         s.rho,
         max_abs(&s.it.mult.lambda),

@@ -368,9 +368,9 @@ impl<'a> SqpState<'a> {
         self.stats.records.push(self.record);
         if o.print_level >= 5 {
             if iter % 10 == 0 {
-                println!("{}", crate::log::header(&self.record.backend));
+                crate::log::log_out!("{}", crate::log::header(&self.record.backend));
             }
-            println!("{}", crate::log::format_record(&self.record));
+            crate::log::log_out!("{}", crate::log::format_record(&self.record));
         }
         if let Some(obs) = observer {
             let (l, cones) = (&it.mult.lambda, &self.geo.cones);

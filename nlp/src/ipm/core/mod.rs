@@ -325,9 +325,9 @@ impl<'p> Core<'p> {
         }
         if let (true, Some(rec)) = (self.opts.print_level >= 5, shared.stats.records.last()) {
             if shared.stats.records.len() % 10 == 1 {
-                println!("{}", crate::log::header(&rec.backend));
+                crate::log::log_out!("{}", crate::log::header(&rec.backend));
             }
-            println!("{}", crate::log::format_record(rec));
+            crate::log::log_out!("{}", crate::log::format_record(rec));
         }
     }
 
