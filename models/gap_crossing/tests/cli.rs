@@ -137,19 +137,8 @@ fn check_errors_exit_2_with_the_reason() {
 fn solve_writes_a_plan_that_check_accepts() {
     let d = tmp("solve");
     let out_dir = d.join("out");
-    let out = run(&[
-        "solve",
-        "--gait",
-        "crawl",
-        "--set",
-        "n_step=12",
-        "--set",
-        "goal.B=[0.5, 0.5, 0.5]",
-        "--set",
-        "goal.F=[2.5, 0.5, 0.5]",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
+    let args = common::small_crawl_solve(&out_dir);
+    let out = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     for f in [
         "solution.json",
@@ -628,7 +617,7 @@ fn failed_solves_leave_no_stale_result() {
 fn a_closed_standard_output_stops_nothing() {
     let d = tmp("closed_stdout");
     let out_dir = d.join("out");
-    let spawn = |args: &[&str]| {
+    let spawn = |args: &[String]| {
         let mut child = Command::new(common::BIN)
             .args(args)
             .stdout(Stdio::piped())
@@ -639,19 +628,7 @@ fn a_closed_standard_output_stops_nothing() {
         drop(child.stdout.take());
         child.wait_with_output().expect("binary ends")
     };
-    let out = spawn(&[
-        "solve",
-        "--gait",
-        "crawl",
-        "--set",
-        "n_step=12",
-        "--set",
-        "goal.B=[0.5, 0.5, 0.5]",
-        "--set",
-        "goal.F=[2.5, 0.5, 0.5]",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
+    let out = spawn(&common::small_crawl_solve(&out_dir));
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(
         !text(&out.stderr).contains("panicked"),
@@ -660,7 +637,7 @@ fn a_closed_standard_output_stops_nothing() {
     );
     let sol = out_dir.join("solution.json");
     assert!(sol.exists(), "solution.json missing");
-    let out = spawn(&["check", sol.to_str().unwrap()]);
+    let out = spawn(&["check".to_string(), sol.to_str().unwrap().to_string()]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(out.stderr.is_empty(), "{}", text(&out.stderr));
 }

@@ -62,37 +62,13 @@ fn failed_solve_output_leaves_the_directory_untouched() {
     std::fs::write(d.join("solution.json"), "old solution").unwrap();
     std::fs::create_dir(d.join("plan.svg")).unwrap();
     let before = listing(&d);
-    let out = run(&[
-        "solve",
-        "--out",
-        s(&d),
-        "--set",
-        "n_step=12",
-        "--set",
-        "goal.B=[0.5, 0.5, 0.5]",
-        "--set",
-        "goal.F=[2.5, 0.5, 0.5]",
-        "--gait",
-        "crawl",
-    ]);
+    let out = run(&common::small_crawl_solve(&d));
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     assert!(text(&out).contains("plan.svg"), "{}", text(&out));
     assert_eq!(listing(&d), before);
     // With the obstacle gone the same run writes every file.
     std::fs::remove_dir(d.join("plan.svg")).unwrap();
-    let out = run(&[
-        "solve",
-        "--out",
-        s(&d),
-        "--set",
-        "n_step=12",
-        "--set",
-        "goal.B=[0.5, 0.5, 0.5]",
-        "--set",
-        "goal.F=[2.5, 0.5, 0.5]",
-        "--gait",
-        "crawl",
-    ]);
+    let out = run(&common::small_crawl_solve(&d));
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     let names: Vec<String> = listing(&d).into_iter().map(|(n, _)| n).collect();
     assert_eq!(
