@@ -193,6 +193,20 @@ fn overrides_use_dotted_paths() {
     assert!(e.contains("gap.minn"), "{e}");
     let e = s.apply_overrides(&["gap.min"]).unwrap_err().to_string();
     assert!(e.contains("key=value"), "{e}");
+    // Beyond f64's range: named as such, not taken for text.
+    let e = s
+        .apply_overrides(&["gap.min=1e400"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("gap.min") && e.contains("finite") && e.contains("range"),
+        "{e}"
+    );
+    let e = s
+        .apply_overrides(&["gap.min=-1e999"])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("range"), "{e}");
 }
 
 #[test]

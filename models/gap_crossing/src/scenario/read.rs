@@ -395,7 +395,8 @@ fn toml_to_json(v: toml::Value, path: &str) -> Result<Value, ScenarioError> {
     })
 }
 
-/// Parses the value of a `--set`: a TOML value, or bare text when it is not one.
+/// Parses the value of a `--set`: a TOML value, or bare text when it is not one; a
+/// number beyond f64's range (`1e400`, which TOML rejects) is an error, not text.
 fn parse_toml_value(s: &str, key: &str) -> Result<Value, ScenarioError> {
     let doc = format!("v = {s}");
     match toml::from_str::<toml::Table>(&doc) {
@@ -403,7 +404,16 @@ fn parse_toml_value(s: &str, key: &str) -> Result<Value, ScenarioError> {
             Some(v) => toml_to_json(v, key),
             None => Ok(Value::String(s.to_string())),
         },
-        Err(_) => Ok(Value::String(s.to_string())),
+        Err(_) => match s.trim().parse::<f64>() {
+            Ok(f) if f.is_infinite() && s.bytes().any(|b| b.is_ascii_digit()) => {
+                Err(ScenarioError::WrongType {
+                    field: key.to_string(),
+                    expected: "a finite number".into(),
+                    found: format!("{} (beyond the range of a 64-bit float)", s.trim()),
+                })
+            }
+            _ => Ok(Value::String(s.to_string())),
+        },
     }
 }
 
