@@ -106,8 +106,10 @@ impl<E> Step<E> {
     }
 }
 
-fn finite(v: f64) -> Option<f64> {
-    v.is_finite().then_some(v)
+/// A row bound as stored: `None` for ±∞ (no bound); NaN is kept, so that the builder
+/// rejects it naming the constraint (it used to become "no bound", silently).
+fn row_bound(v: f64) -> Option<f64> {
+    (!v.is_infinite()).then_some(v)
 }
 
 /// An optimisation problem built symbolically (CasADi's `Opti`): variables, parameters,
@@ -512,7 +514,7 @@ impl PyProblem {
                 .zip(c.lower_bounds())
                 .zip(c.upper_bounds())
             {
-                rows.push((e, finite(l), finite(u)));
+                rows.push((e, row_bound(l), row_bound(u)));
             }
         }
         self.apply(Step::Constraint { name, rows })

@@ -264,3 +264,19 @@ def test_a_closed_standard_output_does_not_stop_a_logging_solve(tmp_path):
     for solver in ("ipm", "sqp"):
         # Rosenbrock in the disc x² + y² ≤ 1.5 (README's example): a finite optimum.
         assert float(open(out + "_" + solver).read()) < 1.0
+
+
+def test_a_nan_bound_is_an_error_naming_the_constraint():
+    """``x <= nan`` used to become "no bound" and the solve succeeded without it."""
+    pb = s.Problem()
+    x = pb.variable("x", 2)
+    pb.minimize((x[0] - 1) ** 2 + (x[1] - 2) ** 2)
+    with pytest.raises(s.BuildError, match="cap"):
+        pb.subject_to(x[0] <= float("nan"), name="cap")
+    with pytest.raises(s.BuildError, match="NaN"):
+        pb.subject_to(x >= float("nan"))
+    # Infinite bounds still mean "no bound" (IPOPT's convention).
+    pb.subject_to(x[0] + x[1] <= float("inf"))
+    sol = pb.solve()
+    assert sol.success
+    np.testing.assert_allclose(sol.value(x), [1.0, 2.0], atol=1e-6)
