@@ -463,8 +463,6 @@ mod tests {
         );
     }
 
-    /// A product read once by a sum is fused with it wherever the regrouping puts them:
-    /// four independent `a·b + c` are four fused steps (one kind, one run).
     /// The ready sets give each kind's offsets lowest first, as a sorted set does, across
     /// summary words and interleaved with insertions.
     #[test]
@@ -494,6 +492,8 @@ mod tests {
         }
     }
 
+    /// A product read once by a sum is fused with it wherever the regrouping puts them:
+    /// four independent `a·b + c` are four fused steps (one kind, one run).
     #[test]
     fn fusable_pairs_stay_adjacent() {
         let x: Vec<Expr> = (0..6).map(|k| Expr::sym(&format!("x{k}"))).collect();

@@ -6,27 +6,14 @@ use gap_crossing::status::StatusKind;
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+
 fn solve(solver: &str, dir: &Path) -> SolutionFile {
     let _ = std::fs::remove_dir_all(dir);
-    let out = Command::new(env!("CARGO_BIN_EXE_gap-crossing"))
-        .args([
-            "solve",
-            "--solver",
-            solver,
-            "--gait",
-            "crawl",
-            "--set",
-            "n_step=12",
-            // Goals 0.5 m ahead (the front feet cross the gap): reachable in 12 stances.
-            "--set",
-            "goal.B=[0.5, 0.5, 0.5]",
-            "--set",
-            "goal.F=[2.5, 0.5, 0.5]",
-            "--out",
-            dir.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    // Goals 0.5 m ahead (the front feet cross the gap): reachable in 12 stances.
+    let mut args = common::small_crawl_solve(dir);
+    args.extend(["--solver".to_string(), solver.to_string()]);
+    let out = common::run(&args);
     assert!(
         out.status.success(),
         "{solver}: {}\n{}",

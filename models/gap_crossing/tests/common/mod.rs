@@ -1,5 +1,7 @@
-//! What the binary's integration tests share: running `gap-crossing` and a fresh
-//! scratch directory per test.
+//! What the binary's integration tests share: running `gap-crossing`, a fresh scratch
+//! directory per test, the arguments of a small solve. Each test file that includes this
+//! module uses part of it.
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -22,8 +24,7 @@ pub fn fresh_dir(tag: &str, name: &str) -> PathBuf {
 
 /// The arguments of `solve` for a small crawl plan writing to `out`: n_step 12 with
 /// goals 0.5 m ahead (the front feet cross the gap), solved in a few hundredths of a
-/// second. (Not every test file that includes this module uses it.)
-#[allow(dead_code)]
+/// second.
 pub fn small_crawl_solve(out: &Path) -> Vec<String> {
     [
         "solve",
